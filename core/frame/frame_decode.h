@@ -1,0 +1,62 @@
+#ifndef FOVEA_CORE_FRAME_FRAME_DECODE_H_
+#define FOVEA_CORE_FRAME_FRAME_DECODE_H_
+
+#include <cstdint>
+#include <string_view>
+
+#include "absl/status/statusor.h"
+#include "core/frame/rgbd_frame.h"
+
+namespace fovea {
+
+// One image as it arrives on the wire, shaped like ROS sensor_msgs/Image.
+// Non-owning: the views must outlive the call that reads them.
+//   Raw form: `data` holds height rows of `step` bytes; `encoding` is
+//     "rgb8"/"bgr8" (colour) or "16UC1"/"32FC1" (depth), little-endian.
+//   Compressed form: `compressed` holds a PNG (colour or 16-bit depth) or a
+//     JPEG (colour) file; width/height/step/encoding may then be 0/empty,
+//     and when set must agree with the file.
+struct RawImage {
+  uint32_t width = 0;
+  uint32_t height = 0;
+  std::string_view encoding;
+  bool is_bigendian = false;
+  uint32_t step = 0;
+  std::string_view data;
+  std::string_view compressed;
+};
+
+struct RawFrame {
+  RawImage color;
+  RawImage depth;
+  Intrinsics intrinsics;
+  double depth_scale = 0.0;  // metres per 16-bit depth unit; 0 means 0.001
+};
+
+struct FrameLimits {
+  uint32_t max_width = 1920;   // pixels; larger frames are refused
+  uint32_t max_height = 1080;  // pixels; larger frames are refused
+};
+
+absl::Status Validate(const FrameLimits& limits);
+
+// Validates and decodes a frame. Every size is checked against `limits`
+// before any pixel buffer is allocated (for compressed images, from the
+// PNG/JPEG header). Errors are INVALID_ARGUMENT and name the field with
+// the wire's names, e.g. "frame.color.step: 1000 is less than width * 3 =
+// 1920". Refused: size or step mismatch, unknown or big-endian encoding,
+// colour and depth of different sizes, zero/negative/non-finite
+// intrinsics, non-finite or non-positive depth_scale, a frame above the
+// limits, no valid depth pixel, undecodable PNG/JPEG.
+// On success the depth is in metres with NaN for no data (0, NaN and
+// non-finite or negative values all become NaN).
+absl::StatusOr<RgbdFrame> DecodeFrame(const RawFrame& raw,
+                                      const FrameLimits& limits);
+
+// Checks intrinsics alone; `field` prefixes the message ("frame.intrinsics").
+absl::Status ValidateIntrinsics(const Intrinsics& intrinsics,
+                                std::string_view field);
+
+}  // namespace fovea
+
+#endif  // FOVEA_CORE_FRAME_FRAME_DECODE_H_

@@ -1,0 +1,105 @@
+#ifndef FOVEA_CORE_PIPELINE_DETECT_H_
+#define FOVEA_CORE_PIPELINE_DETECT_H_
+
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "absl/status/statusor.h"
+#include "core/attention/attention_point.h"
+#include "core/attention/msr.h"
+#include "core/frame/organized_cloud.h"
+#include "core/frame/rgbd_frame.h"
+#include "core/frame/support_plane.h"
+#include "core/frame/table_scene.h"
+#include "core/saliency/ph.h"
+#include "core/saliency/rso.h"
+#include "core/saliency/sh.h"
+
+namespace fovea {
+
+// Saliency channels. Names (SaliencyOpName) are the command-line and
+// metric names.
+enum class SaliencyOp {
+  kPh, kSh, kRso, kSym3d, kItti, kHarel, kHou, kKootstra, kTargetColor,
+  kLocationPrior,
+};
+enum class PyramidKind { kNone, kSimple, kItti };
+enum class LevelCombination { kSum, kMax };
+enum class NormalizationKind { kLin, kNms, kNlm };
+enum class FusionKind { kSum, kMax };
+enum class ExtractionKind { kMsr, kWta, kTj };
+
+std::string_view SaliencyOpName(SaliencyOp op);          // "ph", "sym3d", ...
+std::string_view ExtractionName(ExtractionKind kind);    // "msr", "wta", "tj"
+// Parses "ph", "ph+sh+rso", ... into equally weighted channels.
+absl::StatusOr<std::vector<SaliencyOp>> ParseSaliencyOps(std::string_view text);
+absl::StatusOr<ExtractionKind> ParseExtraction(std::string_view text);
+
+struct WeightedChannel {
+  SaliencyOp op = SaliencyOp::kRso;
+  float weight = 1.0f;  // >= 0; renormalised so the weights sum to 1
+};
+
+struct DetectOptions {
+  // Channels of the master map (thesis eq. 2.42-2.44).
+  std::vector<WeightedChannel> channels = {{SaliencyOp::kRso, 1.0f}};
+  PyramidKind pyramid = PyramidKind::kNone;
+  LevelCombination level_combination = LevelCombination::kSum;
+  NormalizationKind normalization = NormalizationKind::kLin;
+  FusionKind fusion = FusionKind::kSum;
+  ExtractionKind extraction = ExtractionKind::kMsr;
+  int max_points = 10;  // [1, 100]
+  bool keep_channel_maps = false;  // return each channel's map
+
+  NormalOptions normals;
+  SupportPlaneOptions support_plane;
+  TableSceneOptions table_scene;
+  PhOptions ph;
+  ShOptions sh;
+  RsoOptions rso;
+  MsrOptions msr;
+};
+
+// Validates every field. Combinations not built yet (a pyramid, SYM3D,
+// colour channels, WTA, TJ, non-linear normalisation) are UNIMPLEMENTED and
+// name the option and value, e.g. "saliency 'sym3d' is not implemented yet".
+absl::Status Validate(const DetectOptions& options);
+
+struct StageTiming {
+  std::string stage;  // "cloud", "normals", "support_plane", "saliency.rso", ...
+  double seconds = 0.0;
+};
+
+struct NamedMap {
+  std::string name;  // "master" or SaliencyOpName
+  cv::Mat map;       // CV_32FC1, [0, 1]
+};
+
+struct DetectResult {
+  std::vector<AttentionPoint> points;  // most salient first, 3D filled in
+  cv::Mat master;                      // CV_32FC1, [0, 1]
+  std::vector<NamedMap> channel_maps;  // when keep_channel_maps
+  SupportPlane plane;
+  std::vector<StageTiming> timings;
+  double total_seconds = 0.0;
+};
+
+// Called between stages; a non-OK status (e.g. DEADLINE_EXCEEDED,
+// CANCELLED) stops the pipeline and is returned as is.
+using InterruptCheck = std::function<absl::Status()>;
+
+// The whole Detect path on a decoded frame: organized cloud and normals,
+// support plane, table scene, each channel's map, fusion, extraction.
+// Errors: INVALID_ARGUMENT / UNIMPLEMENTED from Validate; NOT_FOUND when
+// there is no support plane; whatever `interrupt` returns.
+absl::StatusOr<DetectResult> RunDetect(const RgbdFrame& frame,
+                                       const DetectOptions& options,
+                                       const InterruptCheck& interrupt = {});
+
+}  // namespace fovea
+
+#endif  // FOVEA_CORE_PIPELINE_DETECT_H_

@@ -1,0 +1,118 @@
+#ifndef FOVEA_CORE_SYNTH_SYNTH_SCENE_H_
+#define FOVEA_CORE_SYNTH_SYNTH_SCENE_H_
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "absl/status/statusor.h"
+#include "core/frame/osd_pcd.h"
+#include "core/frame/rgbd_frame.h"
+
+namespace fovea::synth {
+
+// Synthetic table-top scenes with ground truth, ray-cast through a pinhole
+// camera. World frame: the table top is the plane z = 0, +z up, metres.
+// Every object rests on the table or on another object.
+
+enum class Shape { kBox, kCylinder, kSphere, kCone };
+
+struct Primitive {
+  Shape shape = Shape::kBox;
+  // Pose of the primitive's local frame in the world. Local frames:
+  //   box:      centred, half sizes `half_extents` along local x, y, z;
+  //   cylinder: axis local z, centred, radius `radius`, half height
+  //             `half_extents.z()`, with caps;
+  //   sphere:   centred, radius `radius`;
+  //   cone:     axis local z, base disc (radius `radius`) at local
+  //             z = -half_extents.z(), apex at +half_extents.z().
+  Eigen::Isometry3f pose = Eigen::Isometry3f::Identity();
+  Eigen::Vector3f half_extents = Eigen::Vector3f::Constant(0.05f);
+  float radius = 0.05f;
+  Eigen::Vector3f rgb = {0.8f, 0.2f, 0.2f};  // albedo, [0, 1]
+};
+
+struct SceneSpec {
+  // Table top: a rectangle of the plane z = 0 centred at the origin.
+  Eigen::Vector2f table_half_size = {0.6f, 0.4f};  // metres
+  Eigen::Vector3f table_rgb = {0.55f, 0.45f, 0.35f};
+  std::vector<Primitive> objects;
+  // Camera pose in the world (camera frame: x right, y down, z forward).
+  Eigen::Isometry3f camera_pose = Eigen::Isometry3f::Identity();
+  Intrinsics intrinsics = kKinectV1Intrinsics;
+  int width = 640;   // pixels
+  int height = 480;  // pixels
+};
+
+struct NoiseOptions {
+  bool enabled = true;
+  // Axial noise sigma = k * z^2 (Khoshelham & Elberink 2012: 1.43e-3 / m).
+  float sigma_per_z2 = 1.43e-3f;
+  // Disparity quantisation: depth is quantised to steps of
+  // z^2 / (focal_px * baseline_m) * disparity_step (Kinect: 1/8 px,
+  // baseline 0.075 m).
+  float baseline_m = 0.075f;
+  float disparity_step_px = 0.125f;
+  // Depth is dropped within this many pixels of a depth jump larger than
+  // `edge_jump_m` (the projector shadow and edge dropouts).
+  int edge_dropout_px = 2;
+  float edge_jump_m = 0.03f;
+  // Surfaces darker than this albedo lose their depth with probability
+  // `dark_dropout_probability` per pixel.
+  float dark_albedo = 0.12f;
+  float dark_dropout_probability = 0.6f;
+  // Colour noise, standard deviation in 8-bit units.
+  float color_sigma = 3.0f;
+};
+
+// Ground truth of one object as rendered.
+struct ObjectTruth {
+  int label = 0;      // OSD-style label 10 * (index + 2), object id index + 2
+  Primitive primitive;
+  int visible_pixels = 0;
+};
+
+struct SynthScene {
+  LabelledFrame frame;  // labels: 0 no data, 1 table, 20, 30, ... objects
+  std::vector<ObjectTruth> objects;
+  // The table plane in the camera frame, n . p + d = 0, n towards the
+  // camera.
+  Eigen::Vector3f table_normal_camera = Eigen::Vector3f::UnitZ();
+  float table_d_camera = 0.0f;
+};
+
+// Renders `spec` (noise from `seed`). Pixels that see nothing have NaN depth
+// and label 0; colour is shaded by a fixed light plus ambient.
+SynthScene RenderScene(const SceneSpec& spec, const NoiseOptions& noise,
+                       uint64_t seed);
+
+struct RandomSceneOptions {
+  int min_objects = 2;
+  int max_objects = 6;
+  // Probabilities that an object is stacked on a box already placed, or
+  // placed touching another object.
+  float stack_probability = 0.2f;
+  float touch_probability = 0.3f;
+  // Camera: height above the table and distance back from its centre,
+  // metres, looking at the table centre (a Kinect on a robot's head).
+  float camera_height = 0.75f;
+  float camera_distance = 0.75f;
+};
+
+// A random table-top scene: boxes, cylinders, spheres and cones at random
+// poses and colours, some touching, stacked and occluding, all on the
+// table. Deterministic: the same seed gives the same spec.
+SceneSpec RandomSceneSpec(uint64_t seed, const RandomSceneOptions& options);
+
+// The camera pose looking at `target` from `eye` with the world +z up.
+Eigen::Isometry3f LookAt(const Eigen::Vector3f& eye,
+                         const Eigen::Vector3f& target);
+
+// The demo scene: RandomSceneSpec(seed) rendered with default noise.
+SynthScene GenerateScene(uint64_t seed);
+
+}  // namespace fovea::synth
+
+#endif  // FOVEA_CORE_SYNTH_SYNTH_SCENE_H_
