@@ -1,9 +1,8 @@
 #ifndef FOVEA_CORE_ATTENTION_MSR_H_
 #define FOVEA_CORE_ATTENTION_MSR_H_
 
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "core/attention/attention_point.h"
@@ -20,6 +19,12 @@ struct MsrOptions {
   // Regions smaller than this are inhibited but yield no point (isolated
   // noisy pixels), pixels.
   int min_region_pixels = 20;
+  // Also inhibit the slope around the region: neighbours whose saliency
+  // does not rise above the pixel they are reached from. The thesis
+  // inhibits the region alone, which leaves the lower rim of a salient
+  // object (below the tolerance) to seed further points on the same
+  // object. Off reproduces the thesis exactly.
+  bool inhibit_slope = true;
 };
 
 absl::Status Validate(const MsrOptions& options);

@@ -1,10 +1,10 @@
 #ifndef FOVEA_CORE_EVAL_DETECTION_METRICS_H_
 #define FOVEA_CORE_EVAL_DETECTION_METRICS_H_
 
+#include <Eigen/Core>
 #include <array>
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "core/attention/attention_point.h"
 

@@ -55,8 +55,8 @@ absl::Status Validate(const NormalOptions& options);
 // organized cloud and keeps the 640x480 budget (thesis section 2.3 uses
 // integral-image normals for the same reason); the depth-adaptive window
 // tames Kinect noise, which grows with z^2.
-absl::StatusOr<OrganizedCloud> BuildOrganizedCloud(const RgbdFrame& frame,
-                                                  const NormalOptions& options);
+absl::StatusOr<OrganizedCloud> BuildOrganizedCloud(
+    const RgbdFrame& frame, const NormalOptions& options);
 
 // Back-projection only (normals left as NaN).
 OrganizedCloud BackProject(const RgbdFrame& frame);

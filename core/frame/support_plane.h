@@ -1,11 +1,10 @@
 #ifndef FOVEA_CORE_FRAME_SUPPORT_PLANE_H_
 #define FOVEA_CORE_FRAME_SUPPORT_PLANE_H_
 
-#include <cstdint>
-#include <vector>
-
 #include <Eigen/Core>
+#include <cstdint>
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "core/frame/organized_cloud.h"

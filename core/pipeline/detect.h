@@ -2,11 +2,10 @@
 #define FOVEA_CORE_PIPELINE_DETECT_H_
 
 #include <functional>
+#include <opencv2/core.hpp>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "absl/status/statusor.h"
 #include "core/attention/attention_point.h"
@@ -24,7 +23,15 @@ namespace fovea {
 // Saliency channels. Names (SaliencyOpName) are the command-line and
 // metric names.
 enum class SaliencyOp {
-  kPh, kSh, kRso, kSym3d, kItti, kHarel, kHou, kKootstra, kTargetColor,
+  kPh,
+  kSh,
+  kRso,
+  kSym3d,
+  kItti,
+  kHarel,
+  kHou,
+  kKootstra,
+  kTargetColor,
   kLocationPrior,
 };
 enum class PyramidKind { kNone, kSimple, kItti };
@@ -33,8 +40,8 @@ enum class NormalizationKind { kLin, kNms, kNlm };
 enum class FusionKind { kSum, kMax };
 enum class ExtractionKind { kMsr, kWta, kTj };
 
-std::string_view SaliencyOpName(SaliencyOp op);          // "ph", "sym3d", ...
-std::string_view ExtractionName(ExtractionKind kind);    // "msr", "wta", "tj"
+std::string_view SaliencyOpName(SaliencyOp op);        // "ph", "sym3d", ...
+std::string_view ExtractionName(ExtractionKind kind);  // "msr", "wta", "tj"
 // Parses "ph", "ph+sh+rso", ... into equally weighted channels.
 absl::StatusOr<std::vector<SaliencyOp>> ParseSaliencyOps(std::string_view text);
 absl::StatusOr<ExtractionKind> ParseExtraction(std::string_view text);
@@ -52,7 +59,7 @@ struct DetectOptions {
   NormalizationKind normalization = NormalizationKind::kLin;
   FusionKind fusion = FusionKind::kSum;
   ExtractionKind extraction = ExtractionKind::kMsr;
-  int max_points = 10;  // [1, 100]
+  int max_points = 10;             // [1, 100]
   bool keep_channel_maps = false;  // return each channel's map
 
   NormalOptions normals;
@@ -70,7 +77,8 @@ struct DetectOptions {
 absl::Status Validate(const DetectOptions& options);
 
 struct StageTiming {
-  std::string stage;  // "cloud", "normals", "support_plane", "saliency.rso", ...
+  std::string
+      stage;  // "cloud", "normals", "support_plane", "saliency.rso", ...
   double seconds = 0.0;
 };
 

@@ -1,0 +1,93 @@
+#include "core/pipeline/detect.h"
+
+#include <gtest/gtest.h>
+
+#include "core/synth/synth_scene.h"
+
+namespace fovea {
+namespace {
+
+TEST(DetectTest, FirstPointLiesOnAnObjectInSyntheticScenes) {
+  int on_object = 0;
+  constexpr int kScenes = 8;
+  for (int seed = 1; seed <= kScenes; ++seed) {
+    const synth::SynthScene scene = synth::GenerateScene(seed);
+    absl::StatusOr<DetectResult> result = RunDetect(scene.frame.frame, {});
+    ASSERT_TRUE(result.ok()) << "seed " << seed << ": " << result.status();
+    ASSERT_FALSE(result->points.empty()) << "seed " << seed;
+    const AttentionPoint& p = result->points[0];
+    on_object += scene.frame.labels.at<int>(p.v, p.u) >= 20;
+    EXPECT_FALSE(std::isnan(p.point.z()));
+  }
+  EXPECT_GE(on_object, kScenes - 1);
+}
+
+TEST(DetectTest, PointsComeMostSalientFirstWithTimings) {
+  const synth::SynthScene scene = synth::GenerateScene(3);
+  DetectOptions options;
+  options.channels = {
+      {SaliencyOp::kPh, 1}, {SaliencyOp::kSh, 1}, {SaliencyOp::kRso, 2}};
+  options.keep_channel_maps = true;
+  absl::StatusOr<DetectResult> result = RunDetect(scene.frame.frame, options);
+  ASSERT_TRUE(result.ok()) << result.status();
+  for (size_t i = 1; i < result->points.size(); ++i) {
+    EXPECT_GE(result->points[i - 1].saliency, result->points[i].saliency);
+  }
+  ASSERT_EQ(result->channel_maps.size(), 3u);
+  EXPECT_EQ(result->channel_maps[0].name, "ph");
+  bool has_normals = false, has_plane = false;
+  for (const StageTiming& t : result->timings) {
+    has_normals |= t.stage == "normals";
+    has_plane |= t.stage == "support_plane";
+  }
+  EXPECT_TRUE(has_normals && has_plane);
+}
+
+TEST(DetectTest, UnbuiltOptionsAreUnimplementedAndNamed) {
+  DetectOptions options;
+  options.channels = {{SaliencyOp::kSym3d, 1}};
+  absl::Status s = Validate(options);
+  EXPECT_EQ(s.code(), absl::StatusCode::kUnimplemented);
+  EXPECT_NE(s.message().find("sym3d"), std::string::npos);
+  options = {};
+  options.extraction = ExtractionKind::kTj;
+  s = Validate(options);
+  EXPECT_EQ(s.code(), absl::StatusCode::kUnimplemented);
+  EXPECT_NE(s.message().find("tj"), std::string::npos);
+}
+
+TEST(DetectTest, BadOptionsNameTheField) {
+  DetectOptions options;
+  options.max_points = 0;
+  EXPECT_NE(Validate(options).message().find("options.max_points"),
+            std::string::npos);
+  options = {};
+  options.channels = {{SaliencyOp::kRso, -1.0f}};
+  EXPECT_EQ(Validate(options).code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST(DetectTest, InterruptStopsThePipelineWithItsStatus) {
+  const synth::SynthScene scene = synth::GenerateScene(1);
+  int calls = 0;
+  absl::StatusOr<DetectResult> result =
+      RunDetect(scene.frame.frame, {}, [&calls]() {
+        ++calls;
+        return absl::DeadlineExceededError("deadline");
+      });
+  EXPECT_EQ(result.status().code(), absl::StatusCode::kDeadlineExceeded);
+  EXPECT_EQ(calls, 1);
+}
+
+TEST(DetectTest, ParsesSaliencyNamesAndCombinations) {
+  absl::StatusOr<std::vector<SaliencyOp>> ops = ParseSaliencyOps("ph+sh+rso");
+  ASSERT_TRUE(ops.ok());
+  EXPECT_EQ(ops->size(), 3u);
+  EXPECT_EQ((*ops)[2], SaliencyOp::kRso);
+  const absl::Status bad = ParseSaliencyOps("ph+bogus").status();
+  EXPECT_NE(bad.message().find("bogus"), std::string::npos);
+  EXPECT_EQ(*ParseExtraction("msr"), ExtractionKind::kMsr);
+  EXPECT_FALSE(ParseExtraction("xyz").ok());
+}
+
+}  // namespace
+}  // namespace fovea

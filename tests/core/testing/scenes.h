@@ -1,0 +1,72 @@
+#ifndef FOVEA_TESTS_CORE_TESTING_SCENES_H_
+#define FOVEA_TESTS_CORE_TESTING_SCENES_H_
+
+// Small analytic scenes for core tests.
+
+#include <Eigen/Core>
+#include <cmath>
+#include <opencv2/core.hpp>
+
+#include "core/frame/rgbd_frame.h"
+#include "core/synth/synth_scene.h"
+
+namespace fovea::testing {
+
+// Depth image of the plane n . p + d = 0 seen through `intrinsics`
+// (NaN where a ray misses it or hits behind the camera).
+inline RgbdFrame PlaneFrame(const Eigen::Vector3f& n, float d, int width = 160,
+                            int height = 120,
+                            Intrinsics intrinsics = {130.0, 130.0, 79.5,
+                                                     59.5}) {
+  RgbdFrame frame;
+  frame.intrinsics = intrinsics;
+  frame.color = cv::Mat(height, width, CV_8UC3, cv::Scalar(128, 128, 128));
+  frame.depth = cv::Mat(height, width, CV_32FC1);
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const Eigen::Vector3f ray((u - intrinsics.cx) / intrinsics.fx,
+                                (v - intrinsics.cy) / intrinsics.fy, 1.0f);
+      const float denom = n.dot(ray);
+      const float z = std::abs(denom) > 1e-9f ? -d / denom : -1.0f;
+      frame.depth.at<float>(v, u) =
+          z > 0.0f ? z : std::numeric_limits<float>::quiet_NaN();
+    }
+  }
+  return frame;
+}
+
+// A box of the given size standing on the table centre, camera 0.75 m up
+// and 0.75 m back looking at it; no noise.
+inline synth::SynthScene BoxOnTable(const Eigen::Vector3f& half_extents,
+                                    const Eigen::Vector2f& at = {0.0f, 0.0f}) {
+  synth::SceneSpec spec;
+  spec.camera_pose = synth::LookAt({0.0f, -0.75f, 0.75f}, {0.0f, 0.0f, 0.0f});
+  synth::Primitive box;
+  box.shape = synth::Shape::kBox;
+  box.half_extents = half_extents;
+  box.pose.translation() = Eigen::Vector3f(at.x(), at.y(), half_extents.z());
+  spec.objects.push_back(box);
+  synth::NoiseOptions noise;
+  noise.enabled = false;
+  return synth::RenderScene(spec, noise, 1);
+}
+
+// Height of each pixel above the scene's table (NaN without depth).
+inline cv::Mat HeightAboveTable(const synth::SynthScene& scene) {
+  const RgbdFrame& f = scene.frame.frame;
+  cv::Mat height(f.height(), f.width(), CV_32FC1);
+  for (int v = 0; v < f.height(); ++v) {
+    for (int u = 0; u < f.width(); ++u) {
+      const float z = f.depth.at<float>(v, u);
+      const Eigen::Vector3f p((u - f.intrinsics.cx) * z / f.intrinsics.fx,
+                              (v - f.intrinsics.cy) * z / f.intrinsics.fy, z);
+      height.at<float>(v, u) =
+          scene.table_normal_camera.dot(p) + scene.table_d_camera;
+    }
+  }
+  return height;
+}
+
+}  // namespace fovea::testing
+
+#endif  // FOVEA_TESTS_CORE_TESTING_SCENES_H_

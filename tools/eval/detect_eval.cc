@@ -1,0 +1,144 @@
+#include "tools/eval/detect_eval.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/frame/organized_cloud.h"
+#include "core/frame/osd_pcd.h"
+#include "tools/eval/scene_kind.h"
+
+namespace fovea::eval {
+namespace {
+
+std::string ResolveDataDir(const std::string& dir) {
+  const std::filesystem::path learn = std::filesystem::path(dir) / "learn";
+  if (std::filesystem::is_directory(learn)) return learn.string();
+  return dir;
+}
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  double m = values[mid];
+  if (values.size() % 2 == 0) {
+    m = (m + *std::max_element(values.begin(), values.begin() + mid)) / 2.0;
+  }
+  return m;
+}
+
+// Saliency map in false colour with the points numbered on it, next to the
+// colour image with the ground-truth object outlines.
+void WriteScenePng(const std::string& out_dir, const LabelledFrame& scene,
+                   const DetectResult& result) {
+  cv::Mat map8;
+  result.master.convertTo(map8, CV_8UC1, 255.0);
+  cv::Mat heat;
+  cv::applyColorMap(map8, heat, cv::COLORMAP_JET);
+  cv::Mat bgr;
+  cv::cvtColor(scene.frame.color, bgr, cv::COLOR_RGB2BGR);
+  cv::Mat objects = scene.labels >= 20;
+  std::vector<std::vector<cv::Point>> contours;
+  cv::Mat ids;
+  scene.labels.convertTo(ids, CV_32S, 0.1);
+  for (int id = 2; id < 100; ++id) {
+    cv::Mat mask = (ids == id) & objects;
+    if (cv::countNonZero(mask) == 0) continue;
+    std::vector<std::vector<cv::Point>> c;
+    cv::findContours(mask, c, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+    contours.insert(contours.end(), c.begin(), c.end());
+  }
+  cv::drawContours(bgr, contours, -1, cv::Scalar(255, 255, 255), 1);
+  for (size_t i = 0; i < result.points.size(); ++i) {
+    const cv::Point p(result.points[i].u, result.points[i].v);
+    for (cv::Mat* img : {&heat, &bgr}) {
+      cv::circle(*img, p, 6, cv::Scalar(255, 255, 255), 2);
+      cv::putText(*img, std::to_string(i), p + cv::Point(7, -7),
+                  cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1);
+    }
+  }
+  cv::Mat both;
+  cv::hconcat(bgr, heat, both);
+  cv::imwrite(out_dir + "/" + scene.name + ".png", both);
+}
+
+}  // namespace
+
+DetectEvalSummary Summarize(const std::vector<SceneResult>& scenes,
+                            const std::string& kind) {
+  DetectEvalSummary s;
+  std::vector<double> times;
+  for (const SceneResult& r : scenes) {
+    if (!kind.empty() && r.kind != kind) continue;
+    s.scenes.push_back(r);
+    s.hit_ratio += r.score.hit_ratio;
+    s.distance_to_center += r.score.distance_to_center;
+    s.distance_to_center_thesis += r.score.distance_to_center_thesis;
+    for (int i = 0; i < kHitRatioAtMax; ++i) {
+      s.hit_ratio_at[i] += r.score.hit_ratio_at[i];
+    }
+    times.push_back(r.detect_ms);
+  }
+  const double n = static_cast<double>(s.scenes.size());
+  if (n > 0) {
+    s.hit_ratio /= n;
+    s.distance_to_center /= n;
+    s.distance_to_center_thesis /= n;
+    for (double& h : s.hit_ratio_at) h /= n;
+  }
+  s.detect_ms_median = Median(times);
+  return s;
+}
+
+absl::StatusOr<DetectEvalSummary> EvaluateDetect(
+    const DetectEvalOptions& options) {
+  if (absl::Status s = Validate(options.detect); !s.ok()) return s;
+  absl::StatusOr<std::vector<std::string>> files =
+      ListPcdFiles(ResolveDataDir(options.data_dir));
+  if (!files.ok()) return files.status();
+  if (files->empty()) {
+    return absl::NotFoundError("no .pcd files in " + options.data_dir);
+  }
+  if (!options.out_dir.empty()) {
+    std::filesystem::create_directories(options.out_dir);
+  }
+  std::vector<SceneResult> results;
+  for (const std::string& path : *files) {
+    absl::StatusOr<LabelledFrame> scene = LoadOsdPcd(path);
+    if (!scene.ok()) return scene.status();
+    const auto start = std::chrono::steady_clock::now();
+    absl::StatusOr<DetectResult> result =
+        RunDetect(scene->frame, options.detect);
+    const double ms = std::chrono::duration<double, std::milli>(
+                          std::chrono::steady_clock::now() - start)
+                          .count();
+    if (!result.ok()) {
+      return absl::Status(
+          result.status().code(),
+          scene->name + ": " + std::string(result.status().message()));
+    }
+    const OrganizedCloud cloud = BackProject(scene->frame);
+    SceneResult r;
+    r.name = scene->name;
+    r.kind = SceneKind(scene->name);
+    r.score = ScoreAttentionPoints(result->points, scene->labels, cloud.xyz);
+    r.points = static_cast<int>(result->points.size());
+    r.detect_ms = ms;
+    if (options.verbose) {
+      std::fprintf(
+          stderr, "%-10s %-10s objects %2d hits %2d HR %.2f DC %.2f %6.1f ms\n",
+          r.name.c_str(), r.kind.c_str(), r.score.objects, r.score.hits,
+          r.score.hit_ratio, r.score.distance_to_center, ms);
+    }
+    if (!options.out_dir.empty())
+      WriteScenePng(options.out_dir, *scene, *result);
+    if (r.score.objects > 0) results.push_back(std::move(r));
+  }
+  return Summarize(results, "");
+}
+
+}  // namespace fovea::eval

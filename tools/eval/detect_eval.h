@@ -1,0 +1,49 @@
+#ifndef FOVEA_TOOLS_EVAL_DETECT_EVAL_H_
+#define FOVEA_TOOLS_EVAL_DETECT_EVAL_H_
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/eval/detection_metrics.h"
+#include "core/pipeline/detect.h"
+
+namespace fovea::eval {
+
+struct SceneResult {
+  std::string name;
+  std::string kind;  // SceneKind(name)
+  DetectionScore score;
+  int points = 0;
+  double detect_ms = 0.0;
+};
+
+struct DetectEvalSummary {
+  std::vector<SceneResult> scenes;  // scenes with at least one object
+  double hit_ratio = 0.0;           // mean over scenes
+  double distance_to_center = 0.0;  // mean over scenes
+  double distance_to_center_thesis = 0.0;
+  std::array<double, kHitRatioAtMax> hit_ratio_at{};
+  double detect_ms_median = 0.0;
+};
+
+struct DetectEvalOptions {
+  std::string data_dir;  // an OSD folder (or its learn/ subfolder)
+  DetectOptions detect;
+  std::string out_dir;   // when set, PNGs of maps and points per scene
+  bool verbose = false;  // one line per scene on stderr
+};
+
+// Runs Detect in-process on every PCD of the folder and scores it
+// (thesis section 2.6.1; objects are label / 10).
+absl::StatusOr<DetectEvalSummary> EvaluateDetect(
+    const DetectEvalOptions& options);
+
+// Mean of the per-scene figures over the scenes of one kind ("" = all).
+DetectEvalSummary Summarize(const std::vector<SceneResult>& scenes,
+                            const std::string& kind);
+
+}  // namespace fovea::eval
+
+#endif  // FOVEA_TOOLS_EVAL_DETECT_EVAL_H_
