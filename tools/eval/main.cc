@@ -44,7 +44,7 @@ constexpr int kRunError = 1;
 void PrintTable(const std::vector<SceneResult>& scenes) {
   std::printf("%-12s %-10s %7s %5s %6s %6s %8s\n", "kind", "", "scenes", "",
               "HR", "DC", "ms(med)");
-  for (const std::string& kind :
+  for (const char* kind :
        {"boxes", "stacked", "occluded", "cylindric", "other", ""}) {
     const DetectEvalSummary s = Summarize(scenes, kind);
     if (s.scenes.empty()) continue;

@@ -2,10 +2,18 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <vector>
+
 #include "tests/core/saliency/scene_fixture.h"
 
 namespace fovea {
 namespace {
+
+float Median(std::vector<float> v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
 
 TEST(RsoSaliencyTest, AboutOneOnABoxTopAndAboutZeroOnItsSides) {
   const float half_height = 0.06f;
@@ -14,26 +22,25 @@ TEST(RsoSaliencyTest, AboutOneOnABoxTopAndAboutZeroOnItsSides) {
   absl::StatusOr<cv::Mat> map =
       ComputeRsoSaliency(s.cloud, s.plane, s.table, {});
   ASSERT_TRUE(map.ok());
-  double top_sum = 0, side_sum = 0;
-  int top = 0, side = 0;
+  std::vector<float> top, side;
   for (int v = 0; v < map->rows; ++v) {
     for (int u = 0; u < map->cols; ++u) {
       if (s.truth.frame.labels.at<int>(v, u) < 20) continue;
       if (!s.cloud.HasNormal(u, v)) continue;
       const float h = s.true_height.at<float>(v, u);
       if (h > 2 * half_height - 0.002f) {
-        top_sum += map->at<float>(v, u);
-        ++top;
+        top.push_back(map->at<float>(v, u));
       } else if (h > 0.02f && h < 2 * half_height - 0.02f) {
-        side_sum += map->at<float>(v, u);
-        ++side;
+        side.push_back(map->at<float>(v, u));
       }
     }
   }
-  ASSERT_GT(top, 50);
-  ASSERT_GT(side, 50);
-  EXPECT_GT(top_sum / top, 0.95);
-  EXPECT_LT(side_sum / side, 0.1);
+  ASSERT_GT(top.size(), 50u);
+  ASSERT_GT(side.size(), 50u);
+  // Medians: the face, not the few pixels whose smoothing window straddles
+  // the top's edge.
+  EXPECT_GT(Median(top), 0.95f);
+  EXPECT_LT(Median(side), 0.1f);
 }
 
 TEST(RsoSaliencyTest, TableAndBackgroundAreZero) {
