@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -13,65 +14,40 @@ namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
-// Integral images of x, y, z and the count of valid points, (h+1) x (w+1),
-// in double so that sums over a 640x480 frame stay exact to well below a
-// millimetre.
-struct PointIntegrals {
-  int width = 0;
-  int height = 0;
-  std::vector<double> sx, sy, sz;
-  std::vector<int> count;
-
-  size_t Index(int u, int v) const {
-    return static_cast<size_t>(v) * (width + 1) + u;
-  }
-};
-
-PointIntegrals IntegratePoints(const cv::Mat& xyz) {
-  PointIntegrals in;
-  in.width = xyz.cols;
-  in.height = xyz.rows;
-  const size_t n = static_cast<size_t>(in.width + 1) * (in.height + 1);
-  in.sx.assign(n, 0.0);
-  in.sy.assign(n, 0.0);
-  in.sz.assign(n, 0.0);
-  in.count.assign(n, 0);
-  for (int v = 0; v < in.height; ++v) {
-    const cv::Vec3f* row = xyz.ptr<cv::Vec3f>(v);
-    double rx = 0, ry = 0, rz = 0;
-    int rc = 0;
-    const size_t above = in.Index(0, v);
-    const size_t here = in.Index(0, v + 1);
-    for (int u = 0; u < in.width; ++u) {
-      const cv::Vec3f& p = row[u];
-      if (!std::isnan(p[2])) {
-        rx += p[0];
-        ry += p[1];
-        rz += p[2];
-        ++rc;
-      }
-      in.sx[here + u + 1] = in.sx[above + u + 1] + rx;
-      in.sy[here + u + 1] = in.sy[above + u + 1] + ry;
-      in.sz[here + u + 1] = in.sz[above + u + 1] + rz;
-      in.count[here + u + 1] = in.count[above + u + 1] + rc;
+// The cloud box-smoothed over valid points only: the mean of the valid
+// points in the (2 * half + 1)^2 window around each pixel, NaN where the
+// window holds none. Two separable box filters (sum of points, count of
+// valid points), so the cost does not depend on the window.
+cv::Mat SmoothValidPoints(const cv::Mat& xyz, int half) {
+  const int h = xyz.rows, w = xyz.cols;
+  cv::Mat points(h, w, CV_32FC3), valid(h, w, CV_32FC1);
+  for (int v = 0; v < h; ++v) {
+    const cv::Vec3f* in = xyz.ptr<cv::Vec3f>(v);
+    cv::Vec3f* p = points.ptr<cv::Vec3f>(v);
+    float* c = valid.ptr<float>(v);
+    for (int u = 0; u < w; ++u) {
+      const bool ok = !std::isnan(in[u][2]);
+      p[u] = ok ? in[u] : cv::Vec3f(0.0f, 0.0f, 0.0f);
+      c[u] = ok ? 1.0f : 0.0f;
     }
   }
-  return in;
-}
-
-// Mean of the valid points in the window [u0, u1] x [v0, v1] (inclusive,
-// clipped by the caller). False when the window holds no valid point.
-bool BoxMean(const PointIntegrals& in, int u0, int v0, int u1, int v1,
-             cv::Vec3d& mean) {
-  const size_t a = in.Index(u0, v0), b = in.Index(u1 + 1, v0),
-               c = in.Index(u0, v1 + 1), d = in.Index(u1 + 1, v1 + 1);
-  const int n = in.count[d] - in.count[b] - in.count[c] + in.count[a];
-  if (n <= 0) return false;
-  const double inv = 1.0 / n;
-  mean = {(in.sx[d] - in.sx[b] - in.sx[c] + in.sx[a]) * inv,
-          (in.sy[d] - in.sy[b] - in.sy[c] + in.sy[a]) * inv,
-          (in.sz[d] - in.sz[b] - in.sz[c] + in.sz[a]) * inv};
-  return true;
+  const cv::Size window(2 * half + 1, 2 * half + 1);
+  cv::boxFilter(points, points, -1, window, cv::Point(-1, -1), false,
+                cv::BORDER_CONSTANT);
+  cv::boxFilter(valid, valid, -1, window, cv::Point(-1, -1), false,
+                cv::BORDER_CONSTANT);
+  for (int v = 0; v < h; ++v) {
+    cv::Vec3f* p = points.ptr<cv::Vec3f>(v);
+    const float* c = valid.ptr<float>(v);
+    for (int u = 0; u < w; ++u) {
+      if (c[u] > 0.5f) {
+        p[u] *= 1.0f / c[u];
+      } else {
+        p[u] = {kNaN, kNaN, kNaN};
+      }
+    }
+  }
+  return points;
 }
 
 int HalfWindow(const NormalOptions& options, float z) {
@@ -86,6 +62,11 @@ absl::Status Validate(const NormalOptions& options) {
     return absl::InvalidArgumentError(
         absl::StrCat("normals.smoothing_px_at_1m must be > 0, got ",
                      options.smoothing_px_at_1m));
+  }
+  if (options.smoothing_half_window < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("normals.smoothing_half_window must be >= 0, got ",
+                     options.smoothing_half_window));
   }
   if (options.min_half_window < 1 ||
       options.max_half_window < options.min_half_window) {
@@ -133,11 +114,8 @@ OrganizedCloud BackProject(const RgbdFrame& frame) {
 void EstimateNormals(const NormalOptions& options, OrganizedCloud& cloud) {
   const int w = cloud.width(), h = cloud.height();
   cloud.normals.create(h, w, CV_32FC3);
-  const PointIntegrals in = IntegratePoints(cloud.xyz);
-  auto smoothed = [&](int u, int v, int r, cv::Vec3d& mean) {
-    return BoxMean(in, std::max(u - r, 0), std::max(v - r, 0),
-                   std::min(u + r, w - 1), std::min(v + r, h - 1), mean);
-  };
+  const cv::Mat smooth =
+      SmoothValidPoints(cloud.xyz, options.smoothing_half_window);
   for (int v = 0; v < h; ++v) {
     const cv::Vec3f* row = cloud.xyz.ptr<cv::Vec3f>(v);
     cv::Vec3f* out = cloud.normals.ptr<cv::Vec3f>(v);
@@ -156,22 +134,19 @@ void EstimateNormals(const NormalOptions& options, OrganizedCloud& cloud) {
             std::abs(zu - z) <= max_change && std::abs(zd - z) <= max_change)) {
         continue;
       }
-      const int s = std::max(r / 2, 1);  // smoothing half window
-      cv::Vec3d left, right, up, down;
-      if (!smoothed(u - r, v, s, left) || !smoothed(u + r, v, s, right) ||
-          !smoothed(u, v - r, s, up) || !smoothed(u, v + r, s, down)) {
-        continue;
-      }
-      const cv::Vec3d gu = right - left;
-      const cv::Vec3d gv = down - up;
-      cv::Vec3d n = gv.cross(gu);
-      const double norm = cv::norm(n);
-      if (!(norm > 0.0)) continue;
-      n *= 1.0 / norm;
+      const cv::Vec3f& left = smooth.ptr<cv::Vec3f>(v)[u - r];
+      const cv::Vec3f& right = smooth.ptr<cv::Vec3f>(v)[u + r];
+      const cv::Vec3f& up = smooth.ptr<cv::Vec3f>(v - r)[u];
+      const cv::Vec3f& down = smooth.ptr<cv::Vec3f>(v + r)[u];
+      const cv::Vec3f gu = right - left;
+      const cv::Vec3f gv = down - up;
+      cv::Vec3f n = gv.cross(gu);
+      const float norm2 = n.dot(n);
+      if (!(norm2 > 0.0f)) continue;  // also false for NaN
+      n *= 1.0f / std::sqrt(norm2);
       // Orient towards the camera (the origin): n . p < 0.
-      if (n[0] * row[u][0] + n[1] * row[u][1] + n[2] * z > 0.0) n = -n;
-      out[u] = cv::Vec3f(static_cast<float>(n[0]), static_cast<float>(n[1]),
-                         static_cast<float>(n[2]));
+      if (n[0] * row[u][0] + n[1] * row[u][1] + n[2] * z > 0.0f) n = -n;
+      out[u] = n;
     }
   }
 }

@@ -32,14 +32,17 @@ struct OrganizedCloud {
 };
 
 struct NormalOptions {
-  // Half-size of the smoothing window at 1 m, pixels; it shrinks as 1/z so
-  // that the window covers about the same metric size at every depth.
+  // Half-size of the gradient baseline at 1 m, pixels; it shrinks as 1/z so
+  // that it spans about the same metric size at every depth:
   // 1 m * 5 px / 525 px ~ 1 cm (Holzer et al. 2012, as PCL's
-  // IntegralImageNormalEstimation does).
+  // IntegralImageNormalEstimation scales its window with depth).
   float smoothing_px_at_1m = 5.0f;
-  // Smallest and largest half window, pixels.
+  // Smallest and largest gradient half baseline, pixels.
   int min_half_window = 2;
   int max_half_window = 8;
+  // Half-size of the box the cloud is smoothed with before the gradients
+  // are taken, pixels (5x5: averages Kinect's disparity quantisation).
+  int smoothing_half_window = 2;
   // Depth change above which a neighbour is not on the same surface,
   // as a fraction of depth (PCL's max_depth_change_factor).
   float max_depth_change_factor = 0.02f;
@@ -48,9 +51,10 @@ struct NormalOptions {
 absl::Status Validate(const NormalOptions& options);
 
 // Back-projects the frame and estimates normals. Normals are the cross
-// product of the horizontal and vertical 3D gradients of the
-// box-smoothed point cloud, smoothing over valid points only with integral
-// images (the "average 3D gradient" method of Holzer et al. 2012). Chosen
+// product of the horizontal and vertical 3D gradients (central differences
+// over a depth-adaptive baseline) of the box-smoothed point cloud,
+// smoothing over valid points only (the "average 3D gradient" method of
+// Holzer et al. 2012). Chosen
 // over PCA of k nearest neighbours because it is O(1) per pixel on an
 // organized cloud and keeps the 640x480 budget (thesis section 2.3 uses
 // integral-image normals for the same reason); the depth-adaptive window

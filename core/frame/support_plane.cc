@@ -18,8 +18,15 @@ constexpr float kDegToRad = static_cast<float>(M_PI / 180.0);
 // few are re-scored on all samples (preemptive RANSAC, Nister 2003).
 constexpr int kQuickScoreSamples = 1500;
 constexpr int kFullScoreCandidates = 8;
-// Pixel stride for the least-squares refinement and the hull.
+// Pixel stride for the least-squares refinement.
 constexpr int kRefineStride = 2;
+// Pixel stride for the convex hull's points (the hull is found to within
+// this many pixels, a few millimetres at table range).
+constexpr int kHullStride = 4;
+// The connected components are labelled on every kComponentStride-th row
+// and column; a full-resolution inlier belongs to the table when its
+// block's sample does.
+constexpr int kComponentStride = 2;
 
 struct Sample {
   Eigen::Vector3f p;
@@ -136,9 +143,14 @@ cv::Mat LargestInlierComponent(const OrganizedCloud& cloud,
       m[u] = 255;
     }
   }
+  cv::Mat coarse;
+  cv::resize(mask, coarse,
+             cv::Size((mask.cols + kComponentStride - 1) / kComponentStride,
+                      (mask.rows + kComponentStride - 1) / kComponentStride),
+             0, 0, cv::INTER_NEAREST);
   cv::Mat labels, stats, centroids;
-  const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids,
-                                                 8, CV_32S);
+  const int n = cv::connectedComponentsWithStats(coarse, labels, stats,
+                                                 centroids, 8, CV_32S);
   int best = 0, best_area = 0;
   for (int i = 1; i < n; ++i) {
     const int area = stats.at<int>(i, cv::CC_STAT_AREA);
@@ -147,9 +159,21 @@ cv::Mat LargestInlierComponent(const OrganizedCloud& cloud,
       best = i;
     }
   }
-  count = best_area;
-  if (best == 0) return mask;
-  cv::compare(labels, best, mask, cv::CMP_EQ);
+  count = 0;
+  for (int v = 0; v < mask.rows; ++v) {
+    uint8_t* m = mask.ptr<uint8_t>(v);
+    const int* l =
+        labels.ptr<int>(std::min(v / kComponentStride, labels.rows - 1));
+    for (int u = 0; u < mask.cols; ++u) {
+      if (!m[u]) continue;
+      if (best == 0 ||
+          l[std::min(u / kComponentStride, labels.cols - 1)] != best) {
+        m[u] = 0;
+      } else {
+        ++count;
+      }
+    }
+  }
   return mask;
 }
 
@@ -157,10 +181,10 @@ std::vector<Eigen::Vector2f> HullInPlane(const OrganizedCloud& cloud,
                                          const cv::Mat& inliers,
                                          const SupportPlane& plane) {
   std::vector<cv::Point2f> pts;
-  for (int v = 0; v < cloud.height(); v += kRefineStride) {
+  for (int v = 0; v < cloud.height(); v += kHullStride) {
     const cv::Vec3f* p = cloud.xyz.ptr<cv::Vec3f>(v);
     const uint8_t* m = inliers.ptr<uint8_t>(v);
-    for (int u = 0; u < cloud.width(); u += kRefineStride) {
+    for (int u = 0; u < cloud.width(); u += kHullStride) {
       if (!m[u]) continue;
       const Eigen::Vector2f q = plane.ToPlane({p[u][0], p[u][1], p[u][2]});
       pts.emplace_back(q.x(), q.y());
