@@ -1,0 +1,576 @@
+#include "core/frame/frame_decode.h"
+
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <exception>
+#include <limits>
+#include <new>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <string_view>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/strings/escaping.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/string_view.h"
+#include "core/base/check.h"
+
+namespace fovea {
+namespace {
+
+// Metres per unit of 16-bit depth when the frame's depth_scale is 0.
+constexpr double kDefaultDepthScale = 0.001;
+// Largest FrameLimits.max_width / max_height accepted: keeps every byte
+// count of a 4-byte-per-pixel row and image inside an int for cv::Mat.
+constexpr uint32_t kLargestLimit = 1u << 15;
+// Longest prefix of a client-supplied encoding quoted in an error.
+constexpr size_t kQuotedEncodingChars = 32;
+
+constexpr absl::string_view kPngSignature("\x89PNG\r\n\x1a\n", 8);
+// Signature (8) + IHDR length (4) + type (4) + width, height, bit depth,
+// colour type (10): the bytes ReadPngHeader looks at.
+constexpr size_t kPngHeaderBytes = 26;
+constexpr int kPngColorTypeGrey = 0;
+
+enum class Slot { kColor, kDepth };
+
+// Debian's abseil keeps its own string_view; the header speaks std.
+absl::string_view View(std::string_view text) {
+  return absl::string_view(text.data(), text.size());
+}
+
+// How an image's pixels are carried.
+enum class Format { kRgb8, kBgr8, kDepth16, kDepth32F, kPng, kJpeg };
+
+struct Encoding {
+  absl::string_view name;
+  Format format;
+  Slot slot;
+  uint32_t bytes_per_pixel;
+};
+
+constexpr std::array<Encoding, 4> kEncodings = {{
+    {"rgb8", Format::kRgb8, Slot::kColor, 3},
+    {"bgr8", Format::kBgr8, Slot::kColor, 3},
+    {"16UC1", Format::kDepth16, Slot::kDepth, 2},
+    {"32FC1", Format::kDepth32F, Slot::kDepth, 4},
+}};
+
+// What Inspect learnt about an image without touching its pixels.
+struct Layout {
+  Format format = Format::kRgb8;
+  uint32_t width = 0;
+  uint32_t height = 0;
+  uint32_t step = 0;  // bytes per row; raw formats only
+};
+
+// Width, height and sample layout from a compressed file's header.
+struct FileHeader {
+  uint32_t width = 0;
+  uint32_t height = 0;
+  int bit_depth = 0;  // bits per sample
+  int channels = 0;   // PNG: colour type; JPEG: number of components
+};
+
+absl::string_view SlotName(Slot slot) {
+  return slot == Slot::kColor ? "colour" : "depth";
+}
+
+absl::string_view SlotEncodings(Slot slot) {
+  return slot == Slot::kColor ? "rgb8 or bgr8" : "16UC1 or 32FC1";
+}
+
+std::string Quoted(absl::string_view text) {
+  std::string quoted = absl::StrCat(
+      "\"", absl::CHexEscape(text.substr(0, kQuotedEncodingChars)), "\"");
+  if (text.size() > kQuotedEncodingChars) quoted += "...";
+  return quoted;
+}
+
+uint32_t ReadBigEndian32(const unsigned char* p) {
+  return (uint32_t{p[0]} << 24) | (uint32_t{p[1]} << 16) |
+         (uint32_t{p[2]} << 8) | uint32_t{p[3]};
+}
+
+uint32_t ReadBigEndian16(const unsigned char* p) {
+  return (uint32_t{p[0]} << 8) | uint32_t{p[1]};
+}
+
+bool IsJpegStartOfFrame(unsigned char marker) {
+  // SOF0-SOF15 except DHT (C4), JPG (C8) and DAC (CC).
+  return marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 &&
+         marker != 0xCC;
+}
+
+// Looks up a non-empty encoding and checks it belongs in `slot`.
+absl::StatusOr<const Encoding*> FindEncoding(absl::string_view name, Slot slot,
+                                             absl::string_view field) {
+  for (const Encoding& encoding : kEncodings) {
+    if (encoding.name != name) continue;
+    if (encoding.slot != slot) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          field, ".encoding: ", Quoted(name), " is a ", SlotName(encoding.slot),
+          " encoding; ", SlotName(slot), " takes ", SlotEncodings(slot)));
+    }
+    return &encoding;
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat(field, ".encoding: unknown encoding ", Quoted(name), "; ",
+                   SlotName(slot), " takes ", SlotEncodings(slot)));
+}
+
+// `origin` says where the numbers come from, e.g. " (PNG header)".
+absl::Status CheckDimensions(uint64_t width, uint64_t height,
+                             absl::string_view field, absl::string_view origin,
+                             const FrameLimits& limits) {
+  if (width == 0 || height == 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".", width == 0 ? "width" : "height", ": ", width,
+                     " x ", height, origin, " is empty"));
+  }
+  if (width > limits.max_width) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".width: ", width, origin, " exceeds the limit of ",
+                     limits.max_width, " pixels"));
+  }
+  if (height > limits.max_height) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".height: ", height, origin,
+                     " exceeds the limit of ", limits.max_height, " pixels"));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<FileHeader> ReadPngHeader(absl::string_view file,
+                                         absl::string_view field) {
+  const auto* p = reinterpret_cast<const unsigned char*>(file.data());
+  if (file.size() < kPngHeaderBytes || std::memcmp(p + 12, "IHDR", 4) != 0 ||
+      ReadBigEndian32(p + 8) != 13) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".compressed: not a decodable PNG (no IHDR in ",
+                     file.size(), " bytes)"));
+  }
+  FileHeader header;
+  header.width = ReadBigEndian32(p + 16);
+  header.height = ReadBigEndian32(p + 20);
+  header.bit_depth = p[24];
+  header.channels = p[25];
+  return header;
+}
+
+// Walks the JPEG markers up to the first start-of-frame segment.
+absl::StatusOr<FileHeader> ReadJpegHeader(absl::string_view file,
+                                          absl::string_view field) {
+  const auto* p = reinterpret_cast<const unsigned char*>(file.data());
+  const size_t size = file.size();
+  size_t pos = 2;  // after FF D8
+  while (pos + 4 <= size) {
+    if (p[pos] != 0xFF) break;
+    const unsigned char marker = p[pos + 1];
+    if (marker == 0xFF) {  // fill byte
+      ++pos;
+      continue;
+    }
+    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD8)) {
+      pos += 2;  // stand-alone marker
+      continue;
+    }
+    if (marker == 0xD9 || marker == 0xDA) break;  // EOI / SOS before a frame
+    const size_t length = ReadBigEndian16(p + pos + 2);
+    if (length < 2) break;
+    if (IsJpegStartOfFrame(marker)) {
+      if (length < 8 || pos + 2 + 8 > size) break;
+      FileHeader header;
+      header.bit_depth = p[pos + 4];
+      header.height = ReadBigEndian16(p + pos + 5);
+      header.width = ReadBigEndian16(p + pos + 7);
+      header.channels = p[pos + 9];
+      return header;
+    }
+    pos += 2 + length;
+  }
+  return absl::InvalidArgumentError(absl::StrCat(
+      field, ".compressed: not a decodable JPEG (no frame header in ",
+      file.size(), " bytes)"));
+}
+
+// Checks that width, height, step and encoding sent alongside a compressed
+// file agree with it. Compressed depth is always 16UC1.
+absl::Status CheckAgreesWithFile(const RawImage& image, const FileHeader& file,
+                                 absl::string_view kind, Slot slot,
+                                 absl::string_view field) {
+  if (image.width != 0 && image.width != file.width) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".width: ", image.width, " does not match the ",
+                     kind, "'s width ", file.width));
+  }
+  if (image.height != 0 && image.height != file.height) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".height: ", image.height, " does not match the ",
+                     kind, "'s height ", file.height));
+  }
+  uint32_t bytes_per_pixel = slot == Slot::kColor ? 3 : 2;
+  if (!image.encoding.empty()) {
+    absl::StatusOr<const Encoding*> encoding =
+        FindEncoding(View(image.encoding), slot, field);
+    if (!encoding.ok()) return encoding.status();
+    if (slot == Slot::kDepth && (*encoding)->format != Format::kDepth16) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, ".encoding: ", Quoted(View(image.encoding)),
+                       " does not match the 16-bit ", kind, " (16UC1)"));
+    }
+    bytes_per_pixel = (*encoding)->bytes_per_pixel;
+  }
+  const uint64_t row_bytes = uint64_t{file.width} * bytes_per_pixel;
+  if (image.step != 0 && image.step != row_bytes) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".step: ", image.step, " does not match the ", kind,
+                     "'s rows of ", file.width, " * ", bytes_per_pixel, " = ",
+                     row_bytes, " bytes"));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<Layout> InspectCompressed(const RawImage& image, Slot slot,
+                                         absl::string_view field,
+                                         const FrameLimits& limits) {
+  const absl::string_view file = View(image.compressed);
+  Layout layout;
+  FileHeader header;
+  absl::string_view kind;
+  if (file.substr(0, kPngSignature.size()) == kPngSignature) {
+    kind = "PNG";
+    absl::StatusOr<FileHeader> png = ReadPngHeader(file, field);
+    if (!png.ok()) return png.status();
+    header = *png;
+    layout.format = Format::kPng;
+    if (slot == Slot::kDepth &&
+        (header.bit_depth != 16 || header.channels != kPngColorTypeGrey)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, ".compressed: a ", header.bit_depth,
+                       "-bit PNG of colour type ", header.channels,
+                       "; depth takes a 16-bit grey PNG (colour type 0)"));
+    }
+    if (slot == Slot::kColor && header.bit_depth > 8) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          field, ".compressed: a ", header.bit_depth,
+          "-bit PNG; colour takes an 8-bit PNG (16-bit grey is for depth)"));
+    }
+  } else if (file.size() >= 2 && static_cast<unsigned char>(file[0]) == 0xFF &&
+             static_cast<unsigned char>(file[1]) == 0xD8) {
+    kind = "JPEG";
+    if (slot == Slot::kDepth) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          field, ".compressed: a JPEG; depth takes a 16-bit grey PNG"));
+    }
+    absl::StatusOr<FileHeader> jpeg = ReadJpegHeader(file, field);
+    if (!jpeg.ok()) return jpeg.status();
+    header = *jpeg;
+    layout.format = Format::kJpeg;
+  } else {
+    return absl::InvalidArgumentError(absl::StrCat(
+        field, ".compressed: not a decodable ",
+        slot == Slot::kColor ? "PNG or JPEG" : "PNG", " (", file.size(),
+        " bytes starting ", Quoted(file.substr(0, 8)), ")"));
+  }
+  absl::Status status =
+      CheckDimensions(header.width, header.height, field,
+                      absl::StrCat(" (", kind, " header)"), limits);
+  if (!status.ok()) return status;
+  status = CheckAgreesWithFile(image, header, kind, slot, field);
+  if (!status.ok()) return status;
+  layout.width = header.width;
+  layout.height = header.height;
+  return layout;
+}
+
+absl::StatusOr<Layout> InspectRaw(const RawImage& image, Slot slot,
+                                  absl::string_view field,
+                                  const FrameLimits& limits) {
+  if (image.encoding.empty()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".encoding: empty; raw ", SlotName(slot),
+                     " data takes ", SlotEncodings(slot)));
+  }
+  absl::StatusOr<const Encoding*> encoding =
+      FindEncoding(View(image.encoding), slot, field);
+  if (!encoding.ok()) return encoding.status();
+  absl::Status status =
+      CheckDimensions(image.width, image.height, field, "", limits);
+  if (!status.ok()) return status;
+  const uint64_t bytes_per_pixel = (*encoding)->bytes_per_pixel;
+  const uint64_t row_bytes = uint64_t{image.width} * bytes_per_pixel;
+  if (image.step < row_bytes) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".step: ", image.step, " is less than width * ",
+                     bytes_per_pixel, " = ", row_bytes));
+  }
+  const uint64_t needed = uint64_t{image.step} * (image.height - 1) + row_bytes;
+  if (image.data.size() < needed) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        field, ".data: ", image.data.size(), " bytes, fewer than the ", needed,
+        " that ", image.height, " rows of step ", image.step, " need"));
+  }
+  Layout layout;
+  layout.format = (*encoding)->format;
+  layout.width = image.width;
+  layout.height = image.height;
+  layout.step = image.step;
+  return layout;
+}
+
+// Checks one image of the frame without allocating anything.
+absl::StatusOr<Layout> Inspect(const RawImage& image, Slot slot,
+                               absl::string_view field,
+                               const FrameLimits& limits) {
+  if (image.is_bigendian) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        field, ".is_bigendian: true, but only little-endian data is taken"));
+  }
+  if (!image.data.empty() && !image.compressed.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        field, ".data: ", image.data.size(), " bytes set together with ", field,
+        ".compressed (", image.compressed.size(), " bytes); send one of them"));
+  }
+  if (!image.compressed.empty()) {
+    return InspectCompressed(image, slot, field, limits);
+  }
+  if (image.data.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        field, ".data: empty, and no ", field, ".compressed either"));
+  }
+  return InspectRaw(image, slot, field, limits);
+}
+
+// cv::imdecode on a non-owning view; empty on any failure.
+cv::Mat DecodeFile(absl::string_view file, int flags) {
+  if (file.size() > static_cast<size_t>(std::numeric_limits<int>::max())) {
+    return cv::Mat();
+  }
+  try {
+    const cv::Mat bytes(1, static_cast<int>(file.size()), CV_8UC1,
+                        const_cast<char*>(file.data()));
+    return cv::imdecode(bytes, flags | cv::IMREAD_IGNORE_ORIENTATION);
+  } catch (const std::exception&) {
+    return cv::Mat();
+  }
+}
+
+float DepthFromUnits(uint32_t units, double scale) {
+  return units == 0 ? std::numeric_limits<float>::quiet_NaN()
+                    : static_cast<float>(units * scale);
+}
+
+float DepthFromMetres(float metres) {
+  return metres > 0.0f && metres < std::numeric_limits<float>::infinity()
+             ? metres
+             : std::numeric_limits<float>::quiet_NaN();
+}
+
+cv::Mat ColorFromRaw(const RawImage& image, const Layout& layout) {
+  cv::Mat color(static_cast<int>(layout.height), static_cast<int>(layout.width),
+                CV_8UC3);
+  const size_t row_bytes = size_t{layout.width} * 3;
+  for (int v = 0; v < color.rows; ++v) {
+    const auto* src = reinterpret_cast<const unsigned char*>(
+        image.data.data() + size_t{layout.step} * v);
+    unsigned char* dst = color.ptr<unsigned char>(v);
+    if (layout.format == Format::kRgb8) {
+      std::memcpy(dst, src, row_bytes);
+      continue;
+    }
+    for (size_t i = 0; i < row_bytes; i += 3) {
+      dst[i] = src[i + 2];
+      dst[i + 1] = src[i + 1];
+      dst[i + 2] = src[i];
+    }
+  }
+  return color;
+}
+
+cv::Mat DepthFromRaw(const RawImage& image, const Layout& layout,
+                     double scale) {
+  cv::Mat depth(static_cast<int>(layout.height), static_cast<int>(layout.width),
+                CV_32FC1);
+  const int width = depth.cols;
+  for (int v = 0; v < depth.rows; ++v) {
+    const auto* src = reinterpret_cast<const unsigned char*>(
+        image.data.data() + size_t{layout.step} * v);
+    float* dst = depth.ptr<float>(v);
+    if (layout.format == Format::kDepth16) {
+      for (int u = 0; u < width; ++u) {
+        const uint32_t units =
+            uint32_t{src[2 * u]} | (uint32_t{src[2 * u + 1]} << 8);
+        dst[u] = DepthFromUnits(units, scale);
+      }
+    } else {
+      FOVEA_CHECK(layout.format == Format::kDepth32F);
+      for (int u = 0; u < width; ++u) {
+        const uint32_t bits =
+            uint32_t{src[4 * u]} | (uint32_t{src[4 * u + 1]} << 8) |
+            (uint32_t{src[4 * u + 2]} << 16) | (uint32_t{src[4 * u + 3]} << 24);
+        dst[u] = DepthFromMetres(std::bit_cast<float>(bits));
+      }
+    }
+  }
+  return depth;
+}
+
+absl::StatusOr<cv::Mat> DecodeColor(const RawImage& image, const Layout& layout,
+                                    absl::string_view field) {
+  if (layout.format == Format::kRgb8 || layout.format == Format::kBgr8) {
+    return ColorFromRaw(image, layout);
+  }
+  const absl::string_view kind = layout.format == Format::kPng ? "PNG" : "JPEG";
+  cv::Mat bgr = DecodeFile(View(image.compressed), cv::IMREAD_COLOR);
+  if (bgr.type() != CV_8UC3 || bgr.cols != static_cast<int>(layout.width) ||
+      bgr.rows != static_cast<int>(layout.height)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".compressed: not a decodable ", kind, " (",
+                     image.compressed.size(), " bytes)"));
+  }
+  cv::Mat rgb;
+  cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+  return rgb;
+}
+
+absl::StatusOr<cv::Mat> DecodeDepth(const RawImage& image, const Layout& layout,
+                                    double scale, absl::string_view field) {
+  if (layout.format != Format::kPng) return DepthFromRaw(image, layout, scale);
+  const cv::Mat units = DecodeFile(View(image.compressed), cv::IMREAD_ANYDEPTH);
+  if (units.type() != CV_16UC1 ||
+      units.cols != static_cast<int>(layout.width) ||
+      units.rows != static_cast<int>(layout.height)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".compressed: not a decodable PNG (",
+                     image.compressed.size(), " bytes)"));
+  }
+  cv::Mat depth(units.rows, units.cols, CV_32FC1);
+  for (int v = 0; v < depth.rows; ++v) {
+    const uint16_t* src = units.ptr<uint16_t>(v);
+    float* dst = depth.ptr<float>(v);
+    for (int u = 0; u < depth.cols; ++u) dst[u] = DepthFromUnits(src[u], scale);
+  }
+  return depth;
+}
+
+bool HasValidDepth(const cv::Mat& depth) {
+  for (int v = 0; v < depth.rows; ++v) {
+    const float* row = depth.ptr<float>(v);
+    for (int u = 0; u < depth.cols; ++u) {
+      if (!std::isnan(row[u])) return true;
+    }
+  }
+  return false;
+}
+
+absl::StatusOr<RgbdFrame> DecodeValidatedFrame(const RawFrame& raw,
+                                               const FrameLimits& limits) {
+  absl::Status status = Validate(limits);
+  if (!status.ok()) return status;
+  status = ValidateIntrinsics(raw.intrinsics, "frame.intrinsics");
+  if (!status.ok()) return status;
+  if (!std::isfinite(raw.depth_scale) || raw.depth_scale < 0.0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("frame.depth_scale: ", raw.depth_scale,
+                     " must be finite and > 0 (or 0 for the default ",
+                     kDefaultDepthScale, ")"));
+  }
+  const double scale =
+      raw.depth_scale == 0.0 ? kDefaultDepthScale : raw.depth_scale;
+
+  absl::StatusOr<Layout> color_layout =
+      Inspect(raw.color, Slot::kColor, "frame.color", limits);
+  if (!color_layout.ok()) return color_layout.status();
+  absl::StatusOr<Layout> depth_layout =
+      Inspect(raw.depth, Slot::kDepth, "frame.depth", limits);
+  if (!depth_layout.ok()) return depth_layout.status();
+  if (color_layout->width != depth_layout->width ||
+      color_layout->height != depth_layout->height) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("frame.depth: ", depth_layout->width, " x ",
+                     depth_layout->height, " does not match frame.color ",
+                     color_layout->width, " x ", color_layout->height));
+  }
+
+  RgbdFrame frame;
+  frame.intrinsics = raw.intrinsics;
+  absl::StatusOr<cv::Mat> depth =
+      DecodeDepth(raw.depth, *depth_layout, scale, "frame.depth");
+  if (!depth.ok()) return depth.status();
+  if (!HasValidDepth(*depth)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("frame.depth: no valid depth pixel in ", depth->cols,
+                     " x ", depth->rows, " (all 0, NaN, negative or inf)"));
+  }
+  frame.depth = *std::move(depth);
+  absl::StatusOr<cv::Mat> color =
+      DecodeColor(raw.color, *color_layout, "frame.color");
+  if (!color.ok()) return color.status();
+  frame.color = *std::move(color);
+  return frame;
+}
+
+}  // namespace
+
+absl::Status Validate(const FrameLimits& limits) {
+  if (limits.max_width == 0 || limits.max_width > kLargestLimit) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("limits.max_width: ", limits.max_width, " is not in [1, ",
+                     kLargestLimit, "]"));
+  }
+  if (limits.max_height == 0 || limits.max_height > kLargestLimit) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("limits.max_height: ", limits.max_height,
+                     " is not in [1, ", kLargestLimit, "]"));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status ValidateIntrinsics(const Intrinsics& intrinsics,
+                                std::string_view field_name) {
+  const absl::string_view field = View(field_name);
+  const struct {
+    absl::string_view name;
+    double value;
+    bool positive;
+  } kParameters[] = {{"fx", intrinsics.fx, true},
+                     {"fy", intrinsics.fy, true},
+                     {"cx", intrinsics.cx, false},
+                     {"cy", intrinsics.cy, false}};
+  for (const auto& parameter : kParameters) {
+    if (!std::isfinite(parameter.value)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          field, ".", parameter.name, ": ", parameter.value, " is not finite"));
+    }
+    if (parameter.positive && parameter.value <= 0.0) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, ".", parameter.name, ": ", parameter.value,
+                       " must be > 0 (a focal length in pixels)"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<RgbdFrame> DecodeFrame(const RawFrame& raw,
+                                      const FrameLimits& limits) {
+  // Sizes are bounded by `limits` before anything is allocated, so an
+  // exception here is an allocation failure or an OpenCV bug; neither may
+  // leave core/.
+  try {
+    return DecodeValidatedFrame(raw, limits);
+  } catch (const std::bad_alloc&) {
+    return absl::ResourceExhaustedError(
+        "DecodeFrame: out of memory decoding the frame");
+  } catch (const std::exception& e) {
+    return absl::InternalError(absl::StrCat("DecodeFrame: ", e.what()));
+  }
+}
+
+}  // namespace fovea
