@@ -1,10 +1,9 @@
 #ifndef FOVEA_CORE_FRAME_OSD_PCD_H_
 #define FOVEA_CORE_FRAME_OSD_PCD_H_
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "absl/status/statusor.h"
 #include "core/frame/rgbd_frame.h"
@@ -33,10 +32,9 @@ inline bool IsTableLabel(int label) { return label >= 1 && label <= 9; }
 // nearest point winning; points behind the camera or outside the image are
 // dropped. Depth is the points' z. Errors: NOT_FOUND for a missing file,
 // INVALID_ARGUMENT for an unreadable or malformed one.
-absl::StatusOr<LabelledFrame> LoadOsdPcd(const std::string& path,
-                                         const Intrinsics& intrinsics =
-                                             kKinectV1Intrinsics,
-                                         int width = 640, int height = 480);
+absl::StatusOr<LabelledFrame> LoadOsdPcd(
+    const std::string& path, const Intrinsics& intrinsics = kKinectV1Intrinsics,
+    int width = 640, int height = 480);
 
 // The learn*.pcd (or any *.pcd) files of a folder, sorted by the number in
 // their name ("learn2" before "learn10").
