@@ -1,13 +1,12 @@
 #ifndef FOVEA_CORE_SYNTH_SYNTH_SCENE_H_
 #define FOVEA_CORE_SYNTH_SYNTH_SCENE_H_
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <vector>
 
-#include <Eigen/Core>
-#include <Eigen/Geometry>
-
-#include "absl/status/statusor.h"
+#include "absl/status/status.h"
 #include "core/frame/osd_pcd.h"
 #include "core/frame/rgbd_frame.h"
 
@@ -16,6 +15,11 @@ namespace fovea::synth {
 // Synthetic table-top scenes with ground truth, ray-cast through a pinhole
 // camera. World frame: the table top is the plane z = 0, +z up, metres.
 // Every object rests on the table or on another object.
+//
+// Determinism: all randomness comes from std::mt19937_64 (bit-exact by the
+// standard) through distributions computed in core/synth/random.h, so a seed
+// gives the same scene with every standard library (floating-point maths
+// such as std::sin may still differ in the last bit between libms).
 
 enum class Shape { kBox, kCylinder, kSphere, kCone };
 
@@ -42,9 +46,14 @@ struct SceneSpec {
   // Camera pose in the world (camera frame: x right, y down, z forward).
   Eigen::Isometry3f camera_pose = Eigen::Isometry3f::Identity();
   Intrinsics intrinsics = kKinectV1Intrinsics;
-  int width = 640;   // pixels
-  int height = 480;  // pixels
+  int width = 640;   // pixels, > 0
+  int height = 480;  // pixels, > 0
 };
+
+// OK, or INVALID_ARGUMENT naming the field: sizes and focal lengths must be
+// positive, radii and half extents positive, albedos in [0, 1], poses
+// rotations.
+absl::Status Validate(const SceneSpec& spec);
 
 struct NoiseOptions {
   bool enabled = true;
@@ -67,10 +76,16 @@ struct NoiseOptions {
   float color_sigma = 3.0f;
 };
 
+// OK, or INVALID_ARGUMENT naming the field (negative sigmas, non-positive
+// baseline or disparity step, probabilities outside [0, 1]).
+absl::Status Validate(const NoiseOptions& options);
+
 // Ground truth of one object as rendered.
 struct ObjectTruth {
-  int label = 0;      // OSD-style label 10 * (index + 2), object id index + 2
+  int label = 0;  // OSD-style label 10 * (index + 2), object id index + 2
   Primitive primitive;
+  // Pixels carrying `label` in the rendered frame: seen by the camera and
+  // with depth (pixels whose depth the noise model dropped have label 0).
   int visible_pixels = 0;
 };
 
@@ -83,8 +98,21 @@ struct SynthScene {
   float table_d_camera = 0.0f;
 };
 
-// Renders `spec` (noise from `seed`). Pixels that see nothing have NaN depth
-// and label 0; colour is shaded by a fixed light plus ambient.
+// Renders `spec` (noise from `seed`) by casting one ray per pixel centre;
+// the nearest surface wins. On return:
+//   frame.frame.depth: camera z in metres, NaN where the ray hits nothing or
+//                      the noise model dropped the depth;
+//   frame.frame.color: albedo times (ambient + Lambertian term of a fixed
+//                      world-frame light), RGB; pixels seeing nothing show a
+//                      flat grey background;
+//   frame.labels:      0 where depth is NaN, 1 table, 10 * (k + 2) for
+//                      spec.objects[k];
+//   frame.name:        "synth-<seed>"; frame.frame.intrinsics =
+//                      spec.intrinsics.
+// With noise.enabled the depth gets, in this order, edge dropouts (computed
+// on the noise-free depth), dark-surface dropouts, axial Gaussian noise and
+// disparity quantisation, and the colour gets Gaussian noise.
+// Precondition (checked): Validate(spec) and Validate(noise) are OK.
 SynthScene RenderScene(const SceneSpec& spec, const NoiseOptions& noise,
                        uint64_t seed);
 
@@ -95,22 +123,50 @@ struct RandomSceneOptions {
   // placed touching another object.
   float stack_probability = 0.2f;
   float touch_probability = 0.3f;
+  // Probability that an object is placed between the camera and an object
+  // already on the table, partly hiding it.
+  float occlude_probability = 0.15f;
+  // Probability that an object has a dark albedo (loses depth under the
+  // default NoiseOptions).
+  float dark_object_probability = 0.1f;
   // Camera: height above the table and distance back from its centre,
   // metres, looking at the table centre (a Kinect on a robot's head).
   float camera_height = 0.75f;
   float camera_distance = 0.75f;
+  // Uniform jitter of the eye (x, y, z) and of the look-at target (x, y),
+  // +- metres.
+  float camera_jitter = 0.04f;
+  // Every object keeps at least this share of the pixels it would cover
+  // alone (checked on a half-resolution render while placing), so that no
+  // object is hidden entirely. [0, 1].
+  float min_visible_fraction = 0.3f;
 };
 
+// OK, or INVALID_ARGUMENT naming the field: 0 <= min_objects <= max_objects
+// <= 20, probabilities in [0, 1] with stack + touch + occlude <= 1, camera
+// height > 0, camera distance >= 0, jitter >= 0.
+absl::Status Validate(const RandomSceneOptions& options);
+
 // A random table-top scene: boxes, cylinders, spheres and cones at random
-// poses and colours, some touching, stacked and occluding, all on the
-// table. Deterministic: the same seed gives the same spec.
+// poses and colours (3-15 cm), some touching, stacked and occluding, all on
+// the table and in view of the default 640 x 480 Kinect camera. Boxes rest
+// on a face, cylinders stand or lie, spheres and cones stand on the table;
+// stacked objects stand on a box. Vertical projections of objects at
+// overlapping heights do not overlap, so nothing interpenetrates. The
+// number of objects is drawn from [min_objects, max_objects]; on a crowded
+// table fewer may fit. Deterministic: the same seed gives the same spec.
+// Precondition (checked): Validate(options) is OK.
 SceneSpec RandomSceneSpec(uint64_t seed, const RandomSceneOptions& options);
 
-// The camera pose looking at `target` from `eye` with the world +z up.
+// The camera pose (camera to world) looking at `target` from `eye` with the
+// world +z up: camera z along target - eye, camera x horizontal, camera y
+// pointing down in the world. Looking straight down (or up), image up is
+// world +y. `eye` must differ from `target`.
 Eigen::Isometry3f LookAt(const Eigen::Vector3f& eye,
                          const Eigen::Vector3f& target);
 
-// The demo scene: RandomSceneSpec(seed) rendered with default noise.
+// The demo scene: RandomSceneSpec(seed, {}) rendered with default noise and
+// `seed`. Seeds 1..20 give 2-6 visible objects.
 SynthScene GenerateScene(uint64_t seed);
 
 }  // namespace fovea::synth

@@ -1,0 +1,49 @@
+#ifndef FOVEA_CORE_SYNTH_RAYCAST_H_
+#define FOVEA_CORE_SYNTH_RAYCAST_H_
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <optional>
+
+#include "core/synth/synth_scene.h"
+
+namespace fovea::synth {
+
+// Exact ray casting of the primitives of synth_scene.h. A ray is
+// origin + t * direction; `direction` need not be unit length, and t is in
+// units of its length (so with a camera-frame direction (x, y, 1), t is the
+// camera depth z).
+
+struct RayHit {
+  float t = 0.0f;
+  // Unit outward normal of the surface at the hit, in the ray's frame.
+  Eigen::Vector3f normal = Eigen::Vector3f::UnitZ();
+};
+
+// The nearest intersection of a world-frame ray with the closed surface of
+// `primitive` (box faces; cylinder side and caps; sphere; cone side and base
+// disc) with t in (t_min, t_max), or nullopt.
+std::optional<RayHit> IntersectPrimitive(const Primitive& primitive,
+                                         const Eigen::Vector3f& origin,
+                                         const Eigen::Vector3f& direction,
+                                         float t_min, float t_max);
+
+// The nearest intersection with the table rectangle (z = 0, |x| <= hx,
+// |y| <= hy) with t in (t_min, t_max), or nullopt. Normal +z.
+std::optional<RayHit> IntersectTable(const Eigen::Vector2f& table_half_size,
+                                     const Eigen::Vector3f& origin,
+                                     const Eigen::Vector3f& direction,
+                                     float t_min, float t_max);
+
+// One ray per pixel centre through spec.intrinsics from spec.camera_pose,
+// nearest hit wins.
+struct RaycastImage {
+  cv::Mat depth;   // CV_32FC1, camera z, metres; NaN where nothing is hit
+  cv::Mat hit;     // CV_32SC1: -1 nothing, 0 table, k + 1 spec.objects[k]
+  cv::Mat normal;  // CV_32FC3, world-frame unit normal facing the camera
+};
+RaycastImage RaycastScene(const SceneSpec& spec);
+
+}  // namespace fovea::synth
+
+#endif  // FOVEA_CORE_SYNTH_RAYCAST_H_

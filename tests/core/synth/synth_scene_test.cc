@@ -1,0 +1,723 @@
+#include "core/synth/synth_scene.h"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <numbers>
+#include <opencv2/core.hpp>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "core/synth/footprint.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+
+namespace fovea::synth {
+namespace {
+
+using Eigen::Vector2f;
+using Eigen::Vector3f;
+using ::testing::HasSubstr;
+
+// Principal point on a pixel centre, so pixel (320, 240) looks along the
+// optical axis.
+constexpr Intrinsics kCentredIntrinsics{525.0, 525.0, 320.0, 240.0};
+
+NoiseOptions NoNoise() {
+  NoiseOptions noise;
+  noise.enabled = false;
+  return noise;
+}
+
+SceneSpec EmptySpec(const Vector3f& eye, const Vector3f& target) {
+  SceneSpec spec;
+  spec.intrinsics = kCentredIntrinsics;
+  spec.camera_pose = LookAt(eye, target);
+  return spec;
+}
+
+// A camera `height` metres straight above the table centre.
+SceneSpec TopDownSpec(float height) {
+  return EmptySpec(Vector3f(0, 0, height), Vector3f::Zero());
+}
+
+Primitive MakePrimitive(Shape shape, const Vector3f& centre,
+                        const Vector3f& half_extents, float radius,
+                        float yaw = 0.0f) {
+  Primitive p;
+  p.shape = shape;
+  p.half_extents = half_extents;
+  p.radius = radius;
+  p.pose = Eigen::Isometry3f::Identity();
+  p.pose.linear() =
+      Eigen::AngleAxisf(yaw, Vector3f::UnitZ()).toRotationMatrix();
+  p.pose.translation() = centre;
+  return p;
+}
+
+Vector2f Project(const SceneSpec& spec, const Vector3f& world) {
+  const Vector3f c = spec.camera_pose.inverse() * world;
+  return {static_cast<float>(spec.intrinsics.fx * c.x() / c.z() +
+                             spec.intrinsics.cx),
+          static_cast<float>(spec.intrinsics.fy * c.y() / c.z() +
+                             spec.intrinsics.cy)};
+}
+
+// The camera-frame point of pixel (u, v) with depth z.
+Vector3f BackProject(const Intrinsics& k, int u, int v, float z) {
+  return {static_cast<float>((u - k.cx) * z / k.fx),
+          static_cast<float>((v - k.cy) * z / k.fy), z};
+}
+
+int CountLabel(const cv::Mat& labels, int label) {
+  return cv::countNonZero(labels == label);
+}
+
+float DepthAt(const SynthScene& scene, int u, int v) {
+  return scene.frame.frame.depth.at<float>(v, u);
+}
+
+bool SameBytes(const cv::Mat& a, const cv::Mat& b) {
+  return a.type() == b.type() && a.size() == b.size() && a.isContinuous() &&
+         b.isContinuous() &&
+         std::memcmp(a.data, b.data, a.total() * a.elemSize()) == 0;
+}
+
+Footprint Disc(const Vector2f& centre, float radius) {
+  Footprint f;
+  f.centre = centre;
+  f.radius = radius;
+  f.z_max = 0.1f;
+  return f;
+}
+
+Footprint Rectangle(const Vector2f& centre, const Vector2f& half, float yaw) {
+  Footprint f;
+  f.is_circle = false;
+  f.centre = centre;
+  f.half = half;
+  f.yaw = yaw;
+  f.z_max = 0.1f;
+  return f;
+}
+
+TEST(FootprintTest, OverlapFindsContactOfDiscsAndRotatedRectangles) {
+  EXPECT_TRUE(Overlap(Disc({0, 0}, 0.05f), Disc({0.09f, 0}, 0.05f), 0));
+  EXPECT_FALSE(Overlap(Disc({0, 0}, 0.05f), Disc({0.11f, 0}, 0.05f), 0));
+  EXPECT_TRUE(Overlap(Disc({0, 0}, 0.05f), Disc({0.11f, 0}, 0.05f), 0.02f));
+  // A square turned 45 degrees reaches sqrt(2) * 0.05 along x.
+  const Footprint diamond =
+      Rectangle({0, 0}, {0.05f, 0.05f}, std::numbers::pi_v<float> / 4);
+  EXPECT_TRUE(Overlap(diamond, Rectangle({0.12f, 0}, {0.05f, 0.05f}, 0), 0));
+  EXPECT_FALSE(Overlap(diamond, Rectangle({0.125f, 0}, {0.05f, 0.05f}, 0), 0));
+  // Disc near a rectangle's corner: the corner is sqrt(2) * 0.05 away.
+  const Footprint square = Rectangle({0, 0}, {0.05f, 0.05f}, 0);
+  EXPECT_FALSE(Overlap(square, Disc({0.1f, 0.1f}, 0.07f), 0));
+  EXPECT_TRUE(Overlap(square, Disc({0.1f, 0.1f}, 0.071f), 0));
+  // Objects one above the other do not collide.
+  Footprint above = square;
+  above.z_min = 0.1f;
+  above.z_max = 0.2f;
+  EXPECT_FALSE(Collides(square, above, 0));
+  EXPECT_TRUE(Collides(square, square, 0));
+}
+
+TEST(FootprintTest, ContactDistanceIsWhereFootprintsJustTouch) {
+  const Vector2f x(1, 0);
+  EXPECT_NEAR(
+      ContactDistance(Disc({0, 0}, 0.05f), Disc({0, 0}, 0.03f), {0, 0}, x),
+      0.08f, 1e-6f);
+  const Footprint diamond =
+      Rectangle({0, 0}, {0.05f, 0.05f}, std::numbers::pi_v<float> / 4);
+  EXPECT_NEAR(
+      ContactDistance(diamond, Rectangle({0, 0}, {0.02f, 0.03f}, 0), {0, 0}, x),
+      0.05f * std::numbers::sqrt2_v<float> + 0.02f, 1e-6f);
+  EXPECT_EQ(
+      ContactDistance(Disc({0, 0}, 0.01f), Disc({1, 0}, 0.01f), {1, 0}, x),
+      0.0f);
+}
+
+TEST(LookAtTest, TargetProjectsToPrincipalPointAndImageIsUpright) {
+  const Vector3f eye(0.1f, -0.8f, 0.7f);
+  const Vector3f target(-0.05f, 0.1f, 0.0f);
+  const SceneSpec spec = EmptySpec(eye, target);
+  const Vector2f p = Project(spec, target);
+  EXPECT_NEAR(p.x(), 320.0f, 1e-3f);
+  EXPECT_NEAR(p.y(), 240.0f, 1e-3f);
+  const Eigen::Matrix3f r = spec.camera_pose.linear();
+  EXPECT_NEAR(r.col(0).z(), 0.0f, 1e-6f);  // image rows are horizontal
+  EXPECT_LT(r.col(1).z(), 0.0f);           // image y points down
+  EXPECT_NEAR(r.determinant(), 1.0f, 1e-5f);
+  // Something higher than the target appears higher in the image.
+  EXPECT_LT(Project(spec, target + Vector3f(0, 0, 0.1f)).y(), 240.0f);
+}
+
+TEST(LookAtTest, StraightDownHasWorldPlusYUp) {
+  const SceneSpec spec = TopDownSpec(1.0f);
+  EXPECT_LT(Project(spec, Vector3f(0, 0.1f, 0)).y(), 240.0f);
+  EXPECT_GT(Project(spec, Vector3f(0.1f, 0, 0)).x(), 320.0f);
+}
+
+TEST(ValidateTest, NamesTheBrokenField) {
+  SceneSpec spec;
+  spec.width = 0;
+  EXPECT_THAT(Validate(spec).message(), HasSubstr("width"));
+  spec = SceneSpec();
+  spec.objects.push_back(
+      MakePrimitive(Shape::kSphere, Vector3f::Zero(), Vector3f::Zero(), -1));
+  EXPECT_THAT(Validate(spec).message(), HasSubstr("objects[0].radius"));
+  EXPECT_TRUE(Validate(SceneSpec()).ok());
+
+  NoiseOptions noise;
+  noise.dark_dropout_probability = 1.5f;
+  EXPECT_THAT(Validate(noise).message(), HasSubstr("dark_dropout_probability"));
+  EXPECT_TRUE(Validate(NoiseOptions()).ok());
+
+  RandomSceneOptions options;
+  options.min_objects = 5;
+  options.max_objects = 3;
+  EXPECT_EQ(Validate(options).code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(Validate(options).message(), HasSubstr("max_objects"));
+  EXPECT_TRUE(Validate(RandomSceneOptions()).ok());
+}
+
+// Seen from straight above its centre, a box shows only its top face: the
+// label covers exactly the pixel centres inside the projected top face.
+TEST(RenderSceneTest, BoxFromAboveCoversProjectedTopFace) {
+  SceneSpec spec = TopDownSpec(1.0f);
+  const Vector3f half(0.06f, 0.04f, 0.03f);
+  spec.objects.push_back(
+      MakePrimitive(Shape::kBox, Vector3f(0, 0, half.z()), half, 0.0f));
+  const SynthScene scene = RenderScene(spec, NoNoise(), 1);
+
+  const Vector2f lo =
+      Project(spec, Vector3f(-half.x(), half.y(), 2 * half.z()));
+  const Vector2f hi =
+      Project(spec, Vector3f(half.x(), -half.y(), 2 * half.z()));
+  ASSERT_LT(lo.x(), hi.x());
+  ASSERT_LT(lo.y(), hi.y());
+  int expected = 0;
+  for (int v = 0; v < spec.height; ++v) {
+    for (int u = 0; u < spec.width; ++u) {
+      const bool inside =
+          u >= lo.x() && u <= hi.x() && v >= lo.y() && v <= hi.y();
+      expected += inside;
+      EXPECT_EQ(scene.frame.labels.at<int>(v, u) == 20, inside)
+          << "pixel " << u << ", " << v;
+    }
+  }
+  EXPECT_EQ(CountLabel(scene.frame.labels, 20), expected);
+  ASSERT_EQ(scene.objects.size(), 1u);
+  EXPECT_EQ(scene.objects[0].label, 20);
+  EXPECT_EQ(scene.objects[0].visible_pixels, expected);
+  EXPECT_NEAR(DepthAt(scene, 320, 240), 1.0f - 2 * half.z(), 1e-5f);
+  EXPECT_NEAR(DepthAt(scene, 100, 100), 1.0f, 1e-5f);  // the table
+  EXPECT_EQ(scene.frame.labels.at<int>(100, 100), 1);
+  EXPECT_TRUE(std::isnan(DepthAt(scene, 0, 0)));  // beyond the table
+  EXPECT_EQ(scene.frame.labels.at<int>(0, 0), 0);
+}
+
+struct AnalyticCase {
+  std::string name;
+  Primitive primitive;
+  Vector3f eye;
+  Vector3f target;
+  float depth;  // expected camera z at pixel (320, 240)
+};
+
+// The depth on the optical axis equals the analytic distance to each
+// shape's surface, from above and from the side (rotated poses included).
+TEST(RenderSceneTest, DepthOnAxisMatchesAnalyticDistanceForEveryShape) {
+  const float r = 0.04f;
+  const float h = 0.06f;
+  Primitive lying =
+      MakePrimitive(Shape::kCylinder, Vector3f(0, 0, r), Vector3f(r, r, h), r);
+  lying.pose.linear() =
+      Eigen::AngleAxisf(0.3f, Vector3f::UnitZ()).toRotationMatrix() *
+      Eigen::AngleAxisf(std::numbers::pi_v<float> / 2, Vector3f::UnitX())
+          .toRotationMatrix();
+  const Vector3f above(0, 0, 1);
+  const std::vector<AnalyticCase> cases = {
+      {"box yawed 45 deg, seen on its vertical edge",
+       MakePrimitive(Shape::kBox, Vector3f(0, 0, 0.05f),
+                     Vector3f::Constant(0.05f), 0.0f,
+                     std::numbers::pi_v<float> / 4),
+       Vector3f(-1, 0, 0.05f), Vector3f(0, 0, 0.05f),
+       1.0f - 0.05f * std::numbers::sqrt2_v<float>},
+      {"upright cylinder side",
+       MakePrimitive(Shape::kCylinder, Vector3f(0, 0, h), Vector3f(r, r, h), r),
+       Vector3f(-1, 0, h), Vector3f(0, 0, h), 1.0f - r},
+      {"upright cylinder cap",
+       MakePrimitive(Shape::kCylinder, Vector3f(0, 0, h), Vector3f(r, r, h), r),
+       above, Vector3f::Zero(), 1.0f - 2 * h},
+      {"lying cylinder side from above", lying, above, Vector3f::Zero(),
+       1.0f - 2 * r},
+      {"sphere from the side",
+       MakePrimitive(Shape::kSphere, Vector3f(0, 0, r), Vector3f::Zero(), r),
+       Vector3f(-1, 0, r), Vector3f(0, 0, r), 1.0f - r},
+      {"cone apex from above",
+       MakePrimitive(Shape::kCone, Vector3f(0, 0, h), Vector3f(r, r, h), r),
+       above, Vector3f::Zero(), 1.0f - 2 * h},
+      {"cone side at mid height (radius r / 2)",
+       MakePrimitive(Shape::kCone, Vector3f(0, 0, h), Vector3f(r, r, h), r),
+       Vector3f(-1, 0, h), Vector3f(0, 0, h), 1.0f - r / 2},
+  };
+  for (const AnalyticCase& c : cases) {
+    SceneSpec spec = EmptySpec(c.eye, c.target);
+    spec.objects.push_back(c.primitive);
+    const SynthScene scene = RenderScene(spec, NoNoise(), 1);
+    EXPECT_NEAR(DepthAt(scene, 320, 240), c.depth, 1e-5f) << c.name;
+    EXPECT_EQ(scene.frame.labels.at<int>(240, 320), 20) << c.name;
+  }
+}
+
+// A cone seen from below its base level would show the base disc; seen from
+// the side its silhouette narrows towards the apex.
+TEST(RenderSceneTest, ConeSilhouetteNarrowsTowardsApex) {
+  const float r = 0.05f;
+  const float h = 0.06f;
+  SceneSpec spec = EmptySpec(Vector3f(-1, 0, h), Vector3f(0, 0, h));
+  spec.objects.push_back(
+      MakePrimitive(Shape::kCone, Vector3f(0, 0, h), Vector3f(r, r, h), r));
+  const SynthScene scene = RenderScene(spec, NoNoise(), 1);
+  const cv::Mat mask = scene.frame.labels == 20;
+  const int near_base = cv::countNonZero(mask.row(240 + 25));
+  const int middle = cv::countNonZero(mask.row(240));
+  const int near_apex = cv::countNonZero(mask.row(240 - 25));
+  EXPECT_GT(near_base, middle);
+  EXPECT_GT(middle, near_apex);
+  // Width at mid height: the radius there is r / 2, at distance ~1 m.
+  EXPECT_NEAR(middle, 2 * 525.0f * (r / 2) / 1.0f, 3.0f);
+}
+
+// The silhouette of a sphere seen from distance L is a disc of angular
+// radius asin(r / L).
+TEST(RenderSceneTest, SphereSilhouetteIsDiscOfExpectedRadius) {
+  const float r = 0.05f;
+  SceneSpec spec = TopDownSpec(1.0f);
+  spec.objects.push_back(
+      MakePrimitive(Shape::kSphere, Vector3f(0, 0, r), Vector3f::Zero(), r));
+  const SynthScene scene = RenderScene(spec, NoNoise(), 1);
+  const float distance = 1.0f - r;
+  const float rho = 525.0f * std::tan(std::asin(r / distance));
+  for (int v = 0; v < spec.height; ++v) {
+    for (int u = 0; u < spec.width; ++u) {
+      const float d = std::hypot(u - 320.0f, v - 240.0f);
+      const bool labelled = scene.frame.labels.at<int>(v, u) == 20;
+      if (d < rho - 0.5f) {
+        EXPECT_TRUE(labelled) << u << ", " << v;
+      } else if (d > rho + 0.5f) {
+        EXPECT_FALSE(labelled) << u << ", " << v;
+      }
+    }
+  }
+  const float equivalent_radius =
+      std::sqrt(CountLabel(scene.frame.labels, 20) / std::numbers::pi_v<float>);
+  EXPECT_NEAR(equivalent_radius, rho, 0.3f);
+}
+
+TEST(RenderSceneTest, CylinderInFrontOccludesBox) {
+  SceneSpec spec = EmptySpec(Vector3f(0, -0.8f, 0.4f), Vector3f(0, 0, 0.05f));
+  spec.objects.push_back(MakePrimitive(Shape::kBox, Vector3f(0, 0.1f, 0.06f),
+                                       Vector3f::Constant(0.06f), 0.0f));
+  const SynthScene alone = RenderScene(spec, NoNoise(), 1);
+  spec.objects.push_back(MakePrimitive(Shape::kCylinder,
+                                       Vector3f(0, -0.1f, 0.08f),
+                                       Vector3f(0.04f, 0.04f, 0.08f), 0.04f));
+  const SynthScene both = RenderScene(spec, NoNoise(), 1);
+
+  const int box_alone = alone.objects[0].visible_pixels;
+  const int box_behind = both.objects[0].visible_pixels;
+  EXPECT_GT(box_alone, 1000);
+  EXPECT_GT(box_behind, 0);
+  EXPECT_LT(box_behind, 0.8 * box_alone);
+  EXPECT_GT(both.objects[1].visible_pixels, 1000);
+  // Every box pixel left was a box pixel before, and the box pixels lost
+  // now show the cylinder.
+  const cv::Mat box_before = alone.frame.labels == 20;
+  const cv::Mat box_after = both.frame.labels == 20;
+  EXPECT_EQ(cv::countNonZero(box_after & ~box_before), 0);
+  const cv::Mat lost = box_before & ~box_after;
+  EXPECT_EQ(cv::countNonZero(lost & (both.frame.labels == 30)),
+            cv::countNonZero(lost));
+}
+
+// Lambertian shading: the top and the camera-facing side of one box get
+// different brightness.
+TEST(RenderSceneTest, FacesOfOneBoxDifferInBrightness) {
+  SceneSpec spec = EmptySpec(Vector3f(0, -0.7f, 0.5f), Vector3f::Zero());
+  const float a = 0.06f;
+  Primitive box = MakePrimitive(Shape::kBox, Vector3f(0, 0, a),
+                                Vector3f::Constant(a), 0.0f);
+  box.rgb = Vector3f(0.2f, 0.6f, 0.9f);
+  spec.objects.push_back(box);
+  const SynthScene scene = RenderScene(spec, NoNoise(), 1);
+  const Eigen::Isometry3f camera_to_world = spec.camera_pose;
+  double top_sum = 0, front_sum = 0;
+  int top_n = 0, front_n = 0;
+  for (int v = 0; v < spec.height; ++v) {
+    for (int u = 0; u < spec.width; ++u) {
+      if (scene.frame.labels.at<int>(v, u) != 20) continue;
+      const Vector3f p = camera_to_world * BackProject(spec.intrinsics, u, v,
+                                                       DepthAt(scene, u, v));
+      const cv::Vec3b rgb = scene.frame.frame.color.at<cv::Vec3b>(v, u);
+      if (std::abs(p.z() - 2 * a) < 1e-3f) {
+        top_sum += rgb[1];
+        ++top_n;
+      } else if (std::abs(p.y() + a) < 1e-3f) {
+        front_sum += rgb[1];
+        ++front_n;
+      }
+    }
+  }
+  ASSERT_GT(top_n, 500);
+  ASSERT_GT(front_n, 500);
+  EXPECT_GT(std::abs(top_sum / top_n - front_sum / front_n), 15.0);
+  // Neither face is brighter than its albedo allows.
+  EXPECT_LE(top_sum / top_n, 255.0 * 0.6 + 1);
+}
+
+TEST(RenderSceneTest, TablePointsSatisfyReportedPlane) {
+  const SceneSpec spec = RandomSceneSpec(3, RandomSceneOptions());
+  for (const bool noisy : {false, true}) {
+    NoiseOptions noise;
+    noise.enabled = noisy;
+    const SynthScene scene = RenderScene(spec, noise, 3);
+    const Vector3f n = scene.table_normal_camera;
+    EXPECT_NEAR(n.norm(), 1.0f, 1e-5f);
+    EXPECT_GT(scene.table_d_camera, 0.0f);  // the camera is on n's side
+    int count = 0;
+    int outliers = 0;
+    double sum_sq = 0;
+    for (int v = 0; v < spec.height; ++v) {
+      for (int u = 0; u < spec.width; ++u) {
+        if (scene.frame.labels.at<int>(v, u) != 1) continue;
+        const float z = DepthAt(scene, u, v);
+        const float residual =
+            n.dot(BackProject(spec.intrinsics, u, v, z)) + scene.table_d_camera;
+        // Noise sigma and quantisation step at this depth, plus a margin.
+        const float step = z * z / (525.0f * 0.075f) * 0.125f;
+        const float bound = noisy ? 4 * 1.43e-3f * z * z + step : 1e-4f;
+        ++count;
+        sum_sq += residual * residual;
+        outliers += std::abs(residual) > bound;
+      }
+    }
+    ASSERT_GT(count, 50000);
+    EXPECT_LT(outliers, count / 1000) << "noisy " << noisy;
+    EXPECT_LT(std::sqrt(sum_sq / count), noisy ? 4e-3 : 1e-5)
+        << "noisy " << noisy;
+  }
+}
+
+TEST(RenderSceneTest, DepthNoiseGrowsWithDistance) {
+  std::vector<double> stddev;
+  for (const float height : {0.8f, 1.5f}) {
+    SceneSpec spec = TopDownSpec(height);
+    spec.table_half_size = Vector2f(3, 3);
+    const SynthScene scene = RenderScene(spec, NoiseOptions(), 5);
+    const cv::Mat patch = scene.frame.frame.depth(cv::Rect(220, 140, 200, 200));
+    cv::Scalar mean, sd;
+    cv::meanStdDev(patch, mean, sd);
+    ASSERT_EQ(cv::countNonZero(patch != patch), 0);  // no NaN on the plane
+    const double step = height * height / (525.0 * 0.075) * 0.125;
+    EXPECT_NEAR(mean[0], height, step);
+    stddev.push_back(sd[0]);
+  }
+  EXPECT_GT(stddev[0], 2e-4);  // noise is on at all
+  EXPECT_GT(stddev[1], 2.0 * stddev[0]);
+}
+
+TEST(RenderSceneTest, DarkObjectLosesDepthPixels) {
+  SceneSpec spec = TopDownSpec(1.0f);
+  Primitive dark = MakePrimitive(Shape::kBox, Vector3f(-0.12f, 0, 0.05f),
+                                 Vector3f::Constant(0.05f), 0.0f);
+  dark.rgb = Vector3f(0.05f, 0.05f, 0.06f);
+  Primitive bright = dark;
+  bright.pose.translation().x() = 0.12f;
+  bright.rgb = Vector3f(0.9f, 0.8f, 0.2f);
+  spec.objects = {dark, bright};
+  const SynthScene clean = RenderScene(spec, NoNoise(), 2);
+  const SynthScene noisy = RenderScene(spec, NoiseOptions(), 2);
+  const double dark_kept =
+      static_cast<double>(noisy.objects[0].visible_pixels) /
+      clean.objects[0].visible_pixels;
+  const double bright_kept =
+      static_cast<double>(noisy.objects[1].visible_pixels) /
+      clean.objects[1].visible_pixels;
+  // Both lose their (few) edge pixels; only the dark one loses the rest.
+  EXPECT_GT(bright_kept, 0.95);
+  EXPECT_NEAR(dark_kept / bright_kept,
+              1.0 - NoiseOptions().dark_dropout_probability, 0.07);
+}
+
+// The far side of every depth jump loses depth over edge_dropout_px
+// pixels; the near side and surfaces away from edges keep it.
+TEST(RenderSceneTest, DepthEdgesHaveNaNDropoutsOnTheFarSide) {
+  SceneSpec spec = TopDownSpec(1.0f);
+  spec.objects.push_back(MakePrimitive(Shape::kBox, Vector3f(0, 0, 0.05f),
+                                       Vector3f::Constant(0.05f), 0.0f));
+  const NoiseOptions noise;
+  const SynthScene clean = RenderScene(spec, NoNoise(), 4);
+  const SynthScene noisy = RenderScene(spec, noise, 4);
+  const cv::Mat& box = clean.frame.labels;
+  int band = 0, band_dropped = 0, away = 0, away_dropped = 0;
+  for (int v = 10; v < spec.height - 10; ++v) {
+    for (int u = 10; u < spec.width - 10; ++u) {
+      const bool dropped = std::isnan(DepthAt(noisy, u, v));
+      if (box.at<int>(v, u) == 20) {
+        EXPECT_FALSE(dropped) << "near side " << u << ", " << v;
+        continue;
+      }
+      if (box.at<int>(v, u) != 1) continue;
+      int nearest = 1000;  // Chebyshev distance to the box, capped
+      for (int dv = -6; dv <= 6; ++dv) {
+        for (int du = -6; du <= 6; ++du) {
+          if (box.at<int>(v + dv, u + du) == 20) {
+            nearest = std::min(nearest, std::max(std::abs(du), std::abs(dv)));
+          }
+        }
+      }
+      if (nearest <= noise.edge_dropout_px) {
+        ++band;
+        band_dropped += dropped;
+      } else if (nearest > noise.edge_dropout_px + 1 && nearest < 1000) {
+        ++away;
+        away_dropped += dropped;
+      }
+    }
+  }
+  EXPECT_GT(band, 400);
+  EXPECT_EQ(band_dropped, band);
+  EXPECT_GT(away, 400);
+  EXPECT_EQ(away_dropped, 0);
+}
+
+TEST(GenerateSceneTest, SameSeedGivesIdenticalBytesOtherSeedDiffers) {
+  const SynthScene a = GenerateScene(7);
+  const SynthScene b = GenerateScene(7);
+  EXPECT_TRUE(SameBytes(a.frame.frame.color, b.frame.frame.color));
+  EXPECT_TRUE(SameBytes(a.frame.frame.depth, b.frame.frame.depth));
+  EXPECT_TRUE(SameBytes(a.frame.labels, b.frame.labels));
+  const SynthScene c = GenerateScene(8);
+  EXPECT_FALSE(SameBytes(a.frame.frame.color, c.frame.frame.color));
+  EXPECT_FALSE(SameBytes(a.frame.frame.depth, c.frame.frame.depth));
+  EXPECT_FALSE(SameBytes(a.frame.labels, c.frame.labels));
+}
+
+// The demo seeds: OSD-style labels only, label 0 exactly where depth is
+// missing, truthful visible counts and 2-6 clearly visible objects.
+TEST(GenerateSceneTest, DemoSeedsHaveValidLabelsAndTwoToSixObjects) {
+  for (uint64_t seed = 1; seed <= 20; ++seed) {
+    SCOPED_TRACE(seed);
+    const SynthScene scene = GenerateScene(seed);
+    const LabelledFrame& f = scene.frame;
+    EXPECT_EQ(f.name, "synth-" + std::to_string(seed));
+    EXPECT_EQ(f.frame.intrinsics.fx, kKinectV1Intrinsics.fx);
+    ASSERT_EQ(f.frame.color.type(), CV_8UC3);
+    ASSERT_EQ(f.frame.depth.type(), CV_32FC1);
+    ASSERT_EQ(f.labels.type(), CV_32SC1);
+    EXPECT_EQ(f.frame.depth.size(), cv::Size(640, 480));
+    EXPECT_EQ(f.labels.size(), cv::Size(640, 480));
+
+    std::set<int> allowed = {0, 1};
+    for (size_t i = 0; i < scene.objects.size(); ++i) {
+      EXPECT_EQ(scene.objects[i].label, 10 * (static_cast<int>(i) + 2));
+      allowed.insert(scene.objects[i].label);
+    }
+    int bad = 0;
+    int nan_mismatch = 0;
+    for (int v = 0; v < 480; ++v) {
+      for (int u = 0; u < 640; ++u) {
+        const int label = f.labels.at<int>(v, u);
+        bad += allowed.count(label) == 0;
+        nan_mismatch +=
+            (label == 0) != std::isnan(f.frame.depth.at<float>(v, u));
+      }
+    }
+    EXPECT_EQ(bad, 0);
+    EXPECT_EQ(nan_mismatch, 0);
+    int visible = 0;
+    for (const ObjectTruth& o : scene.objects) {
+      EXPECT_EQ(o.visible_pixels, CountLabel(f.labels, o.label));
+      visible += o.visible_pixels >= 150;
+    }
+    EXPECT_GE(visible, 2);
+    EXPECT_LE(visible, 6);
+    EXPECT_GT(CountLabel(f.labels, 1), 640 * 480 / 5);  // the table
+  }
+}
+
+// --- Independent geometry for the physical-placement test. ---
+
+// Whether local point p is inside the primitive shrunk by `eps`.
+bool InsideLocal(const Primitive& prim, const Vector3f& p, float eps) {
+  const Vector3f& h = prim.half_extents;
+  const float r = prim.radius;
+  switch (prim.shape) {
+    case Shape::kBox:
+      return (p.cwiseAbs() - h).maxCoeff() < -eps;
+    case Shape::kCylinder:
+      return std::abs(p.z()) < h.z() - eps && p.head<2>().norm() < r - eps;
+    case Shape::kSphere:
+      return p.norm() < r - eps;
+    case Shape::kCone: {
+      if (std::abs(p.z()) >= h.z() - eps) return false;
+      return p.head<2>().norm() < r * (h.z() - p.z()) / (2 * h.z()) - eps;
+    }
+  }
+  return false;
+}
+
+// Points filling the primitive on a grid, world frame.
+std::vector<Vector3f> InteriorPoints(const Primitive& prim) {
+  const Vector3f box =
+      prim.shape == Shape::kBox
+          ? prim.half_extents
+          : Vector3f(prim.radius, prim.radius,
+                     prim.shape == Shape::kSphere ? prim.radius
+                                                  : prim.half_extents.z());
+  constexpr int kN = 12;
+  std::vector<Vector3f> points;
+  for (int i = 0; i <= kN; ++i) {
+    for (int j = 0; j <= kN; ++j) {
+      for (int k = 0; k <= kN; ++k) {
+        const Vector3f local = box.cwiseProduct(
+            Vector3f(i, j, k) * (2.0f / kN) - Vector3f::Ones());
+        // Surface points count (inflated by 10 um).
+        if (InsideLocal(prim, local, -1e-5f)) {
+          points.push_back(prim.pose * local);
+        }
+      }
+    }
+  }
+  return points;
+}
+
+// Lowest world z of the primitive.
+float LowestZ(const Primitive& prim) {
+  const Vector3f c = prim.pose.translation();
+  const Vector3f axis = prim.pose.linear().col(2);
+  const float h = prim.half_extents.z();
+  const float r = prim.radius;
+  const float across = std::sqrt(std::max(0.0f, 1 - axis.z() * axis.z()));
+  switch (prim.shape) {
+    case Shape::kBox: {
+      float lowest = 1e9f;
+      for (int i = 0; i < 8; ++i) {
+        const Vector3f corner(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1);
+        lowest = std::min(
+            lowest, (prim.pose * corner.cwiseProduct(prim.half_extents)).z());
+      }
+      return lowest;
+    }
+    case Shape::kCylinder:
+      return c.z() - std::abs(axis.z()) * h - r * across;
+    case Shape::kSphere:
+      return c.z() - r;
+    case Shape::kCone: {
+      const float base = c.z() - axis.z() * h - r * across;
+      return std::min(base, c.z() + axis.z() * h);
+    }
+  }
+  return 0.0f;
+}
+
+TEST(RandomSceneSpecTest, ObjectsRestOnTableOrBoxAndDoNotInterpenetrate) {
+  constexpr float kTol = 1e-4f;
+  int total = 0, stacked = 0;
+  std::set<Shape> shapes;
+  for (uint64_t seed = 1; seed <= 40; ++seed) {
+    SCOPED_TRACE(seed);
+    const SceneSpec spec = RandomSceneSpec(seed, RandomSceneOptions());
+    ASSERT_TRUE(Validate(spec).ok());
+    EXPECT_GE(spec.objects.size(), 2u);
+    EXPECT_LE(spec.objects.size(), 6u);
+    std::vector<std::vector<Vector3f>> interiors;
+    for (const Primitive& p : spec.objects) {
+      interiors.push_back(InteriorPoints(p));
+      shapes.insert(p.shape);
+    }
+    for (size_t i = 0; i < spec.objects.size(); ++i) {
+      const Primitive& p = spec.objects[i];
+      ++total;
+      // Household sizes: 2.5-15 cm in every dimension.
+      const Vector3f size =
+          2 * (p.shape == Shape::kBox ? p.half_extents
+               : p.shape == Shape::kSphere
+                   ? Vector3f::Constant(p.radius)
+                   : Vector3f(p.radius, p.radius, p.half_extents.z()));
+      EXPECT_GE(size.minCoeff(), 0.025f);
+      EXPECT_LE(size.maxCoeff(), 0.15f);
+      // Every point on the table rectangle and in front of the camera.
+      for (const Vector3f& q : interiors[i]) {
+        ASSERT_LE(std::abs(q.x()), spec.table_half_size.x());
+        ASSERT_LE(std::abs(q.y()), spec.table_half_size.y());
+        ASSERT_GE(q.z(), -kTol);
+      }
+      const Vector2f centre_px = Project(spec, p.pose.translation());
+      EXPECT_TRUE(centre_px.x() > 0 && centre_px.x() < 640 &&
+                  centre_px.y() > 0 && centre_px.y() < 480);
+      // Resting: on the table, or on the top face of a level box with the
+      // centre of mass above that face.
+      const float lowest = LowestZ(p);
+      if (std::abs(lowest) > kTol) {
+        bool supported = false;
+        for (const Primitive& s : spec.objects) {
+          if (&s == &p || s.shape != Shape::kBox) continue;
+          const bool level = std::abs(s.pose.linear().col(2).z()) > 1 - 1e-5f;
+          const float top = s.pose.translation().z() + s.half_extents.z();
+          const Vector3f local = s.pose.inverse() * p.pose.translation();
+          supported |= level && std::abs(top - lowest) < kTol &&
+                       std::abs(local.x()) <= s.half_extents.x() &&
+                       std::abs(local.y()) <= s.half_extents.y();
+        }
+        EXPECT_TRUE(supported) << "object " << i << " floats at " << lowest;
+        ++stacked;
+      }
+      // No point of one object inside another (1 mm tolerance).
+      for (size_t j = 0; j < spec.objects.size(); ++j) {
+        if (j == i) continue;
+        const Primitive& o = spec.objects[j];
+        const Eigen::Isometry3f to_local = o.pose.inverse();
+        int inside = 0;
+        for (const Vector3f& q : interiors[i]) {
+          inside += InsideLocal(o, to_local * q, 1e-3f);
+        }
+        EXPECT_EQ(inside, 0) << "objects " << i << " and " << j;
+      }
+    }
+  }
+  EXPECT_GT(stacked, 0);  // stacking happens
+  EXPECT_GT(total, 40 * 3);
+  EXPECT_EQ(shapes.size(), 4u);  // all shapes occur
+}
+
+TEST(RandomSceneSpecTest, SameSeedSameSpec) {
+  const SceneSpec a = RandomSceneSpec(11, RandomSceneOptions());
+  const SceneSpec b = RandomSceneSpec(11, RandomSceneOptions());
+  ASSERT_EQ(a.objects.size(), b.objects.size());
+  for (size_t i = 0; i < a.objects.size(); ++i) {
+    EXPECT_EQ(a.objects[i].pose.matrix(), b.objects[i].pose.matrix());
+    EXPECT_EQ(a.objects[i].rgb, b.objects[i].rgb);
+  }
+  EXPECT_EQ(a.camera_pose.matrix(), b.camera_pose.matrix());
+}
+
+TEST(RandomSceneSpecTest, HonoursObjectCountBounds) {
+  RandomSceneOptions options;
+  options.min_objects = 1;
+  options.max_objects = 1;
+  EXPECT_EQ(RandomSceneSpec(5, options).objects.size(), 1u);
+  options.min_objects = 0;
+  options.max_objects = 0;
+  EXPECT_TRUE(RandomSceneSpec(5, options).objects.empty());
+}
+
+}  // namespace
+}  // namespace fovea::synth
