@@ -1,0 +1,102 @@
+#include "server/capabilities.h"
+
+#include <array>
+
+#include "server/convert.h"
+
+#ifndef FOVEA_VERSION
+#error "FOVEA_VERSION must be defined by the build (server/CMakeLists.txt)"
+#endif
+
+namespace fovea::server {
+namespace {
+
+constexpr std::array kAllSaliencyOps = {
+    SaliencyOp::kPh,          SaliencyOp::kSh,
+    SaliencyOp::kRso,         SaliencyOp::kSym3d,
+    SaliencyOp::kItti,        SaliencyOp::kHarel,
+    SaliencyOp::kHou,         SaliencyOp::kKootstra,
+    SaliencyOp::kTargetColor, SaliencyOp::kLocationPrior,
+};
+constexpr std::array kAllPyramids = {PyramidKind::kNone, PyramidKind::kSimple,
+                                     PyramidKind::kItti};
+constexpr std::array kAllNormalizations = {
+    NormalizationKind::kLin, NormalizationKind::kNms, NormalizationKind::kNlm};
+constexpr std::array kAllExtractions = {
+    ExtractionKind::kMsr, ExtractionKind::kWta, ExtractionKind::kTj};
+
+// The values of `all` for which `set(options, value)` on default options
+// passes Validate.
+template <typename T, size_t N, typename Setter>
+std::vector<T> Accepted(const std::array<T, N>& all, Setter set) {
+  std::vector<T> accepted;
+  for (T value : all) {
+    DetectOptions options;
+    set(options, value);
+    if (Validate(options).ok()) accepted.push_back(value);
+  }
+  return accepted;
+}
+
+}  // namespace
+
+std::string_view ServerVersion() { return FOVEA_VERSION; }
+
+std::vector<SaliencyOp> ImplementedSaliencyOps() {
+  return Accepted(kAllSaliencyOps, [](DetectOptions& options, SaliencyOp op) {
+    options.channels = {{op, 1.0f}};
+  });
+}
+
+std::vector<PyramidKind> ImplementedPyramids() {
+  return Accepted(kAllPyramids, [](DetectOptions& options, PyramidKind kind) {
+    options.pyramid = kind;
+  });
+}
+
+std::vector<NormalizationKind> ImplementedNormalizations() {
+  return Accepted(kAllNormalizations,
+                  [](DetectOptions& options, NormalizationKind kind) {
+                    options.normalization = kind;
+                  });
+}
+
+std::vector<ExtractionKind> ImplementedExtractions() {
+  return Accepted(kAllExtractions,
+                  [](DetectOptions& options, ExtractionKind kind) {
+                    options.extraction = kind;
+                  });
+}
+
+v1::Capabilities BuildCapabilities(const FrameLimits& limits,
+                                   uint64_t max_message_bytes) {
+  v1::Capabilities out;
+  out.set_server_version(std::string(ServerVersion()));
+  for (const char* encoding : {"rgb8", "bgr8"})
+    out.add_color_encodings(encoding);
+  for (const char* encoding : {"16UC1", "32FC1"}) {
+    out.add_depth_encodings(encoding);
+  }
+  for (const char* format : {"png", "jpeg"}) out.add_compressed_formats(format);
+  out.set_max_width(limits.max_width);
+  out.set_max_height(limits.max_height);
+  out.set_max_message_bytes(max_message_bytes);
+  for (SaliencyOp op : ImplementedSaliencyOps()) {
+    out.add_saliency_operators(ToProtoEnum(op));
+  }
+  for (PyramidKind kind : ImplementedPyramids()) {
+    out.add_pyramids(ToProtoEnum(kind));
+  }
+  for (NormalizationKind kind : ImplementedNormalizations()) {
+    out.add_normalizations(ToProtoEnum(kind));
+  }
+  for (ExtractionKind kind : ImplementedExtractions()) {
+    out.add_extractions(ToProtoEnum(kind));
+  }
+  // Segmentation and models arrive with their issues.
+  out.set_segment_incremental(false);
+  *out.mutable_default_detect_options() = ToProtoDetectOptions(DetectOptions{});
+  return out;
+}
+
+}  // namespace fovea::server

@@ -1,0 +1,491 @@
+#include "server/convert.h"
+
+#include <cmath>
+#include <cstdint>
+#include <exception>
+#include <opencv2/imgcodecs.hpp>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+
+namespace fovea::server {
+namespace {
+
+// Largest value of one channel of `target_color_rgb`.
+constexpr uint32_t kMaxColorValue = 255;
+// Full scale of a 16-bit saliency PNG (frame.proto, SaliencyMapImage).
+constexpr double kPngFullScale = 65535.0;
+
+RawImage ToRawImage(const v1::Image& image) {
+  RawImage raw;
+  raw.width = image.width();
+  raw.height = image.height();
+  raw.encoding = image.encoding();
+  raw.is_bigendian = image.is_bigendian();
+  raw.step = image.step();
+  raw.data = image.data();
+  raw.compressed = image.compressed();
+  return raw;
+}
+
+absl::Status UnknownEnumValue(const std::string& field, int value) {
+  return absl::InvalidArgumentError(
+      absl::StrCat(field, ": unknown value ", value));
+}
+
+absl::StatusOr<SaliencyOp> FromProto(v1::SaliencyOperator op,
+                                     const std::string& field) {
+  switch (op) {
+    case v1::PH:
+      return SaliencyOp::kPh;
+    case v1::SH:
+      return SaliencyOp::kSh;
+    case v1::RSO:
+      return SaliencyOp::kRso;
+    case v1::SYM3D:
+      return SaliencyOp::kSym3d;
+    case v1::ITTI:
+      return SaliencyOp::kItti;
+    case v1::HAREL:
+      return SaliencyOp::kHarel;
+    case v1::HOU:
+      return SaliencyOp::kHou;
+    case v1::KOOTSTRA:
+      return SaliencyOp::kKootstra;
+    case v1::TARGET_COLOR:
+      return SaliencyOp::kTargetColor;
+    case v1::LOCATION_PRIOR:
+      return SaliencyOp::kLocationPrior;
+    case v1::SALIENCY_OPERATOR_UNSPECIFIED:
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, ": an operator is required"));
+    default:
+      return UnknownEnumValue(field, op);
+  }
+}
+
+// The FromProto overloads below leave `out` alone for UNSPECIFIED, so the
+// core default stands.
+absl::Status FromProto(v1::Pyramid in, PyramidKind& out) {
+  switch (in) {
+    case v1::PYRAMID_UNSPECIFIED:
+      return absl::OkStatus();
+    case v1::NONE:
+      out = PyramidKind::kNone;
+      return absl::OkStatus();
+    case v1::SIMPLE:
+      out = PyramidKind::kSimple;
+      return absl::OkStatus();
+    case v1::ITTI_PYRAMID:
+      out = PyramidKind::kItti;
+      return absl::OkStatus();
+    default:
+      return UnknownEnumValue("options.pyramid", in);
+  }
+}
+
+absl::Status FromProto(v1::LevelCombination in, LevelCombination& out) {
+  switch (in) {
+    case v1::LEVEL_COMBINATION_UNSPECIFIED:
+      return absl::OkStatus();
+    case v1::LEVELS_SUM:
+      out = LevelCombination::kSum;
+      return absl::OkStatus();
+    case v1::LEVELS_MAX:
+      out = LevelCombination::kMax;
+      return absl::OkStatus();
+    default:
+      return UnknownEnumValue("options.level_combination", in);
+  }
+}
+
+absl::Status FromProto(v1::Normalization in, NormalizationKind& out) {
+  switch (in) {
+    case v1::NORMALIZATION_UNSPECIFIED:
+      return absl::OkStatus();
+    case v1::LIN:
+      out = NormalizationKind::kLin;
+      return absl::OkStatus();
+    case v1::NMS:
+      out = NormalizationKind::kNms;
+      return absl::OkStatus();
+    case v1::NLM:
+      out = NormalizationKind::kNlm;
+      return absl::OkStatus();
+    default:
+      return UnknownEnumValue("options.normalization", in);
+  }
+}
+
+absl::Status FromProto(v1::Fusion in, FusionKind& out) {
+  switch (in) {
+    case v1::FUSION_UNSPECIFIED:
+      return absl::OkStatus();
+    case v1::FUSION_SUM:
+      out = FusionKind::kSum;
+      return absl::OkStatus();
+    case v1::FUSION_MAX:
+      out = FusionKind::kMax;
+      return absl::OkStatus();
+    default:
+      return UnknownEnumValue("options.fusion", in);
+  }
+}
+
+absl::Status FromProto(v1::Extraction in, ExtractionKind& out) {
+  switch (in) {
+    case v1::EXTRACTION_UNSPECIFIED:
+      return absl::OkStatus();
+    case v1::MSR:
+      out = ExtractionKind::kMsr;
+      return absl::OkStatus();
+    case v1::WTA:
+      out = ExtractionKind::kWta;
+      return absl::OkStatus();
+    case v1::TJ:
+      out = ExtractionKind::kTj;
+      return absl::OkStatus();
+    default:
+      return UnknownEnumValue("options.extraction", in);
+  }
+}
+
+absl::StatusOr<std::vector<WeightedChannel>> ToChannels(
+    const v1::DetectOptions& options) {
+  std::vector<WeightedChannel> channels;
+  channels.reserve(options.saliency_size());
+  for (int i = 0; i < options.saliency_size(); ++i) {
+    const v1::WeightedOperator& in = options.saliency(i);
+    const std::string field = absl::StrCat("options.saliency[", i, "]");
+    absl::StatusOr<SaliencyOp> op = FromProto(in.op(), field + ".op");
+    if (!op.ok()) return op.status();
+    const double weight = in.weight();
+    if (!std::isfinite(weight) || weight < 0.0) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          field, ".weight: ", weight, " is not a finite value >= 0"));
+    }
+    channels.push_back(
+        {*op, weight == 0.0 ? 1.0f : static_cast<float>(weight)});
+  }
+  return channels;
+}
+
+absl::Status CheckTopDownCues(const v1::DetectOptions& options) {
+  const int n = options.target_color_rgb_size();
+  if (n != 0 && n != 3) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "options.target_color_rgb: ", n, " values, expected 0 or 3"));
+  }
+  for (int i = 0; i < n; ++i) {
+    if (options.target_color_rgb(i) > kMaxColorValue) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "options.target_color_rgb[", i, "]: ", options.target_color_rgb(i),
+          " is above ", kMaxColorValue));
+    }
+  }
+  const double sigma = options.location_prior_sigma_px();
+  if (!std::isfinite(sigma) || sigma < 0.0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("options.location_prior_sigma_px: ", sigma,
+                     " is not a finite value >= 0"));
+  }
+  return absl::OkStatus();
+}
+
+v1::Point3 ToPoint3(const Eigen::Vector3f& p) {
+  v1::Point3 out;
+  out.set_x(p.x());
+  out.set_y(p.y());
+  out.set_z(p.z());
+  return out;
+}
+
+absl::Status AddMap(const std::string& name, const cv::Mat& map,
+                    v1::DetectResponse& response) {
+  absl::StatusOr<std::string> png = EncodeSaliencyPng(map);
+  if (!png.ok()) {
+    return absl::Status(
+        png.status().code(),
+        absl::StrCat("map '", name, "': ", png.status().message()));
+  }
+  v1::SaliencyMapImage* out = response.add_maps();
+  out->set_name(name);
+  out->mutable_image()->set_width(map.cols);
+  out->mutable_image()->set_height(map.rows);
+  out->mutable_image()->set_compressed(*std::move(png));
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+RawFrame ToRawFrame(const v1::Frame& frame) {
+  RawFrame raw;
+  raw.color = ToRawImage(frame.color());
+  raw.depth = ToRawImage(frame.depth());
+  raw.intrinsics.fx = frame.intrinsics().fx();
+  raw.intrinsics.fy = frame.intrinsics().fy();
+  raw.intrinsics.cx = frame.intrinsics().cx();
+  raw.intrinsics.cy = frame.intrinsics().cy();
+  raw.depth_scale = frame.depth_scale();
+  return raw;
+}
+
+v1::Frame ToProtoFrame(const RgbdFrame& frame, DepthEncoding depth_encoding,
+                       double depth_scale) {
+  v1::Frame out;
+  const int width = frame.color.cols;
+  const int height = frame.color.rows;
+
+  v1::Image* color = out.mutable_color();
+  color->set_width(width);
+  color->set_height(height);
+  color->set_encoding("rgb8");
+  color->set_step(width * 3);
+  std::string* color_bytes = color->mutable_data();
+  color_bytes->reserve(static_cast<size_t>(width) * height * 3);
+  for (int v = 0; v < height; ++v) {
+    color_bytes->append(reinterpret_cast<const char*>(frame.color.ptr(v)),
+                        static_cast<size_t>(width) * 3);
+  }
+
+  v1::Image* depth = out.mutable_depth();
+  depth->set_width(frame.depth.cols);
+  depth->set_height(frame.depth.rows);
+  std::string* depth_bytes = depth->mutable_data();
+  if (depth_encoding == DepthEncoding::k32FC1) {
+    depth->set_encoding("32FC1");
+    depth->set_step(frame.depth.cols * 4);
+    for (int v = 0; v < frame.depth.rows; ++v) {
+      depth_bytes->append(reinterpret_cast<const char*>(frame.depth.ptr(v)),
+                          static_cast<size_t>(frame.depth.cols) * 4);
+    }
+  } else {
+    depth->set_encoding("16UC1");
+    depth->set_step(frame.depth.cols * 2);
+    out.set_depth_scale(depth_scale);
+    depth_bytes->resize(static_cast<size_t>(frame.depth.cols) *
+                        frame.depth.rows * 2);
+    char* dst = depth_bytes->data();
+    for (int v = 0; v < frame.depth.rows; ++v) {
+      const float* row = frame.depth.ptr<float>(v);
+      for (int u = 0; u < frame.depth.cols; ++u) {
+        const double units = std::round(row[u] / depth_scale);
+        const uint16_t value =
+            (std::isfinite(units) && units > 0.0 && units <= 65535.0)
+                ? static_cast<uint16_t>(units)
+                : 0;
+        // Little-endian, as the wire says.
+        *dst++ = static_cast<char>(value & 0xff);
+        *dst++ = static_cast<char>(value >> 8);
+      }
+    }
+  }
+
+  out.mutable_intrinsics()->set_fx(frame.intrinsics.fx);
+  out.mutable_intrinsics()->set_fy(frame.intrinsics.fy);
+  out.mutable_intrinsics()->set_cx(frame.intrinsics.cx);
+  out.mutable_intrinsics()->set_cy(frame.intrinsics.cy);
+  return out;
+}
+
+absl::StatusOr<DetectOptions> ToDetectOptions(
+    const v1::DetectOptions& options) {
+  DetectOptions out;
+  if (options.saliency_size() > 0) {
+    absl::StatusOr<std::vector<WeightedChannel>> channels = ToChannels(options);
+    if (!channels.ok()) return channels.status();
+    out.channels = *std::move(channels);
+  }
+  for (absl::Status status :
+       {FromProto(options.pyramid(), out.pyramid),
+        FromProto(options.level_combination(), out.level_combination),
+        FromProto(options.normalization(), out.normalization),
+        FromProto(options.fusion(), out.fusion),
+        FromProto(options.extraction(), out.extraction),
+        CheckTopDownCues(options)}) {
+    if (!status.ok()) return status;
+  }
+  if (options.max_points() > static_cast<uint32_t>(kMaxPointsLimit)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("options.max_points: ", options.max_points(), " is above ",
+                     kMaxPointsLimit));
+  }
+  if (options.max_points() != 0) {
+    out.max_points = static_cast<int>(options.max_points());
+  }
+  out.keep_channel_maps = options.return_channel_maps();
+
+  // Core names the field itself ("options.saliency: 'sym3d' is not
+  // implemented yet").
+  if (absl::Status status = Validate(out); !status.ok()) return status;
+  return out;
+}
+
+v1::SaliencyOperator ToProtoEnum(SaliencyOp op) {
+  switch (op) {
+    case SaliencyOp::kPh:
+      return v1::PH;
+    case SaliencyOp::kSh:
+      return v1::SH;
+    case SaliencyOp::kRso:
+      return v1::RSO;
+    case SaliencyOp::kSym3d:
+      return v1::SYM3D;
+    case SaliencyOp::kItti:
+      return v1::ITTI;
+    case SaliencyOp::kHarel:
+      return v1::HAREL;
+    case SaliencyOp::kHou:
+      return v1::HOU;
+    case SaliencyOp::kKootstra:
+      return v1::KOOTSTRA;
+    case SaliencyOp::kTargetColor:
+      return v1::TARGET_COLOR;
+    case SaliencyOp::kLocationPrior:
+      return v1::LOCATION_PRIOR;
+  }
+  return v1::SALIENCY_OPERATOR_UNSPECIFIED;
+}
+
+v1::Pyramid ToProtoEnum(PyramidKind pyramid) {
+  switch (pyramid) {
+    case PyramidKind::kNone:
+      return v1::NONE;
+    case PyramidKind::kSimple:
+      return v1::SIMPLE;
+    case PyramidKind::kItti:
+      return v1::ITTI_PYRAMID;
+  }
+  return v1::PYRAMID_UNSPECIFIED;
+}
+
+v1::LevelCombination ToProtoEnum(LevelCombination combination) {
+  switch (combination) {
+    case LevelCombination::kSum:
+      return v1::LEVELS_SUM;
+    case LevelCombination::kMax:
+      return v1::LEVELS_MAX;
+  }
+  return v1::LEVEL_COMBINATION_UNSPECIFIED;
+}
+
+v1::Normalization ToProtoEnum(NormalizationKind normalization) {
+  switch (normalization) {
+    case NormalizationKind::kLin:
+      return v1::LIN;
+    case NormalizationKind::kNms:
+      return v1::NMS;
+    case NormalizationKind::kNlm:
+      return v1::NLM;
+  }
+  return v1::NORMALIZATION_UNSPECIFIED;
+}
+
+v1::Fusion ToProtoEnum(FusionKind fusion) {
+  switch (fusion) {
+    case FusionKind::kSum:
+      return v1::FUSION_SUM;
+    case FusionKind::kMax:
+      return v1::FUSION_MAX;
+  }
+  return v1::FUSION_UNSPECIFIED;
+}
+
+v1::Extraction ToProtoEnum(ExtractionKind extraction) {
+  switch (extraction) {
+    case ExtractionKind::kMsr:
+      return v1::MSR;
+    case ExtractionKind::kWta:
+      return v1::WTA;
+    case ExtractionKind::kTj:
+      return v1::TJ;
+  }
+  return v1::EXTRACTION_UNSPECIFIED;
+}
+
+v1::DetectOptions ToProtoDetectOptions(const DetectOptions& options) {
+  v1::DetectOptions out;
+  for (const WeightedChannel& channel : options.channels) {
+    v1::WeightedOperator* op = out.add_saliency();
+    op->set_op(ToProtoEnum(channel.op));
+    op->set_weight(channel.weight);
+  }
+  out.set_pyramid(ToProtoEnum(options.pyramid));
+  out.set_level_combination(ToProtoEnum(options.level_combination));
+  out.set_normalization(ToProtoEnum(options.normalization));
+  out.set_fusion(ToProtoEnum(options.fusion));
+  out.set_extraction(ToProtoEnum(options.extraction));
+  out.set_max_points(static_cast<uint32_t>(options.max_points));
+  out.set_return_channel_maps(options.keep_channel_maps);
+  return out;
+}
+
+absl::StatusOr<std::string> EncodeSaliencyPng(const cv::Mat& map) {
+  if (map.type() != CV_32FC1 || map.empty()) {
+    return absl::InternalError(
+        absl::StrCat("saliency map is not a non-empty CV_32FC1 image (type ",
+                     map.type(), ", ", map.cols, "x", map.rows, ")"));
+  }
+  try {
+    cv::Mat finite = map.clone();
+    cv::patchNaNs(finite, 0.0);
+    cv::Mat pixels;
+    // convertTo rounds and saturates to [0, 65535].
+    finite.convertTo(pixels, CV_16UC1, kPngFullScale);
+    std::vector<uchar> png;
+    if (!cv::imencode(".png", pixels, png)) {
+      return absl::InternalError("saliency map: PNG encoding failed");
+    }
+    return std::string(png.begin(), png.end());
+  } catch (const std::exception& e) {
+    return absl::InternalError(
+        absl::StrCat("saliency map: PNG encoding failed: ", e.what()));
+  }
+}
+
+absl::StatusOr<v1::DetectResponse> ToDetectResponse(
+    const DetectResult& result, const v1::DetectRequest& request) {
+  v1::DetectResponse response;
+  response.set_request_id(request.request_id());
+  response.set_frame_id(request.frame().frame_id());
+  response.set_stamp_ns(request.frame().stamp_ns());
+
+  for (size_t i = 0; i < result.points.size(); ++i) {
+    const AttentionPoint& in = result.points[i];
+    v1::AttentionPoint* out = response.add_points();
+    out->set_u(static_cast<uint32_t>(in.u));
+    out->set_v(static_cast<uint32_t>(in.v));
+    *out->mutable_point() = ToPoint3(in.point);
+    out->set_saliency(in.saliency);
+    out->set_rank(static_cast<uint32_t>(i));
+  }
+
+  v1::SupportPlane* plane = response.mutable_support_plane();
+  *plane->mutable_normal() = ToPoint3(result.plane.normal);
+  plane->set_d(result.plane.d);
+  plane->set_inlier_count(static_cast<uint32_t>(result.plane.inlier_count));
+
+  if (request.options().return_saliency_map()) {
+    if (absl::Status status = AddMap("master", result.master, response);
+        !status.ok()) {
+      return status;
+    }
+  }
+  if (request.options().return_channel_maps()) {
+    for (const NamedMap& map : result.channel_maps) {
+      if (absl::Status status = AddMap(map.name, map.map, response);
+          !status.ok()) {
+        return status;
+      }
+    }
+  }
+
+  for (const StageTiming& timing : result.timings) {
+    v1::StageTiming* out = response.add_timings();
+    out->set_stage(timing.stage);
+    out->set_seconds(timing.seconds);
+  }
+  return response;
+}
+
+}  // namespace fovea::server

@@ -1,0 +1,82 @@
+#ifndef FOVEA_SERVER_CONVERT_H_
+#define FOVEA_SERVER_CONVERT_H_
+
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "core/frame/frame_decode.h"
+#include "core/pipeline/detect.h"
+#include "fovea/v1/detect.pb.h"
+#include "fovea/v1/frame.pb.h"
+
+namespace fovea::server {
+
+// Conversions between the wire contract (fovea.v1) and core/'s types. No
+// gRPC here: every function is tested on its own.
+
+// Largest `max_points` a request may ask for (detect.proto).
+inline constexpr int kMaxPointsLimit = 100;
+
+// The wire frame as core's RawFrame. Non-owning: the views point into
+// `frame`'s strings, which must outlive the result. Nothing is checked
+// here; DecodeFrame validates and names the wire fields.
+RawFrame ToRawFrame(const v1::Frame& frame);
+
+// How ToProtoFrame writes depth.
+enum class DepthEncoding {
+  k32FC1,  // float32 metres, NaN for no data
+  k16UC1,  // uint16 in units of `depth_scale` metres, 0 for no data
+};
+
+// A decoded frame as raw wire images: colour "rgb8" (step = width * 3),
+// depth as `depth_encoding` (step = width * bytes per pixel). For 16UC1,
+// depth is rounded to units of `depth_scale` (metres per unit, > 0);
+// values that do not fit in 16 bits, and NaN, become 0 (no data). The
+// inverse of DecodeFrame for raw frames, used by the warm-up and tests.
+v1::Frame ToProtoFrame(const RgbdFrame& frame, DepthEncoding depth_encoding,
+                       double depth_scale = 0.001);
+
+// Request options to core options, starting from core's defaults:
+//   - empty `saliency` means the default channels; a weight of 0 means 1;
+//     a negative or non-finite weight, or a channel without an operator,
+//     is INVALID_ARGUMENT naming "options.saliency[i]...";
+//   - an UNSPECIFIED enum means core's default; a value outside the enum
+//     (proto3 enums are open) is INVALID_ARGUMENT naming the field;
+//   - max_points 0 means 10; above kMaxPointsLimit is INVALID_ARGUMENT
+//     naming "options.max_points";
+//   - target_color_rgb must be empty or 3 values of at most 255, and
+//     location_prior_sigma_px finite and >= 0 (INVALID_ARGUMENT);
+//   - finally core's Validate(DetectOptions): an operator or strategy not
+//     built yet is UNIMPLEMENTED and names it, e.g. "options.saliency:
+//     'sym3d' is not implemented yet".
+absl::StatusOr<DetectOptions> ToDetectOptions(const v1::DetectOptions& options);
+
+// Core options as the wire states them (for Capabilities' defaults).
+v1::DetectOptions ToProtoDetectOptions(const DetectOptions& options);
+
+// Enum values on the wire. Every core value has one.
+v1::SaliencyOperator ToProtoEnum(SaliencyOp op);
+v1::Pyramid ToProtoEnum(PyramidKind pyramid);
+v1::LevelCombination ToProtoEnum(LevelCombination combination);
+v1::Normalization ToProtoEnum(NormalizationKind normalization);
+v1::Fusion ToProtoEnum(FusionKind fusion);
+v1::Extraction ToProtoEnum(ExtractionKind extraction);
+
+// A saliency map (CV_32FC1, values in [0, 1]) as a 16-bit grey PNG file:
+// pixel = round(value * 65535), clamped to [0, 65535], NaN as 0. INTERNAL
+// for a map of another type or when OpenCV fails.
+absl::StatusOr<std::string> EncodeSaliencyPng(const cv::Mat& map);
+
+// The response to `request` from core's result: request_id, frame_id and
+// stamp echoed; points in order with rank 0, 1, ...; the support plane;
+// the stage timings in order; the master map ("master") when
+// options.return_saliency_map and each channel map (by its name) when
+// options.return_channel_maps, as 16-bit PNG. Errors: INTERNAL when a map
+// cannot be encoded.
+absl::StatusOr<v1::DetectResponse> ToDetectResponse(
+    const DetectResult& result, const v1::DetectRequest& request);
+
+}  // namespace fovea::server
+
+#endif  // FOVEA_SERVER_CONVERT_H_

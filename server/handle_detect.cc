@@ -1,0 +1,57 @@
+#include "server/handle_detect.h"
+
+#include <chrono>
+#include <string>
+
+#include "server/convert.h"
+
+namespace fovea::server {
+namespace {
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+}  // namespace
+
+absl::StatusOr<v1::DetectResponse> HandleDetect(
+    const v1::DetectRequest& request, const DetectOptions& options,
+    const FrameLimits& limits, const InterruptCheck& interrupt,
+    double queue_seconds) {
+  auto start = std::chrono::steady_clock::now();
+  absl::StatusOr<RgbdFrame> frame =
+      DecodeFrame(ToRawFrame(request.frame()), limits);
+  if (!frame.ok()) return frame.status();
+  const double decode_seconds = SecondsSince(start);
+  if (interrupt) {
+    if (absl::Status status = interrupt(); !status.ok()) return status;
+  }
+
+  absl::StatusOr<DetectResult> result = RunDetect(*frame, options, interrupt);
+  if (!result.ok()) return result.status();
+
+  start = std::chrono::steady_clock::now();
+  absl::StatusOr<v1::DetectResponse> response =
+      ToDetectResponse(*result, request);
+  if (!response.ok()) return response.status();
+  const double encode_seconds = SecondsSince(start);
+
+  // Put "queue" and "decode" before core's stages, "encode" after.
+  google::protobuf::RepeatedPtrField<v1::StageTiming> timings;
+  auto add = [&timings](std::string stage, double seconds) {
+    v1::StageTiming* timing = timings.Add();
+    timing->set_stage(std::move(stage));
+    timing->set_seconds(seconds);
+  };
+  add("queue", queue_seconds);
+  add("decode", decode_seconds);
+  for (const v1::StageTiming& timing : response->timings()) {
+    add(timing.stage(), timing.seconds());
+  }
+  add("encode", encode_seconds);
+  response->mutable_timings()->Swap(&timings);
+  return response;
+}
+
+}  // namespace fovea::server

@@ -1,0 +1,123 @@
+// fovea-server: the Fovea perception service over gRPC.
+
+#include <pthread.h>
+#include <signal.h>
+
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <thread>
+
+#include "absl/flags/flag.h"
+#include "absl/flags/parse.h"
+#include "absl/flags/usage.h"
+#include "absl/flags/usage_config.h"
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "absl/time/time.h"
+#include "server/capabilities.h"
+#include "server/log.h"
+#include "server/server.h"
+
+namespace {
+
+int Cores() {
+  const unsigned n = std::thread::hardware_concurrency();
+  return n == 0 ? 1 : static_cast<int>(n);
+}
+
+}  // namespace
+
+ABSL_FLAG(std::string, listen, "0.0.0.0:50051",
+          "host:port of the gRPC server. All interfaces by default, so a "
+          "robot (or another container) can reach it; use "
+          "127.0.0.1:50051 to serve this machine only.");
+ABSL_FLAG(std::string, metrics_listen, "127.0.0.1:9464",
+          "host:port of the Prometheus endpoint (GET /metrics); empty "
+          "disables it. Loopback by default; use 0.0.0.0:9464 for a scraper "
+          "on another host or container.");
+ABSL_FLAG(int, concurrency, Cores(),
+          "Frames computed at once (worker threads); default: the number of "
+          "cores.");
+ABSL_FLAG(int, queue, 2 * Cores(),
+          "Frames waiting for a worker; beyond it calls fail at once with "
+          "RESOURCE_EXHAUSTED. Default: twice the number of cores.");
+ABSL_FLAG(int, max_message_bytes, fovea::server::kDefaultMaxMessageBytes,
+          "Largest request accepted, bytes (64 MiB: a raw 1920x1080 "
+          "rgb8 + 32FC1 frame fits).");
+ABSL_FLAG(uint32_t, max_width, fovea::FrameLimits{}.max_width,
+          "Widest frame accepted, pixels; wider frames are INVALID_ARGUMENT.");
+ABSL_FLAG(uint32_t, max_height, fovea::FrameLimits{}.max_height,
+          "Tallest frame accepted, pixels; taller frames are "
+          "INVALID_ARGUMENT.");
+ABSL_FLAG(double, grace_period_s, 10.0,
+          "On SIGTERM/SIGINT: seconds in-flight calls get to finish before "
+          "they are cancelled.");
+ABSL_FLAG(std::string, log_level, "info", "debug, info, warn or error.");
+
+int main(int argc, char** argv) {
+  absl::SetProgramUsageMessage(
+      "Fovea perception service: attention points (Detect) and, later, "
+      "object masks from RGB-D frames over gRPC (fovea.v1.Perception; "
+      "health: grpc.health.v1; server reflection on).\n"
+      "Usage: fovea-server [--listen=HOST:PORT] "
+      "[--metrics_listen=HOST:PORT] [--concurrency=N] [--queue=N] ...\n"
+      "SIGTERM or SIGINT: health NOT_SERVING, stop accepting, let calls "
+      "finish within --grace_period_s, exit 0.");
+  // List this program's flags in --help, not those of linked libraries.
+  absl::FlagsUsageConfig usage;
+  usage.contains_help_flags = [](absl::string_view file) {
+    return absl::StrContains(file, "server/main.cc");
+  };
+  usage.contains_helpshort_flags = usage.contains_help_flags;
+  absl::SetFlagsUsageConfig(usage);
+  absl::ParseCommandLine(argc, argv);
+
+  using fovea::server::LogError;
+  using fovea::server::LogInfo;
+  absl::StatusOr<fovea::server::LogLevel> level =
+      fovea::server::ParseLogLevel(absl::GetFlag(FLAGS_log_level));
+  if (!level.ok()) {
+    LogError(level.status().ToString());
+    return 2;
+  }
+  fovea::server::SetLogLevel(*level);
+  const double grace_s = absl::GetFlag(FLAGS_grace_period_s);
+  if (!(grace_s >= 0.0)) {
+    LogError(absl::StrCat("--grace_period_s: ", grace_s, " is negative"));
+    return 2;
+  }
+
+  // Block the stop signals in every thread (threads inherit the mask, so
+  // this comes before any is started); main waits for them with sigwait,
+  // so nothing runs inside a signal handler.
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGTERM);
+  sigaddset(&stop_signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+
+  fovea::server::ServerConfig config;
+  config.listen = absl::GetFlag(FLAGS_listen);
+  config.metrics_listen = absl::GetFlag(FLAGS_metrics_listen);
+  config.concurrency = absl::GetFlag(FLAGS_concurrency);
+  config.queue = absl::GetFlag(FLAGS_queue);
+  config.max_message_bytes = absl::GetFlag(FLAGS_max_message_bytes);
+  config.limits.max_width = absl::GetFlag(FLAGS_max_width);
+  config.limits.max_height = absl::GetFlag(FLAGS_max_height);
+
+  absl::StatusOr<std::unique_ptr<fovea::server::FoveaServer>> server =
+      fovea::server::FoveaServer::Start(config);
+  if (!server.ok()) {
+    LogError(server.status().ToString());
+    return server.status().code() == absl::StatusCode::kInvalidArgument ? 2 : 1;
+  }
+
+  int signal_number = 0;
+  sigwait(&stop_signals, &signal_number);
+  LogInfo(absl::StrCat("received ", strsignal(signal_number)));
+  (*server)->Shutdown(absl::Seconds(grace_s));
+  server->reset();
+  LogInfo("stopped");
+  return 0;
+}

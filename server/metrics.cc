@@ -1,0 +1,256 @@
+#include "server/metrics.h"
+
+#include <prometheus/counter.h>
+#include <prometheus/exposer.h>
+#include <prometheus/family.h>
+#include <prometheus/gauge.h>
+#include <prometheus/histogram.h>
+#include <prometheus/registry.h>
+#include <prometheus/text_serializer.h>
+
+#include <array>
+#include <exception>
+#include <mutex>
+
+#include "absl/strings/str_cat.h"
+#include "core/base/check.h"
+#include "server/status_util.h"
+
+namespace fovea::server {
+namespace {
+
+struct MethodInfo {
+  std::string_view name;
+  std::string_view type;  // go-grpc-prometheus' grpc_type
+};
+
+constexpr std::array<MethodInfo, 4> kMethods = {{
+    {"Detect", "unary"},
+    {"Segment", "server_stream"},
+    {"SegmentIncremental", "server_stream"},
+    {"GetCapabilities", "unary"},
+}};
+
+// go-grpc-prometheus' handling-time buckets (Prometheus' DefBuckets).
+const prometheus::Histogram::BucketBoundaries& HandlingBuckets() {
+  static const auto* buckets = new prometheus::Histogram::BucketBoundaries{
+      0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1, 2.5, 5, 10};
+  return *buckets;
+}
+
+// Stages and queue waits are shorter than whole calls: finer at the low
+// end (0.5 ms up), same top.
+const prometheus::Histogram::BucketBoundaries& StageBuckets() {
+  static const auto* buckets = new prometheus::Histogram::BucketBoundaries{
+      0.0005, 0.001, 0.0025, 0.005, 0.01, 0.025, 0.05,
+      0.1,    0.25,  0.5,    1,     2.5,  5,     10};
+  return *buckets;
+}
+
+// The series of one method, created up front; updates take no registry
+// lock.
+struct MethodSeries {
+  prometheus::Counter* started = nullptr;
+  prometheus::Counter* received = nullptr;
+  prometheus::Counter* sent = nullptr;
+  prometheus::Histogram* handling = nullptr;
+  std::array<prometheus::Counter*, kAllStatusCodes.size()> handled{};
+};
+
+class Metrics {
+ public:
+  static Metrics& Get() {
+    static Metrics* metrics = new Metrics;
+    return *metrics;
+  }
+
+  const std::shared_ptr<prometheus::Registry>& registry() const {
+    return registry_;
+  }
+
+  MethodSeries& Method(std::string_view method) {
+    for (size_t i = 0; i < kMethods.size(); ++i) {
+      if (kMethods[i].name == method) return methods_[i];
+    }
+    std::fprintf(stderr, "metrics: unknown method '%.*s'\n",
+                 static_cast<int>(method.size()), method.data());
+    FOVEA_CHECK(false);
+    return methods_[0];
+  }
+
+  prometheus::Histogram& Stage(std::string_view stage) {
+    return stage_family_.Add({{"stage", std::string(stage)}}, StageBuckets());
+  }
+
+  prometheus::Gauge& inflight() { return inflight_; }
+  prometheus::Histogram& queue_wait() { return queue_wait_; }
+
+  void SetBuildInfo(std::string_view version) {
+    build_info_family_.Add({{"version", std::string(version)}}).Set(1);
+  }
+
+ private:
+  Metrics()
+      : registry_(std::make_shared<prometheus::Registry>()),
+        started_family_(prometheus::BuildCounter()
+                            .Name("grpc_server_started_total")
+                            .Help("Total number of RPCs started on the server.")
+                            .Register(*registry_)),
+        handled_family_(
+            prometheus::BuildCounter()
+                .Name("grpc_server_handled_total")
+                .Help("Total number of RPCs completed on the server, "
+                      "regardless of success or failure.")
+                .Register(*registry_)),
+        received_family_(
+            prometheus::BuildCounter()
+                .Name("grpc_server_msg_received_total")
+                .Help("Total number of RPC stream messages received on the "
+                      "server.")
+                .Register(*registry_)),
+        sent_family_(prometheus::BuildCounter()
+                         .Name("grpc_server_msg_sent_total")
+                         .Help("Total number of gRPC stream messages sent by "
+                               "the server.")
+                         .Register(*registry_)),
+        handling_family_(
+            prometheus::BuildHistogram()
+                .Name("grpc_server_handling_seconds")
+                .Help("Histogram of response latency (seconds) of gRPC that "
+                      "had been application-level handled by the server.")
+                .Register(*registry_)),
+        stage_family_(
+            prometheus::BuildHistogram()
+                .Name("fovea_stage_duration_seconds")
+                .Help("Wall time of one pipeline stage of one call, seconds.")
+                .Register(*registry_)),
+        inflight_(prometheus::BuildGauge()
+                      .Name("fovea_inflight_requests")
+                      .Help("Calls started and not yet finished, queued "
+                            "ones included.")
+                      .Register(*registry_)
+                      .Add({})),
+        queue_wait_(prometheus::BuildHistogram()
+                        .Name("fovea_queue_wait_seconds")
+                        .Help("Time a Detect job waited for a worker, seconds.")
+                        .Register(*registry_)
+                        .Add({}, StageBuckets())),
+        build_info_family_(prometheus::BuildGauge()
+                               .Name("fovea_build_info")
+                               .Help("Always 1; the label is the server "
+                                     "version.")
+                               .Register(*registry_)) {
+    for (size_t i = 0; i < kMethods.size(); ++i) {
+      const prometheus::Labels labels = {
+          {"grpc_type", std::string(kMethods[i].type)},
+          {"grpc_service", std::string(kServiceName)},
+          {"grpc_method", std::string(kMethods[i].name)}};
+      MethodSeries& series = methods_[i];
+      series.started = &started_family_.Add(labels);
+      series.received = &received_family_.Add(labels);
+      series.sent = &sent_family_.Add(labels);
+      series.handling = &handling_family_.Add(labels, HandlingBuckets());
+      for (size_t c = 0; c < kAllStatusCodes.size(); ++c) {
+        prometheus::Labels with_code = labels;
+        with_code["grpc_code"] = std::string(GrpcCodeName(kAllStatusCodes[c]));
+        series.handled[c] = &handled_family_.Add(with_code);
+      }
+    }
+  }
+
+  std::shared_ptr<prometheus::Registry> registry_;
+  prometheus::Family<prometheus::Counter>& started_family_;
+  prometheus::Family<prometheus::Counter>& handled_family_;
+  prometheus::Family<prometheus::Counter>& received_family_;
+  prometheus::Family<prometheus::Counter>& sent_family_;
+  prometheus::Family<prometheus::Histogram>& handling_family_;
+  prometheus::Family<prometheus::Histogram>& stage_family_;
+  prometheus::Gauge& inflight_;
+  prometheus::Histogram& queue_wait_;
+  prometheus::Family<prometheus::Gauge>& build_info_family_;
+  std::array<MethodSeries, kMethods.size()> methods_;
+};
+
+size_t CodeIndex(absl::StatusCode code) {
+  const int value = static_cast<int>(code);
+  if (value < 0 || value >= static_cast<int>(kAllStatusCodes.size())) {
+    return static_cast<size_t>(absl::StatusCode::kUnknown);
+  }
+  return static_cast<size_t>(value);
+}
+
+}  // namespace
+
+void InitMetrics(std::string_view version) {
+  static std::once_flag once;
+  std::call_once(once, [version] { Metrics::Get().SetBuildInfo(version); });
+}
+
+void InitStageSeries(const std::vector<std::string>& stages) {
+  for (const std::string& stage : stages) Metrics::Get().Stage(stage);
+}
+
+void RecordCallStarted(std::string_view method) {
+  Metrics::Get().Method(method).started->Increment();
+}
+
+void RecordMessageReceived(std::string_view method) {
+  Metrics::Get().Method(method).received->Increment();
+}
+
+void RecordMessageSent(std::string_view method) {
+  Metrics::Get().Method(method).sent->Increment();
+}
+
+void RecordCallHandled(std::string_view method, absl::StatusCode code,
+                       double seconds) {
+  MethodSeries& series = Metrics::Get().Method(method);
+  series.handled[CodeIndex(code)]->Increment();
+  series.handling->Observe(seconds);
+}
+
+void RecordStage(std::string_view stage, double seconds) {
+  Metrics::Get().Stage(stage).Observe(seconds);
+}
+
+void RecordQueueWait(double seconds) {
+  Metrics::Get().queue_wait().Observe(seconds);
+}
+
+void IncrementInflight() { Metrics::Get().inflight().Increment(); }
+
+void DecrementInflight() { Metrics::Get().inflight().Decrement(); }
+
+std::string MetricsText() {
+  return prometheus::TextSerializer().Serialize(
+      Metrics::Get().registry()->Collect());
+}
+
+struct MetricsEndpoint::Impl {
+  std::unique_ptr<prometheus::Exposer> exposer;
+};
+
+MetricsEndpoint::MetricsEndpoint(std::unique_ptr<Impl> impl)
+    : impl_(std::move(impl)) {}
+
+MetricsEndpoint::~MetricsEndpoint() = default;
+
+absl::StatusOr<std::unique_ptr<MetricsEndpoint>> MetricsEndpoint::Start(
+    const std::string& listen) {
+  auto impl = std::make_unique<Impl>();
+  try {
+    impl->exposer = std::make_unique<prometheus::Exposer>(listen);
+  } catch (const std::exception& e) {
+    return absl::UnavailableError(absl::StrCat(
+        "--metrics_listen: cannot listen on '", listen, "': ", e.what()));
+  }
+  impl->exposer->RegisterCollectable(Metrics::Get().registry());
+  return std::unique_ptr<MetricsEndpoint>(new MetricsEndpoint(std::move(impl)));
+}
+
+int MetricsEndpoint::port() const {
+  const std::vector<int> ports = impl_->exposer->GetListeningPorts();
+  return ports.empty() ? 0 : ports.front();
+}
+
+}  // namespace fovea::server

@@ -1,0 +1,88 @@
+#ifndef FOVEA_SERVER_METRICS_H_
+#define FOVEA_SERVER_METRICS_H_
+
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+
+namespace fovea::server {
+
+// The server's Prometheus metrics, behind functions: prometheus-cpp types
+// never leave metrics.cc. One process-wide registry.
+//
+// gRPC series use the names and labels of go-grpc-prometheus, so the
+// gRPC ecosystem's dashboards work unchanged. Each carries grpc_type
+// ("unary" or "server_stream"), grpc_service ("fovea.v1.Perception") and
+// grpc_method ("Detect", "Segment", "SegmentIncremental",
+// "GetCapabilities"):
+//   grpc_server_started_total          counter
+//   grpc_server_handled_total          counter, plus grpc_code ("OK",
+//                                      "InvalidArgument", ...: gRPC-Go's
+//                                      spelling, see GrpcCodeName)
+//   grpc_server_msg_received_total     counter
+//   grpc_server_msg_sent_total         counter
+//   grpc_server_handling_seconds       histogram, buckets .005 .01 .025 .05
+//                                      .1 .25 .5 1 2.5 5 10 (Prometheus'
+//                                      DefBuckets, as go-grpc-prometheus)
+// Fovea's own:
+//   fovea_stage_duration_seconds{stage}  histogram; stages are core's
+//                                        timings plus "queue", "decode",
+//                                        "encode"
+//   fovea_inflight_requests              gauge: calls started, not finished
+//   fovea_queue_wait_seconds             histogram: submit to start of work
+//   fovea_build_info{version}            gauge, always 1
+// Every series of every method exists at zero from InitMetrics on (every
+// method x every code for handled_total).
+
+// The gRPC service the gRPC series describe.
+inline constexpr std::string_view kServiceName = "fovea.v1.Perception";
+
+// Sets fovea_build_info{version} to 1. Call once at start-up; later calls
+// are ignored. Every other family and series exists at zero from the first
+// call of any function here (this one included).
+void InitMetrics(std::string_view version);
+
+// Creates fovea_stage_duration_seconds{stage} at zero for each name.
+void InitStageSeries(const std::vector<std::string>& stages);
+
+// Per call. `method` is one of the four Perception methods (anything else
+// is a bug: FOVEA_CHECK).
+void RecordCallStarted(std::string_view method);
+void RecordMessageReceived(std::string_view method);
+void RecordMessageSent(std::string_view method);
+void RecordCallHandled(std::string_view method, absl::StatusCode code,
+                       double seconds);
+
+void RecordStage(std::string_view stage, double seconds);
+void RecordQueueWait(double seconds);
+void IncrementInflight();
+void DecrementInflight();
+
+// The registry in Prometheus' text format, as /metrics serves it.
+std::string MetricsText();
+
+// The HTTP endpoint serving /metrics. Stops serving when destroyed.
+class MetricsEndpoint {
+ public:
+  // Listens on `listen` ("host:port"; port 0 picks a free one).
+  // UNAVAILABLE when the address cannot be bound.
+  static absl::StatusOr<std::unique_ptr<MetricsEndpoint>> Start(
+      const std::string& listen);
+  ~MetricsEndpoint();
+
+  // The bound port.
+  int port() const;
+
+ private:
+  struct Impl;
+  explicit MetricsEndpoint(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace fovea::server
+
+#endif  // FOVEA_SERVER_METRICS_H_

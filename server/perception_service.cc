@@ -1,0 +1,212 @@
+#include "server/perception_service.h"
+
+#include <chrono>
+#include <string>
+#include <utility>
+
+#include "absl/status/status.h"
+#include "absl/strings/escaping.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "server/capabilities.h"
+#include "server/convert.h"
+#include "server/handle_detect.h"
+#include "server/log.h"
+#include "server/metrics.h"
+#include "server/status_util.h"
+
+namespace fovea::server {
+namespace {
+
+// Longest request_id written to the log; the id comes from the client.
+constexpr size_t kMaxLoggedRequestId = 128;
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// The metrics and the log line of one call: started when constructed,
+// handled at End*. Each call ends exactly once.
+class CallRecord {
+ public:
+  CallRecord(std::string_view method, std::string_view request_id)
+      : method_(method),
+        request_id_(request_id.substr(0, kMaxLoggedRequestId)),
+        start_(Clock::now()) {
+    RecordCallStarted(method_);
+    RecordMessageReceived(method_);
+    IncrementInflight();
+  }
+
+  // A unary call: one message sent when OK.
+  grpc::Status EndUnary(const absl::Status& status) {
+    if (status.ok()) RecordMessageSent(method_);
+    return End(status);
+  }
+
+  // A server stream; its messages were counted as they were sent.
+  grpc::Status EndStream(const absl::Status& status) { return End(status); }
+
+ private:
+  grpc::Status End(const absl::Status& status) {
+    const double seconds = SecondsSince(start_);
+    RecordCallHandled(method_, status.code(), seconds);
+    DecrementInflight();
+    std::string line = absl::StrFormat(
+        "call method=%s request_id=\"%s\" code=%s ms=%.1f", method_,
+        absl::CEscape(request_id_), GrpcCodeName(status.code()), seconds * 1e3);
+    if (!status.ok()) {
+      absl::StrAppend(&line, " message=\"", absl::CEscape(status.message()),
+                      "\"");
+    }
+    LogInfo(line);
+    return ToGrpcStatus(status);
+  }
+
+  const std::string_view method_;  // a string literal
+  const std::string request_id_;
+  const Clock::time_point start_;
+};
+
+// DEADLINE_EXCEEDED once the client's deadline passed, CANCELLED once the
+// call was cancelled, else OK. Safe on any thread.
+absl::Status CheckInterrupt(const grpc::CallbackServerContext& context) {
+  if (std::chrono::system_clock::now() >= context.deadline()) {
+    return absl::DeadlineExceededError("the client's deadline passed");
+  }
+  if (context.IsCancelled()) {
+    return absl::CancelledError(
+        "the call was cancelled (by the client, or by a server shutdown)");
+  }
+  return absl::OkStatus();
+}
+
+// One Detect call. Converts the options at once, then runs on a worker;
+// finishes exactly once and deletes itself in OnDone.
+class DetectReactor final : public grpc::ServerUnaryReactor {
+ public:
+  DetectReactor(const ServiceConfig& config, WorkQueue& work,
+                grpc::CallbackServerContext* context,
+                const v1::DetectRequest* request, v1::DetectResponse* response)
+      : config_(config),
+        context_(context),
+        request_(request),
+        response_(response),
+        call_("Detect", request->request_id()) {
+    absl::StatusOr<DetectOptions> options = ToDetectOptions(request->options());
+    if (!options.ok()) {
+      Complete(options.status());
+      return;
+    }
+    options_ = *std::move(options);
+    submitted_ = Clock::now();
+    if (!work.TrySubmit([this] { Run(); })) {
+      Complete(absl::ResourceExhaustedError(
+          absl::StrCat("server busy: ", work.workers(), " frames in work and ",
+                       work.queue_capacity(), " queued; retry later")));
+    }
+  }
+
+  void OnDone() override { delete this; }
+
+ private:
+  // On a worker thread.
+  void Run() {
+    const double queue_seconds = SecondsSince(submitted_);
+    RecordQueueWait(queue_seconds);
+    if (config_.before_detect_job) config_.before_detect_job();
+    if (absl::Status status = CheckInterrupt(*context_); !status.ok()) {
+      Complete(status);
+      return;
+    }
+    absl::StatusOr<v1::DetectResponse> response = HandleDetect(
+        *request_, options_, config_.limits,
+        [this] { return CheckInterrupt(*context_); }, queue_seconds);
+    if (!response.ok()) {
+      Complete(response.status());
+      return;
+    }
+    for (const v1::StageTiming& timing : response->timings()) {
+      RecordStage(timing.stage(), timing.seconds());
+    }
+    *response_ = *std::move(response);
+    Complete(absl::OkStatus());
+  }
+
+  // The last thing the reactor does: OnDone may delete it right after.
+  void Complete(const absl::Status& status) { Finish(call_.EndUnary(status)); }
+
+  const ServiceConfig& config_;  // the service's; outlives every call
+  // gRPC's, valid until OnDone.
+  grpc::CallbackServerContext* const context_;
+  const v1::DetectRequest* const request_;
+  v1::DetectResponse* const response_;
+  CallRecord call_;
+  DetectOptions options_;
+  Clock::time_point submitted_;
+};
+
+// A server-streaming call refused with `status` before any message.
+class RefusedStream final
+    : public grpc::ServerWriteReactor<v1::SegmentResponse> {
+ public:
+  RefusedStream(std::string_view method, std::string_view request_id,
+                const absl::Status& status)
+      : call_(method, request_id) {
+    Finish(call_.EndStream(status));
+  }
+
+  void OnDone() override { delete this; }
+
+ private:
+  CallRecord call_;
+};
+
+}  // namespace
+
+PerceptionService::PerceptionService(ServiceConfig config, WorkQueue* work)
+    : config_(std::move(config)),
+      work_(work),
+      capabilities_(
+          BuildCapabilities(config_.limits, config_.max_message_bytes)) {}
+
+grpc::ServerUnaryReactor* PerceptionService::Detect(
+    grpc::CallbackServerContext* context, const v1::DetectRequest* request,
+    v1::DetectResponse* response) {
+  return new DetectReactor(config_, *work_, context, request, response);
+}
+
+grpc::ServerWriteReactor<v1::SegmentResponse>* PerceptionService::Segment(
+    grpc::CallbackServerContext* context, const v1::SegmentRequest* request) {
+  return new RefusedStream(
+      "Segment", request->request_id(),
+      absl::UnimplementedError(
+          "Segment is not built yet: object segmentation arrives in a later "
+          "issue (see GetCapabilities.segmentation_methods)"));
+}
+
+grpc::ServerWriteReactor<v1::SegmentResponse>*
+PerceptionService::SegmentIncremental(
+    grpc::CallbackServerContext* context,
+    const v1::SegmentIncrementalRequest* request) {
+  return new RefusedStream(
+      "SegmentIncremental", request->request_id(),
+      absl::UnimplementedError(
+          "SegmentIncremental is not built yet: incremental segmentation "
+          "arrives in a later issue (see "
+          "GetCapabilities.segment_incremental)"));
+}
+
+grpc::ServerUnaryReactor* PerceptionService::GetCapabilities(
+    grpc::CallbackServerContext* context,
+    const v1::GetCapabilitiesRequest* request, v1::Capabilities* response) {
+  CallRecord call("GetCapabilities", "");
+  *response = capabilities_;
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  reactor->Finish(call.EndUnary(absl::OkStatus()));
+  return reactor;
+}
+
+}  // namespace fovea::server

@@ -1,0 +1,68 @@
+#ifndef FOVEA_SERVER_PERCEPTION_SERVICE_H_
+#define FOVEA_SERVER_PERCEPTION_SERVICE_H_
+
+#include <grpcpp/grpcpp.h>
+
+#include <cstdint>
+#include <functional>
+
+#include "core/frame/frame_decode.h"
+#include "fovea/v1/perception.grpc.pb.h"
+#include "server/work_queue.h"
+
+namespace fovea::server {
+
+struct ServiceConfig {
+  FrameLimits limits;              // largest frame accepted
+  uint64_t max_message_bytes = 0;  // reported by GetCapabilities
+  // Test hook, null in production: called on the worker thread at the
+  // start of every Detect job, before the deadline check. Tests block it
+  // to fill the queue deterministically.
+  std::function<void()> before_detect_job;
+};
+
+// fovea.v1.Perception on gRPC's callback API. Handlers are thin: they
+// convert, hand the CPU work to the WorkQueue (never running it on gRPC's
+// callback threads), and finish the call from the worker through
+// ToGrpcStatus. Every call is counted (metrics.h) and logged in one line:
+//   call method=Detect request_id="r1" code=OK ms=23.4
+// with message="..." added when the code is not OK.
+//
+// Detect: options are converted on the callback thread (a bad option
+// fails at once); the frame is decoded and processed on a worker. A full
+// queue is RESOURCE_EXHAUSTED at once. The client's deadline is checked
+// when the job starts (a job that expired while queued is not computed)
+// and between stages: DEADLINE_EXCEEDED once it passed, CANCELLED when
+// the call was cancelled (by the client, or by a shutdown past its grace
+// period).
+// Segment, SegmentIncremental: UNIMPLEMENTED until their issues land.
+// GetCapabilities: BuildCapabilities, computed once.
+class PerceptionService final : public v1::Perception::CallbackService {
+ public:
+  // `work` is not owned; it must outlive every call the service starts
+  // (the server stops it only after grpc::Server::Shutdown returned).
+  PerceptionService(ServiceConfig config, WorkQueue* work);
+
+  grpc::ServerUnaryReactor* Detect(grpc::CallbackServerContext* context,
+                                   const v1::DetectRequest* request,
+                                   v1::DetectResponse* response) override;
+  grpc::ServerWriteReactor<v1::SegmentResponse>* Segment(
+      grpc::CallbackServerContext* context,
+      const v1::SegmentRequest* request) override;
+  grpc::ServerWriteReactor<v1::SegmentResponse>* SegmentIncremental(
+      grpc::CallbackServerContext* context,
+      const v1::SegmentIncrementalRequest* request) override;
+  grpc::ServerUnaryReactor* GetCapabilities(
+      grpc::CallbackServerContext* context,
+      const v1::GetCapabilitiesRequest* request,
+      v1::Capabilities* response) override;
+
+ private:
+  const ServiceConfig config_;
+  WorkQueue* const work_;  // not owned
+  const v1::Capabilities capabilities_;
+};
+
+}  // namespace fovea::server
+
+#endif  // FOVEA_SERVER_PERCEPTION_SERVICE_H_

@@ -1,0 +1,236 @@
+#include "server/server.h"
+
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/health_check_service_interface.h>
+
+#include <chrono>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "core/synth/synth_scene.h"
+#include "server/capabilities.h"
+#include "server/convert.h"
+#include "server/handle_detect.h"
+#include "server/log.h"
+
+namespace fovea::server {
+namespace {
+
+// The names health reports on: the whole server and the service.
+constexpr const char* kHealthNames[] = {"", "fovea.v1.Perception"};
+
+// Warm-up frame: the synthetic scene of this seed, rendered at
+// 1 / kWarmUpDownscale of the Kinect's 640x480 (320x240: small, yet large
+// enough for core's pixel-sized defaults, e.g. MSR's smallest region, to
+// yield points, so every stage runs).
+constexpr uint64_t kWarmUpSeed = 1;
+constexpr int kWarmUpDownscale = 2;
+
+// A small synthetic scene as a wire request, default options.
+v1::DetectRequest WarmUpRequest() {
+  synth::SceneSpec spec =
+      synth::RandomSceneSpec(kWarmUpSeed, synth::RandomSceneOptions{});
+  const double s = 1.0 / kWarmUpDownscale;
+  spec.width /= kWarmUpDownscale;
+  spec.height /= kWarmUpDownscale;
+  spec.intrinsics.fx *= s;
+  spec.intrinsics.fy *= s;
+  // Pixel centres: x' + 0.5 = (x + 0.5) * s.
+  spec.intrinsics.cx = (spec.intrinsics.cx + 0.5) * s - 0.5;
+  spec.intrinsics.cy = (spec.intrinsics.cy + 0.5) * s - 0.5;
+  synth::SynthScene scene =
+      synth::RenderScene(spec, synth::NoiseOptions{}, kWarmUpSeed);
+  v1::DetectRequest request;
+  request.set_request_id("warm-up");
+  *request.mutable_frame() =
+      ToProtoFrame(scene.frame.frame, DepthEncoding::k32FC1);
+  return request;
+}
+
+// Stage names known before any call: the server's own, and core's
+// "saliency.<op>" and "extract.<strategy>" for what core implements. The
+// warm-up adds the rest of core's (cloud, normals, ...).
+std::vector<std::string> KnownStages() {
+  std::vector<std::string> stages = {"queue", "decode", "encode"};
+  for (SaliencyOp op : ImplementedSaliencyOps()) {
+    stages.push_back("saliency." + std::string(SaliencyOpName(op)));
+  }
+  for (ExtractionKind kind : ImplementedExtractions()) {
+    stages.push_back("extract." + std::string(ExtractionName(kind)));
+  }
+  return stages;
+}
+
+}  // namespace
+
+absl::Status Validate(const ServerConfig& config) {
+  if (config.listen.empty()) {
+    return absl::InvalidArgumentError("--listen: empty, expected host:port");
+  }
+  if (config.concurrency < 1) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--concurrency: ", config.concurrency, " is below 1"));
+  }
+  if (config.queue < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--queue: ", config.queue, " is negative"));
+  }
+  if (config.max_message_bytes < 1) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--max_message_bytes: ", config.max_message_bytes, " is below 1"));
+  }
+  if (absl::Status status = Validate(config.limits); !status.ok()) {
+    return absl::Status(
+        status.code(),
+        absl::StrCat("--max_width/--max_height: ", status.message()));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
+    ServerConfig config) {
+  if (absl::Status status = Validate(config); !status.ok()) return status;
+  InitMetrics(ServerVersion());
+  InitStageSeries(KnownStages());
+
+  std::unique_ptr<FoveaServer> server(new FoveaServer);
+  if (!config.metrics_listen.empty()) {
+    absl::StatusOr<std::unique_ptr<MetricsEndpoint>> metrics =
+        MetricsEndpoint::Start(config.metrics_listen);
+    if (!metrics.ok()) return metrics.status();
+    server->metrics_ = *std::move(metrics);
+  }
+  server->work_ = std::make_unique<WorkQueue>(config.concurrency, config.queue);
+  server->service_ = std::make_unique<PerceptionService>(
+      ServiceConfig{config.limits,
+                    static_cast<uint64_t>(config.max_message_bytes),
+                    config.before_detect_job},
+      server->work_.get());
+
+  grpc::EnableDefaultHealthCheckService(true);
+  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+  grpc::ServerBuilder builder;
+  // Refuse a port another process already serves (Linux would otherwise
+  // share it silently with SO_REUSEPORT).
+  builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
+  builder.SetMaxReceiveMessageSize(config.max_message_bytes);
+  builder.AddListeningPort(config.listen, grpc::InsecureServerCredentials(),
+                           &server->port_);
+  builder.RegisterService(server->service_.get());
+  server->server_ = builder.BuildAndStart();
+  if (server->server_ == nullptr || server->port_ == 0) {
+    return absl::UnavailableError(
+        absl::StrCat("--listen: cannot listen on '", config.listen, "'"));
+  }
+  // The default health service starts with "" SERVING.
+  server->SetServing(false);
+
+  LogInfo(absl::StrFormat(
+      "fovea-server %s listening on %s (port %d), metrics %s, concurrency "
+      "%d, queue %d, max message %d bytes, max frame %dx%d",
+      ServerVersion(), config.listen, server->port_,
+      config.metrics_listen.empty()
+          ? std::string("off")
+          : absl::StrCat("on port ", server->metrics_port(), " /metrics"),
+      config.concurrency, config.queue, config.max_message_bytes,
+      config.limits.max_width, config.limits.max_height));
+
+  if (config.warm_up) {
+    FoveaServer* self = server.get();
+    const FrameLimits limits = config.limits;
+    server->warm_up_thread_ =
+        std::thread([self, limits] { self->WarmUp(limits); });
+  } else {
+    {
+      absl::MutexLock lock(&server->mu_);
+      server->warmed_up_ = true;
+    }
+    server->SetServing(true);
+  }
+  return server;
+}
+
+FoveaServer::~FoveaServer() { Shutdown(absl::ZeroDuration()); }
+
+int FoveaServer::metrics_port() const {
+  return metrics_ == nullptr ? 0 : metrics_->port();
+}
+
+bool FoveaServer::warmed_up() const {
+  absl::MutexLock lock(&mu_);
+  return warmed_up_;
+}
+
+void FoveaServer::SetServing(bool serving) {
+  grpc::HealthCheckServiceInterface* health =
+      server_ == nullptr ? nullptr : server_->GetHealthCheckService();
+  if (health == nullptr) return;
+  for (const char* name : kHealthNames) {
+    health->SetServingStatus(name, serving);
+  }
+}
+
+void FoveaServer::WarmUp(const FrameLimits& limits) {
+  const auto start = std::chrono::steady_clock::now();
+  const v1::DetectRequest request = WarmUpRequest();
+  absl::StatusOr<DetectOptions> options = ToDetectOptions(request.options());
+  absl::StatusOr<v1::DetectResponse> response =
+      options.ok() ? HandleDetect(request, *options, limits, {}, 0.0)
+                   : absl::StatusOr<v1::DetectResponse>(options.status());
+  const double ms = std::chrono::duration<double, std::milli>(
+                        std::chrono::steady_clock::now() - start)
+                        .count();
+  if (response.ok()) {
+    std::vector<std::string> stages;
+    for (const v1::StageTiming& timing : response->timings()) {
+      stages.push_back(timing.stage());
+    }
+    InitStageSeries(stages);
+    LogInfo(absl::StrFormat("warm-up Detect done in %.1f ms, %d points", ms,
+                            response->points_size()));
+  } else {
+    LogError(absl::StrCat(
+        "warm-up Detect failed after ", absl::StrFormat("%.1f", ms),
+        " ms (serving anyway): ", response.status().ToString()));
+  }
+  absl::MutexLock lock(&mu_);
+  warmed_up_ = true;
+  if (!draining_) {
+    SetServing(true);
+    LogInfo("health: SERVING");
+  }
+}
+
+void FoveaServer::Drain() {
+  absl::MutexLock lock(&mu_);
+  if (draining_) return;
+  draining_ = true;
+  SetServing(false);
+  LogInfo("draining: health NOT_SERVING");
+}
+
+void FoveaServer::Shutdown(absl::Duration grace) {
+  {
+    absl::MutexLock lock(&mu_);
+    if (shut_down_) return;
+    shut_down_ = true;
+  }
+  Drain();
+  if (server_ != nullptr) {
+    LogInfo(absl::StrCat("shutting down: in-flight calls have ",
+                         absl::FormatDuration(grace)));
+    const auto start = std::chrono::steady_clock::now();
+    server_->Shutdown(absl::ToChronoTime(absl::Now() + grace));
+    LogInfo(absl::StrFormat("gRPC server stopped after %.1f ms",
+                            std::chrono::duration<double, std::milli>(
+                                std::chrono::steady_clock::now() - start)
+                                .count()));
+  }
+  if (work_ != nullptr) work_->Stop();
+  if (warm_up_thread_.joinable()) warm_up_thread_.join();
+  metrics_.reset();
+}
+
+}  // namespace fovea::server

@@ -1,0 +1,103 @@
+#ifndef FOVEA_SERVER_SERVER_H_
+#define FOVEA_SERVER_SERVER_H_
+
+#include <grpcpp/grpcpp.h>
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "absl/base/thread_annotations.h"
+#include "absl/status/statusor.h"
+#include "absl/synchronization/mutex.h"
+#include "absl/time/time.h"
+#include "core/frame/frame_decode.h"
+#include "server/metrics.h"
+#include "server/perception_service.h"
+#include "server/work_queue.h"
+
+namespace fovea::server {
+
+// Default largest receive message: a raw 1280x720 rgb8 + 32FC1 frame is
+// about 6.5 MB; 64 MiB leaves room for 1920x1080 and compressed files.
+inline constexpr int kDefaultMaxMessageBytes = 64 << 20;
+
+struct ServerConfig {
+  std::string listen = "127.0.0.1:50051";  // host:port of the gRPC server
+  std::string metrics_listen;              // host:port of /metrics; empty: none
+  int concurrency = 1;                     // frames computed at once, >= 1
+  int queue = 2;                           // frames waiting for a worker, >= 0
+  int max_message_bytes = kDefaultMaxMessageBytes;  // largest request, > 0
+  FrameLimits limits;                               // largest frame
+  bool warm_up = true;  // run one Detect before reporting SERVING
+  // Test hook, see ServiceConfig::before_detect_job.
+  std::function<void()> before_detect_job;
+};
+
+// Names the flag of the first bad field (--concurrency, ...).
+absl::Status Validate(const ServerConfig& config);
+
+// The running server: the Perception service, the grpc.health.v1 service
+// (for "" and "fovea.v1.Perception"), server reflection, the worker pool
+// and the /metrics endpoint.
+//
+// Health: NOT_SERVING from start until the warm-up (one Detect on a small
+// synthetic frame, on its own thread) is done, then SERVING; NOT_SERVING
+// again from Drain on. A warm-up that fails is logged as an error and the
+// server still reports SERVING: the failure is then the scene's or core's,
+// and each call reports its own error.
+class FoveaServer {
+ public:
+  // Validates `config`, starts listening and returns at once (the warm-up
+  // runs in the background). UNAVAILABLE when an address cannot be bound.
+  static absl::StatusOr<std::unique_ptr<FoveaServer>> Start(
+      ServerConfig config);
+
+  // Shutdown(absl::ZeroDuration()) unless already shut down.
+  ~FoveaServer();
+
+  FoveaServer(const FoveaServer&) = delete;
+  FoveaServer& operator=(const FoveaServer&) = delete;
+
+  int port() const { return port_; }
+  // 0 without a metrics endpoint.
+  int metrics_port() const;
+
+  // True once the warm-up finished (OK or not).
+  bool warmed_up() const;
+
+  // Health NOT_SERVING for both names; calls are still served, so load
+  // balancers can move traffic away first. Idempotent.
+  void Drain();
+
+  // Drain, stop accepting calls, let in-flight calls (queued ones too)
+  // finish for up to `grace`, then cancel what is left (their jobs see
+  // CANCELLED at their next stage boundary) and wait for them; stop the
+  // workers and the metrics endpoint. Idempotent; blocks until done.
+  void Shutdown(absl::Duration grace);
+
+  // Detect jobs accepted and waiting for a worker.
+  int queued_jobs() const { return work_->waiting(); }
+
+ private:
+  FoveaServer() = default;
+  void SetServing(bool serving);
+  void WarmUp(const FrameLimits& limits);
+
+  int port_ = 0;
+  std::unique_ptr<WorkQueue> work_;
+  std::unique_ptr<PerceptionService> service_;
+  std::unique_ptr<MetricsEndpoint> metrics_;
+  std::unique_ptr<grpc::Server> server_;  // after service_: destroyed first
+  std::thread warm_up_thread_;
+
+  mutable absl::Mutex mu_;
+  bool warmed_up_ ABSL_GUARDED_BY(mu_) = false;
+  bool draining_ ABSL_GUARDED_BY(mu_) = false;
+  bool shut_down_ ABSL_GUARDED_BY(mu_) = false;
+};
+
+}  // namespace fovea::server
+
+#endif  // FOVEA_SERVER_SERVER_H_

@@ -1,0 +1,69 @@
+#include "server/work_queue.h"
+
+#include <utility>
+
+#include "core/base/check.h"
+
+namespace fovea::server {
+
+WorkQueue::WorkQueue(int workers, int queue_capacity)
+    : queue_capacity_(queue_capacity) {
+  FOVEA_CHECK(workers >= 1);
+  FOVEA_CHECK(queue_capacity >= 0);
+  threads_.reserve(workers);
+  for (int i = 0; i < workers; ++i) {
+    threads_.emplace_back([this] { WorkerLoop(); });
+  }
+}
+
+WorkQueue::~WorkQueue() { Stop(); }
+
+bool WorkQueue::TrySubmit(absl::AnyInvocable<void() &&> job) {
+  absl::MutexLock lock(&mu_);
+  if (stopping_) return false;
+  // A job counts against the queue only if no worker is free to take it.
+  const int in_system = running_ + static_cast<int>(jobs_.size());
+  if (in_system >= workers() + queue_capacity_) return false;
+  jobs_.push_back(std::move(job));
+  return true;
+}
+
+void WorkQueue::Stop() {
+  {
+    absl::MutexLock lock(&mu_);
+    stopping_ = true;
+  }
+  for (std::thread& thread : threads_) {
+    if (thread.joinable()) thread.join();
+  }
+}
+
+int WorkQueue::waiting() const {
+  absl::MutexLock lock(&mu_);
+  return static_cast<int>(jobs_.size());
+}
+
+int WorkQueue::running() const {
+  absl::MutexLock lock(&mu_);
+  return running_;
+}
+
+void WorkQueue::WorkerLoop() {
+  while (true) {
+    absl::AnyInvocable<void() &&> job;
+    {
+      absl::MutexLock lock(&mu_);
+      auto has_work_or_stop = [this]() { return !jobs_.empty() || stopping_; };
+      mu_.Await(absl::Condition(&has_work_or_stop));
+      if (jobs_.empty()) return;  // stopping and drained
+      job = std::move(jobs_.front());
+      jobs_.pop_front();
+      ++running_;
+    }
+    std::move(job)();
+    absl::MutexLock lock(&mu_);
+    --running_;
+  }
+}
+
+}  // namespace fovea::server

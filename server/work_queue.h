@@ -1,0 +1,62 @@
+#ifndef FOVEA_SERVER_WORK_QUEUE_H_
+#define FOVEA_SERVER_WORK_QUEUE_H_
+
+#include <deque>
+#include <thread>
+#include <vector>
+
+#include "absl/base/thread_annotations.h"
+#include "absl/functional/any_invocable.h"
+#include "absl/synchronization/mutex.h"
+
+namespace fovea::server {
+
+// A fixed pool of worker threads with a bounded queue: the server's limit
+// on how many frames are computed at once. CPU work runs here, never on
+// gRPC's callback threads.
+//
+// At most `workers` jobs run at once and at most `queue_capacity` more wait;
+// TrySubmit refuses a job beyond that, so the caller can answer
+// RESOURCE_EXHAUSTED at once instead of letting work pile up. Jobs run in
+// submission order.
+class WorkQueue {
+ public:
+  // `workers` >= 1, `queue_capacity` >= 0 (checked: FOVEA_CHECK).
+  WorkQueue(int workers, int queue_capacity);
+  // Stop().
+  ~WorkQueue();
+
+  WorkQueue(const WorkQueue&) = delete;
+  WorkQueue& operator=(const WorkQueue&) = delete;
+
+  // Queues `job` and returns true, or returns false (and drops `job`
+  // unrun) when the pool is full or stopped.
+  bool TrySubmit(absl::AnyInvocable<void() &&> job);
+
+  // Refuses new jobs, runs every job already accepted, joins the workers.
+  // Idempotent. Accepted jobs always run: each one owns a call that must
+  // be finished.
+  void Stop();
+
+  int workers() const { return static_cast<int>(threads_.size()); }
+  int queue_capacity() const { return queue_capacity_; }
+  // Jobs accepted and not yet started.
+  int waiting() const;
+  // Jobs running now.
+  int running() const;
+
+ private:
+  void WorkerLoop();
+
+  const int queue_capacity_;
+  std::vector<std::thread> threads_;
+
+  mutable absl::Mutex mu_;
+  std::deque<absl::AnyInvocable<void() &&>> jobs_ ABSL_GUARDED_BY(mu_);
+  int running_ ABSL_GUARDED_BY(mu_) = 0;
+  bool stopping_ ABSL_GUARDED_BY(mu_) = false;
+};
+
+}  // namespace fovea::server
+
+#endif  // FOVEA_SERVER_WORK_QUEUE_H_

@@ -1,0 +1,300 @@
+#include "server/convert.h"
+
+#include <cmath>
+#include <limits>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
+#include "core/synth/synth_scene.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "server/capabilities.h"
+
+namespace fovea::server {
+namespace {
+
+using ::testing::HasSubstr;
+
+TEST(ToDetectOptionsTest, EmptyOptionsAreCoreDefaults) {
+  absl::StatusOr<DetectOptions> options = ToDetectOptions(v1::DetectOptions());
+  ASSERT_TRUE(options.ok()) << options.status();
+  const DetectOptions defaults;
+  ASSERT_EQ(options->channels.size(), defaults.channels.size());
+  EXPECT_EQ(options->channels[0].op, defaults.channels[0].op);
+  EXPECT_EQ(options->max_points, 10);
+  EXPECT_EQ(options->pyramid, defaults.pyramid);
+  EXPECT_EQ(options->extraction, defaults.extraction);
+  EXPECT_FALSE(options->keep_channel_maps);
+}
+
+TEST(ToDetectOptionsTest, ChannelsWithZeroWeightWeighOne) {
+  v1::DetectOptions in;
+  in.add_saliency()->set_op(v1::PH);
+  v1::WeightedOperator* sh = in.add_saliency();
+  sh->set_op(v1::SH);
+  sh->set_weight(0.25);
+  in.set_max_points(3);
+  in.set_return_channel_maps(true);
+  absl::StatusOr<DetectOptions> options = ToDetectOptions(in);
+  ASSERT_TRUE(options.ok()) << options.status();
+  ASSERT_EQ(options->channels.size(), 2u);
+  EXPECT_EQ(options->channels[0].op, SaliencyOp::kPh);
+  EXPECT_FLOAT_EQ(options->channels[0].weight, 1.0f);
+  EXPECT_EQ(options->channels[1].op, SaliencyOp::kSh);
+  EXPECT_FLOAT_EQ(options->channels[1].weight, 0.25f);
+  EXPECT_EQ(options->max_points, 3);
+  EXPECT_TRUE(options->keep_channel_maps);
+}
+
+TEST(ToDetectOptionsTest, NegativeWeightIsInvalidAndNamed) {
+  v1::DetectOptions in;
+  in.add_saliency()->set_op(v1::RSO);
+  v1::WeightedOperator* ph = in.add_saliency();
+  ph->set_op(v1::PH);
+  ph->set_weight(-1.0);
+  absl::Status status = ToDetectOptions(in).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(status.message(), HasSubstr("options.saliency[1].weight"));
+}
+
+TEST(ToDetectOptionsTest, ChannelWithoutOperatorIsInvalid) {
+  v1::DetectOptions in;
+  in.add_saliency()->set_weight(1.0);
+  absl::Status status = ToDetectOptions(in).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(status.message(), HasSubstr("options.saliency[0].op"));
+}
+
+TEST(ToDetectOptionsTest, MaxPointsAboveHundredIsInvalid) {
+  v1::DetectOptions in;
+  in.set_max_points(100);
+  EXPECT_TRUE(ToDetectOptions(in).ok());
+  in.set_max_points(101);
+  absl::Status status = ToDetectOptions(in).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(status.message(), HasSubstr("options.max_points"));
+}
+
+TEST(ToDetectOptionsTest, ValueOutsideTheEnumIsInvalidAndNamed) {
+  v1::DetectOptions in;
+  in.set_pyramid(static_cast<v1::Pyramid>(99));
+  absl::Status status = ToDetectOptions(in).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(status.message(), HasSubstr("options.pyramid"));
+}
+
+TEST(ToDetectOptionsTest, OptionNotBuiltYetIsUnimplementedAndNamed) {
+  v1::DetectOptions sym3d;
+  sym3d.add_saliency()->set_op(v1::SYM3D);
+  absl::Status status = ToDetectOptions(sym3d).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kUnimplemented);
+  EXPECT_THAT(status.message(), HasSubstr("sym3d"));
+
+  v1::DetectOptions wta;
+  wta.set_extraction(v1::WTA);
+  status = ToDetectOptions(wta).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kUnimplemented);
+  EXPECT_THAT(status.message(), HasSubstr("extraction"));
+}
+
+TEST(ToDetectOptionsTest, BadTopDownCuesAreInvalid) {
+  v1::DetectOptions two_values;
+  two_values.add_target_color_rgb(1);
+  two_values.add_target_color_rgb(2);
+  EXPECT_THAT(ToDetectOptions(two_values).status().message(),
+              HasSubstr("options.target_color_rgb"));
+  v1::DetectOptions too_bright;
+  for (uint32_t c : {10u, 300u, 10u}) too_bright.add_target_color_rgb(c);
+  EXPECT_THAT(ToDetectOptions(too_bright).status().message(),
+              HasSubstr("options.target_color_rgb[1]"));
+  v1::DetectOptions sigma;
+  sigma.set_location_prior_sigma_px(-2);
+  EXPECT_THAT(ToDetectOptions(sigma).status().message(),
+              HasSubstr("options.location_prior_sigma_px"));
+}
+
+TEST(ToDetectOptionsTest, DefaultsSurviveTheWire) {
+  const DetectOptions defaults;
+  absl::StatusOr<DetectOptions> back =
+      ToDetectOptions(ToProtoDetectOptions(defaults));
+  ASSERT_TRUE(back.ok()) << back.status();
+  ASSERT_EQ(back->channels.size(), defaults.channels.size());
+  for (size_t i = 0; i < defaults.channels.size(); ++i) {
+    EXPECT_EQ(back->channels[i].op, defaults.channels[i].op);
+    EXPECT_FLOAT_EQ(back->channels[i].weight, defaults.channels[i].weight);
+  }
+  EXPECT_EQ(back->pyramid, defaults.pyramid);
+  EXPECT_EQ(back->level_combination, defaults.level_combination);
+  EXPECT_EQ(back->normalization, defaults.normalization);
+  EXPECT_EQ(back->fusion, defaults.fusion);
+  EXPECT_EQ(back->extraction, defaults.extraction);
+  EXPECT_EQ(back->max_points, defaults.max_points);
+}
+
+TEST(ToRawFrameTest, ViewsPointIntoTheRequest) {
+  v1::Frame frame;
+  frame.mutable_color()->set_width(2);
+  frame.mutable_color()->set_height(1);
+  frame.mutable_color()->set_encoding("bgr8");
+  frame.mutable_color()->set_step(6);
+  frame.mutable_color()->set_data("abcdef");
+  frame.mutable_depth()->set_compressed("png bytes");
+  frame.mutable_intrinsics()->set_fx(500);
+  frame.mutable_intrinsics()->set_cy(7);
+  frame.set_depth_scale(0.0001);
+  const RawFrame raw = ToRawFrame(frame);
+  EXPECT_EQ(raw.color.width, 2u);
+  EXPECT_EQ(raw.color.height, 1u);
+  EXPECT_EQ(raw.color.encoding, "bgr8");
+  EXPECT_EQ(raw.color.step, 6u);
+  EXPECT_EQ(raw.color.data.data(), frame.color().data().data());
+  EXPECT_EQ(raw.color.data.size(), 6u);
+  EXPECT_EQ(raw.depth.compressed, "png bytes");
+  EXPECT_TRUE(raw.depth.data.empty());
+  EXPECT_EQ(raw.intrinsics.fx, 500);
+  EXPECT_EQ(raw.intrinsics.cy, 7);
+  EXPECT_EQ(raw.depth_scale, 0.0001);
+}
+
+// ToProtoFrame writes what DecodeFrame reads back: colour exactly, depth
+// exactly (32FC1) or to the millimetre (16UC1), no-data pixels as NaN.
+TEST(ToProtoFrameTest, RoundTripsThroughDecodeFrame) {
+  const synth::SynthScene scene = synth::GenerateScene(7);
+  const RgbdFrame& original = scene.frame.frame;
+  for (DepthEncoding encoding :
+       {DepthEncoding::k32FC1, DepthEncoding::k16UC1}) {
+    const v1::Frame wire = ToProtoFrame(original, encoding);
+    absl::StatusOr<RgbdFrame> decoded =
+        DecodeFrame(ToRawFrame(wire), FrameLimits());
+    ASSERT_TRUE(decoded.ok()) << decoded.status();
+    EXPECT_EQ(cv::norm(decoded->color, original.color, cv::NORM_INF), 0);
+    // Half a millimetre of rounding, plus float error.
+    const double tolerance = encoding == DepthEncoding::k32FC1 ? 0.0 : 0.000501;
+    int compared = 0;
+    for (int v = 0; v < original.depth.rows; ++v) {
+      for (int u = 0; u < original.depth.cols; ++u) {
+        const float a = original.depth.at<float>(v, u);
+        const float b = decoded->depth.at<float>(v, u);
+        if (std::isnan(a)) {
+          EXPECT_TRUE(std::isnan(b)) << u << "," << v;
+          continue;
+        }
+        ASSERT_NEAR(a, b, tolerance) << u << "," << v;
+        ++compared;
+      }
+    }
+    EXPECT_GT(compared, 0);
+    EXPECT_EQ(decoded->intrinsics.fx, original.intrinsics.fx);
+    EXPECT_EQ(decoded->intrinsics.cx, original.intrinsics.cx);
+  }
+}
+
+DetectResult SmallResult() {
+  DetectResult result;
+  AttentionPoint first;
+  first.u = 3;
+  first.v = 1;
+  first.saliency = 1.0f;
+  first.point = {0.1f, -0.2f, 0.9f};
+  AttentionPoint second;  // no depth: NaN point
+  second.u = 0;
+  second.v = 0;
+  second.saliency = 0.5f;
+  result.points = {first, second};
+  result.master = cv::Mat(2, 4, CV_32FC1, cv::Scalar(0.0f));
+  result.master.at<float>(1, 3) = 1.0f;
+  result.master.at<float>(0, 1) = 0.5f;
+  result.master.at<float>(0, 2) = std::numeric_limits<float>::quiet_NaN();
+  result.master.at<float>(1, 0) = 1.5f;  // clamped
+  result.channel_maps = {{"rso", result.master.clone()}};
+  result.plane.normal = {0.0f, -1.0f, 0.0f};
+  result.plane.d = 0.7f;
+  result.plane.inlier_count = 1234;
+  result.timings = {{"cloud", 0.001}, {"saliency.rso", 0.002}};
+  return result;
+}
+
+TEST(ToDetectResponseTest, EchoesIdsAndRanksPoints) {
+  v1::DetectRequest request;
+  request.set_request_id("r-17");
+  request.mutable_frame()->set_frame_id("head_camera");
+  request.mutable_frame()->set_stamp_ns(123456789);
+  absl::StatusOr<v1::DetectResponse> response =
+      ToDetectResponse(SmallResult(), request);
+  ASSERT_TRUE(response.ok()) << response.status();
+  EXPECT_EQ(response->request_id(), "r-17");
+  EXPECT_EQ(response->frame_id(), "head_camera");
+  EXPECT_EQ(response->stamp_ns(), 123456789);
+  ASSERT_EQ(response->points_size(), 2);
+  EXPECT_EQ(response->points(0).u(), 3u);
+  EXPECT_EQ(response->points(0).v(), 1u);
+  EXPECT_EQ(response->points(0).rank(), 0u);
+  EXPECT_DOUBLE_EQ(response->points(0).saliency(), 1.0);
+  EXPECT_FLOAT_EQ(response->points(0).point().z(), 0.9f);
+  EXPECT_EQ(response->points(1).rank(), 1u);
+  EXPECT_TRUE(std::isnan(response->points(1).point().x()));
+  EXPECT_FLOAT_EQ(response->support_plane().normal().y(), -1.0f);
+  EXPECT_FLOAT_EQ(response->support_plane().d(), 0.7f);
+  EXPECT_EQ(response->support_plane().inlier_count(), 1234u);
+  ASSERT_EQ(response->timings_size(), 2);
+  EXPECT_EQ(response->timings(1).stage(), "saliency.rso");
+  EXPECT_DOUBLE_EQ(response->timings(1).seconds(), 0.002);
+  EXPECT_EQ(response->maps_size(), 0);  // not asked for
+}
+
+TEST(ToDetectResponseTest, MapsAreSixteenBitPngsWhenAsked) {
+  v1::DetectRequest request;
+  request.mutable_options()->set_return_saliency_map(true);
+  request.mutable_options()->set_return_channel_maps(true);
+  absl::StatusOr<v1::DetectResponse> response =
+      ToDetectResponse(SmallResult(), request);
+  ASSERT_TRUE(response.ok()) << response.status();
+  ASSERT_EQ(response->maps_size(), 2);
+  EXPECT_EQ(response->maps(0).name(), "master");
+  EXPECT_EQ(response->maps(1).name(), "rso");
+  const v1::Image& image = response->maps(0).image();
+  EXPECT_EQ(image.width(), 4u);
+  EXPECT_EQ(image.height(), 2u);
+  const std::string& png = image.compressed();
+  const cv::Mat decoded = cv::imdecode(
+      std::vector<uchar>(png.begin(), png.end()), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(decoded.type(), CV_16UC1);
+  EXPECT_EQ(decoded.at<uint16_t>(1, 3), 65535);
+  EXPECT_EQ(decoded.at<uint16_t>(0, 1), 32768);  // round(0.5 * 65535)
+  EXPECT_EQ(decoded.at<uint16_t>(0, 2), 0);      // NaN
+  EXPECT_EQ(decoded.at<uint16_t>(1, 0), 65535);  // 1.5 clamped
+  EXPECT_EQ(decoded.at<uint16_t>(0, 0), 0);
+}
+
+TEST(EncodeSaliencyPngTest, RefusesAMapOfAnotherType) {
+  EXPECT_EQ(EncodeSaliencyPng(cv::Mat(2, 2, CV_8UC1)).status().code(),
+            absl::StatusCode::kInternal);
+  EXPECT_EQ(EncodeSaliencyPng(cv::Mat()).status().code(),
+            absl::StatusCode::kInternal);
+}
+
+TEST(CapabilitiesTest, ListWhatCoreValidates) {
+  const v1::Capabilities capabilities = BuildCapabilities(FrameLimits(), 1000);
+  std::vector<int> ops(capabilities.saliency_operators().begin(),
+                       capabilities.saliency_operators().end());
+  // The operators of this issue; each one listed passes core's Validate.
+  EXPECT_THAT(ops, ::testing::IsSupersetOf({v1::PH, v1::SH, v1::RSO}));
+  for (int op : ops) {
+    v1::DetectOptions options;
+    options.add_saliency()->set_op(static_cast<v1::SaliencyOperator>(op));
+    EXPECT_TRUE(ToDetectOptions(options).ok()) << op;
+  }
+  EXPECT_THAT(ops, ::testing::Not(::testing::Contains(v1::SYM3D)));
+  EXPECT_THAT(capabilities.pyramids(), ::testing::Contains(v1::NONE));
+  EXPECT_THAT(capabilities.normalizations(), ::testing::Contains(v1::LIN));
+  EXPECT_THAT(capabilities.extractions(), ::testing::Contains(v1::MSR));
+  EXPECT_EQ(capabilities.max_width(), FrameLimits().max_width);
+  EXPECT_EQ(capabilities.max_message_bytes(), 1000u);
+  EXPECT_THAT(capabilities.compressed_formats(),
+              ::testing::ElementsAre("png", "jpeg"));
+  EXPECT_FALSE(capabilities.server_version().empty());
+}
+
+}  // namespace
+}  // namespace fovea::server

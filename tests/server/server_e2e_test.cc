@@ -1,0 +1,511 @@
+// End to end: an in-process FoveaServer on loopback, a real gRPC channel.
+
+#include <grpcpp/grpcpp.h>
+
+#include <atomic>
+#include <chrono>
+#include <future>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "absl/synchronization/mutex.h"
+#include "core/synth/synth_scene.h"
+#include "fovea/v1/perception.grpc.pb.h"
+#include "gmock/gmock.h"
+#include "gtest/gtest.h"
+#include "server/capabilities.h"
+#include "server/convert.h"
+#include "server/server.h"
+#include "tests/server/test_util.h"
+
+namespace fovea::server {
+namespace {
+
+using ::fovea::server::testing::FreePort;
+using ::fovea::server::testing::HealthStatus;
+using ::fovea::server::testing::HttpGet;
+using ::fovea::server::testing::MakeSyntheticRequest;
+using ::fovea::server::testing::MetricValue;
+using ::fovea::server::testing::SyntheticRequest;
+using ::fovea::server::testing::WaitFor;
+using ::testing::HasSubstr;
+
+constexpr auto kStartTimeout = std::chrono::seconds(60);
+constexpr auto kCallTimeout = std::chrono::seconds(30);
+
+// Holds every Detect job at its start while closed; tests use it to keep a
+// worker busy and fill the queue without sleeping.
+class WorkerGate {
+ public:
+  void Close() {
+    absl::MutexLock lock(&mu_);
+    open_ = false;
+  }
+  void Open() {
+    absl::MutexLock lock(&mu_);
+    open_ = true;
+  }
+  int entered() const {
+    absl::MutexLock lock(&mu_);
+    return entered_;
+  }
+  // ServiceConfig::before_detect_job: waits while the gate is closed.
+  void Pass() {
+    absl::MutexLock lock(&mu_);
+    ++entered_;
+    mu_.Await(absl::Condition(&open_));
+  }
+
+ private:
+  mutable absl::Mutex mu_;
+  bool open_ = true;
+  int entered_ = 0;
+};
+
+class ServerTest : public ::testing::Test {
+ protected:
+  // Starts a server with `config` adjusted for the test (ports, gate) and
+  // waits for health SERVING.
+  void StartServer(ServerConfig config = DefaultConfig()) {
+    config.listen = "127.0.0.1:" + std::to_string(FreePort());
+    config.metrics_listen = "127.0.0.1:" + std::to_string(FreePort());
+    config.before_detect_job = [this] { gate_.Pass(); };
+    absl::StatusOr<std::unique_ptr<FoveaServer>> server =
+        FoveaServer::Start(config);
+    ASSERT_TRUE(server.ok()) << server.status();
+    server_ = *std::move(server);
+    channel_ =
+        grpc::CreateChannel("127.0.0.1:" + std::to_string(server_->port()),
+                            grpc::InsecureChannelCredentials());
+    stub_ = v1::Perception::NewStub(channel_);
+    ASSERT_TRUE(
+        WaitFor([this] { return HealthStatus(channel_, "") == "SERVING"; },
+                kStartTimeout));
+  }
+
+  void TearDown() override {
+    gate_.Open();
+    if (server_ != nullptr) server_->Shutdown(absl::Seconds(5));
+  }
+
+  static ServerConfig DefaultConfig() {
+    ServerConfig config;
+    config.concurrency = 2;
+    config.queue = 4;
+    return config;
+  }
+
+  grpc::Status Detect(
+      const v1::DetectRequest& request, v1::DetectResponse* response,
+      std::chrono::milliseconds deadline =
+          std::chrono::duration_cast<std::chrono::milliseconds>(kCallTimeout)) {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + deadline);
+    return stub_->Detect(&context, request, response);
+  }
+
+  // Detect on its own thread.
+  std::future<grpc::Status> DetectAsync(
+      v1::DetectRequest request,
+      std::chrono::milliseconds deadline =
+          std::chrono::duration_cast<std::chrono::milliseconds>(kCallTimeout)) {
+    return std::async(std::launch::async, [this, request, deadline] {
+      v1::DetectResponse response;
+      return Detect(request, &response, deadline);
+    });
+  }
+
+  std::string Scrape() {
+    std::optional<std::string> text =
+        HttpGet(server_->metrics_port(), "/metrics");
+    EXPECT_TRUE(text.has_value());
+    return text.value_or("");
+  }
+
+  double Handled(const std::string& text, const std::string& method,
+                 const std::string& code) {
+    return MetricValue(
+               text, "grpc_server_handled_total",
+               {"grpc_method=\"" + method + "\"", "grpc_code=\"" + code + "\""})
+        .value_or(-1);
+  }
+
+  WorkerGate gate_;
+  std::unique_ptr<FoveaServer> server_;
+  std::shared_ptr<grpc::Channel> channel_;
+  std::unique_ptr<v1::Perception::Stub> stub_;
+};
+
+TEST_F(ServerTest, DetectFirstPointLiesOnAnObject) {
+  StartServer();
+  int on_object = 0;
+  constexpr int kSeeds = 6;
+  for (int seed = 1; seed <= kSeeds; ++seed) {
+    const bool depth_16uc1 = seed % 2 == 0;
+    SyntheticRequest scene = MakeSyntheticRequest(seed, depth_16uc1);
+    v1::DetectResponse response;
+    const grpc::Status status = Detect(scene.request, &response);
+    ASSERT_TRUE(status.ok())
+        << "seed " << seed << ": " << status.error_message();
+    EXPECT_EQ(response.request_id(), scene.request.request_id());
+    EXPECT_EQ(response.frame_id(), "camera");
+    EXPECT_EQ(response.stamp_ns(), 1000 + seed);
+    ASSERT_GT(response.points_size(), 0) << "seed " << seed;
+    for (int i = 0; i < response.points_size(); ++i) {
+      EXPECT_EQ(response.points(i).rank(), static_cast<uint32_t>(i));
+    }
+    const v1::AttentionPoint& first = response.points(0);
+    const int label = scene.labels[first.v() * scene.width + first.u()];
+    if (label >= 20) ++on_object;
+    RecordProperty("seed_" + std::to_string(seed) + "_first_label", label);
+    ASSERT_GE(response.timings_size(), 3);
+    EXPECT_EQ(response.timings(0).stage(), "queue");
+    EXPECT_EQ(response.timings(1).stage(), "decode");
+    EXPECT_EQ(response.timings(response.timings_size() - 1).stage(), "encode");
+  }
+  // Most first points on objects.
+  EXPECT_GE(on_object, kSeeds - 1) << on_object << " of " << kSeeds;
+}
+
+TEST_F(ServerTest, MalformedFrameIsInvalidArgumentAndServerGoesOn) {
+  StartServer();
+  SyntheticRequest good = MakeSyntheticRequest(3, false);
+  v1::DetectRequest bad = good.request;
+  bad.mutable_frame()->mutable_color()->set_step(100);  // < 640 * 3
+  v1::DetectResponse response;
+  const grpc::Status status = Detect(bad, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("frame.color.step"));
+
+  EXPECT_TRUE(Detect(good.request, &response).ok());
+}
+
+TEST_F(ServerTest, OversizedFrameIsInvalidArgumentAndServerGoesOn) {
+  StartServer();
+  // Consistent in itself, but wider than the default 1920 limit.
+  v1::DetectRequest wide;
+  constexpr int kWidth = 2000;
+  constexpr int kHeight = 4;
+  v1::Image* color = wide.mutable_frame()->mutable_color();
+  color->set_width(kWidth);
+  color->set_height(kHeight);
+  color->set_encoding("rgb8");
+  color->set_step(kWidth * 3);
+  color->set_data(std::string(kWidth * 3 * kHeight, '\x80'));
+  v1::Image* depth = wide.mutable_frame()->mutable_depth();
+  depth->set_width(kWidth);
+  depth->set_height(kHeight);
+  depth->set_encoding("16UC1");
+  depth->set_step(kWidth * 2);
+  depth->set_data(std::string(kWidth * 2 * kHeight, '\x03'));
+  *wide.mutable_frame()->mutable_intrinsics() =
+      MakeSyntheticRequest(1, false).request.frame().intrinsics();
+  v1::DetectResponse response;
+  const grpc::Status status = Detect(wide, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("width"));
+  EXPECT_THAT(status.error_message(), HasSubstr("frame."));
+
+  EXPECT_TRUE(Detect(MakeSyntheticRequest(1, false).request, &response).ok());
+}
+
+TEST_F(ServerTest, RawFrameOf1280x720FitsTheDefaultMessageLimit) {
+  StartServer();
+  // About 6.5 MB raw (rgb8 + 32FC1): above gRPC's default 4 MiB.
+  synth::SceneSpec spec = synth::RandomSceneSpec(4, {});
+  spec.width = 1280;
+  spec.height = 720;
+  spec.intrinsics = {1050.0, 1050.0, 639.5, 359.5};
+  const synth::SynthScene scene =
+      synth::RenderScene(spec, synth::NoiseOptions{}, 4);
+  v1::DetectRequest request;
+  *request.mutable_frame() =
+      ToProtoFrame(scene.frame.frame, DepthEncoding::k32FC1);
+  ASSERT_GT(request.ByteSizeLong(), 4u << 20);
+  v1::DetectResponse response;
+  const grpc::Status status = Detect(request, &response);
+  EXPECT_TRUE(status.ok()) << status.error_message();
+}
+
+TEST_F(ServerTest, OptionNotBuiltIsUnimplementedAndTooManyPointsInvalid) {
+  StartServer();
+  v1::DetectRequest request = MakeSyntheticRequest(1, false).request;
+  request.mutable_options()->add_saliency()->set_op(v1::SYM3D);
+  v1::DetectResponse response;
+  grpc::Status status = Detect(request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::UNIMPLEMENTED);
+  EXPECT_THAT(status.error_message(), HasSubstr("sym3d"));
+
+  request.mutable_options()->clear_saliency();
+  request.mutable_options()->set_max_points(101);
+  status = Detect(request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("options.max_points"));
+}
+
+TEST_F(ServerTest, ShortDeadlineIsDeadlineExceeded) {
+  StartServer();
+  v1::DetectResponse response;
+  const grpc::Status status = Detect(MakeSyntheticRequest(2, false).request,
+                                     &response, std::chrono::milliseconds(1));
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED);
+}
+
+TEST_F(ServerTest, JobWhoseDeadlinePassedInTheQueueIsNotComputed) {
+  ServerConfig config = DefaultConfig();
+  config.concurrency = 1;
+  config.queue = 1;
+  StartServer(config);
+  const v1::DetectRequest request = MakeSyntheticRequest(1, false).request;
+  const std::string before = Scrape();
+  const double decodes_before =
+      MetricValue(before, "fovea_stage_duration_seconds_count",
+                  {"stage=\"decode\""})
+          .value_or(-1);
+
+  gate_.Close();
+  std::future<grpc::Status> held = DetectAsync(request);
+  ASSERT_TRUE(WaitFor([this] { return gate_.entered() == 1; }, kCallTimeout));
+  std::future<grpc::Status> expiring =
+      DetectAsync(request, std::chrono::milliseconds(1000));
+  ASSERT_TRUE(
+      WaitFor([this] { return server_->queued_jobs() == 1; }, kCallTimeout));
+  // The client gives up while its job waits behind the held one.
+  EXPECT_EQ(expiring.get().error_code(), grpc::StatusCode::DEADLINE_EXCEEDED);
+  gate_.Open();
+  EXPECT_TRUE(held.get().ok());
+
+  // The server answered the expired job DEADLINE_EXCEEDED without decoding
+  // its frame: one decode (the held call's) more than before.
+  ASSERT_TRUE(WaitFor(
+      [&] { return Handled(Scrape(), "Detect", "DeadlineExceeded") == 1; },
+      kCallTimeout));
+  const double decodes_after =
+      MetricValue(Scrape(), "fovea_stage_duration_seconds_count",
+                  {"stage=\"decode\""})
+          .value_or(-1);
+  EXPECT_EQ(decodes_after, decodes_before + 1);
+}
+
+TEST_F(ServerTest, FullQueueIsResourceExhausted) {
+  ServerConfig config = DefaultConfig();
+  config.concurrency = 1;
+  config.queue = 1;
+  StartServer(config);
+  const v1::DetectRequest request = MakeSyntheticRequest(1, false).request;
+
+  gate_.Close();
+  std::future<grpc::Status> running = DetectAsync(request);
+  ASSERT_TRUE(WaitFor([this] { return gate_.entered() == 1; }, kCallTimeout));
+  std::future<grpc::Status> queued = DetectAsync(request);
+  ASSERT_TRUE(
+      WaitFor([this] { return server_->queued_jobs() == 1; }, kCallTimeout));
+
+  // One worker busy, one job queued: the next is refused at once.
+  v1::DetectResponse response;
+  const grpc::Status refused = Detect(request, &response);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(refused.error_message(), HasSubstr("busy"));
+
+  gate_.Open();
+  EXPECT_TRUE(running.get().ok());
+  EXPECT_TRUE(queued.get().ok());
+  EXPECT_EQ(Handled(Scrape(), "Detect", "ResourceExhausted"), 1);
+}
+
+TEST_F(ServerTest, SegmentMethodsAreUnimplemented) {
+  StartServer();
+  {
+    grpc::ClientContext context;
+    v1::SegmentRequest request;
+    auto reader = stub_->Segment(&context, request);
+    v1::SegmentResponse response;
+    EXPECT_FALSE(reader->Read(&response));
+    const grpc::Status status = reader->Finish();
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::UNIMPLEMENTED);
+    EXPECT_THAT(status.error_message(), HasSubstr("not built yet"));
+  }
+  {
+    grpc::ClientContext context;
+    v1::SegmentIncrementalRequest request;
+    auto reader = stub_->SegmentIncremental(&context, request);
+    v1::SegmentResponse response;
+    EXPECT_FALSE(reader->Read(&response));
+    const grpc::Status status = reader->Finish();
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::UNIMPLEMENTED);
+    EXPECT_THAT(status.error_message(), HasSubstr("not built yet"));
+  }
+  const std::string text = Scrape();
+  EXPECT_EQ(
+      MetricValue(text, "grpc_server_handled_total",
+                  {"grpc_method=\"Segment\"", "grpc_code=\"Unimplemented\"",
+                   "grpc_type=\"server_stream\""}),
+      1);
+}
+
+TEST_F(ServerTest, CapabilitiesReportWhatCoreImplements) {
+  StartServer();
+  grpc::ClientContext context;
+  v1::Capabilities capabilities;
+  ASSERT_TRUE(stub_
+                  ->GetCapabilities(&context, v1::GetCapabilitiesRequest(),
+                                    &capabilities)
+                  .ok());
+  EXPECT_EQ(capabilities.server_version(), ServerVersion());
+  EXPECT_THAT(capabilities.saliency_operators(),
+              ::testing::UnorderedElementsAre(v1::PH, v1::SH, v1::RSO));
+  EXPECT_THAT(capabilities.extractions(), ::testing::ElementsAre(v1::MSR));
+  EXPECT_THAT(capabilities.color_encodings(),
+              ::testing::ElementsAre("rgb8", "bgr8"));
+  EXPECT_THAT(capabilities.depth_encodings(),
+              ::testing::ElementsAre("16UC1", "32FC1"));
+  EXPECT_EQ(capabilities.max_width(), 1920u);
+  EXPECT_EQ(capabilities.max_message_bytes(),
+            static_cast<uint64_t>(kDefaultMaxMessageBytes));
+  EXPECT_TRUE(capabilities.segmentation_methods().empty());
+  EXPECT_FALSE(capabilities.segment_incremental());
+  EXPECT_EQ(capabilities.default_detect_options().max_points(), 10u);
+}
+
+TEST_F(ServerTest, HealthServingAfterWarmUpThenNotServingOnDrain) {
+  StartServer();
+  EXPECT_TRUE(server_->warmed_up());
+  EXPECT_EQ(HealthStatus(channel_, ""), "SERVING");
+  EXPECT_EQ(HealthStatus(channel_, "fovea.v1.Perception"), "SERVING");
+  server_->Drain();
+  EXPECT_EQ(HealthStatus(channel_, ""), "NOT_SERVING");
+  EXPECT_EQ(HealthStatus(channel_, "fovea.v1.Perception"), "NOT_SERVING");
+  // Draining still serves calls until Shutdown.
+  v1::DetectResponse response;
+  EXPECT_TRUE(Detect(MakeSyntheticRequest(1, false).request, &response).ok());
+}
+
+TEST_F(ServerTest, MetricsScrapeShowsCountersWithGrpcLabels) {
+  StartServer();
+  const std::string before = Scrape();
+  const std::vector<std::string> detect = {
+      "grpc_method=\"Detect\"", "grpc_service=\"fovea.v1.Perception\"",
+      "grpc_type=\"unary\""};
+  auto with = [&detect](const std::string& label) {
+    std::vector<std::string> labels = detect;
+    labels.push_back(label);
+    return labels;
+  };
+  // Zero-initialised series exist before any call (codes no test in this
+  // binary produces, since the tests may share one process).
+  EXPECT_EQ(MetricValue(before, "grpc_server_handled_total",
+                        with("grpc_code=\"DataLoss\"")),
+            0);
+  EXPECT_EQ(MetricValue(before, "grpc_server_handled_total",
+                        with("grpc_code=\"Unauthenticated\"")),
+            0);
+  EXPECT_EQ(MetricValue(before, "grpc_server_handled_total",
+                        {"grpc_method=\"SegmentIncremental\"",
+                         "grpc_type=\"server_stream\"",
+                         "grpc_code=\"DeadlineExceeded\""}),
+            0);
+  EXPECT_EQ(MetricValue(before, "fovea_build_info",
+                        {"version=\"" + std::string(ServerVersion()) + "\""}),
+            1);
+  EXPECT_TRUE(MetricValue(before, "fovea_stage_duration_seconds_count",
+                          {"stage=\"support_plane\""})
+                  .has_value());
+  EXPECT_TRUE(MetricValue(before, "grpc_server_handling_seconds_bucket",
+                          {"grpc_method=\"Detect\"", "le=\"0.005\""})
+                  .has_value());
+  const double started =
+      MetricValue(before, "grpc_server_started_total", detect).value_or(-1);
+  const double invalid = Handled(before, "Detect", "InvalidArgument");
+  const double ok = Handled(before, "Detect", "OK");
+
+  v1::DetectRequest bad = MakeSyntheticRequest(1, false).request;
+  bad.mutable_frame()->mutable_depth()->set_step(7);
+  v1::DetectResponse response;
+  EXPECT_EQ(Detect(bad, &response).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  ASSERT_TRUE(Detect(MakeSyntheticRequest(1, false).request, &response).ok());
+
+  // Handled is recorded before the status goes out, so it is there now.
+  const std::string after = Scrape();
+  EXPECT_EQ(MetricValue(after, "grpc_server_started_total", detect),
+            started + 2);
+  EXPECT_EQ(Handled(after, "Detect", "InvalidArgument"), invalid + 1);
+  EXPECT_EQ(Handled(after, "Detect", "OK"), ok + 1);
+  EXPECT_EQ(MetricValue(after, "grpc_server_msg_received_total", detect),
+            MetricValue(before, "grpc_server_msg_received_total", detect)
+                    .value_or(-1) +
+                2);
+  EXPECT_EQ(
+      MetricValue(after, "grpc_server_msg_sent_total", detect),
+      MetricValue(before, "grpc_server_msg_sent_total", detect).value_or(-1) +
+          1);
+  EXPECT_EQ(MetricValue(after, "grpc_server_handling_seconds_count", detect),
+            MetricValue(before, "grpc_server_handling_seconds_count", detect)
+                    .value_or(-1) +
+                2);
+  EXPECT_GE(MetricValue(after, "fovea_stage_duration_seconds_count",
+                        {"stage=\"saliency.rso\""})
+                .value_or(-1),
+            1);
+  EXPECT_EQ(
+      MetricValue(after, "fovea_queue_wait_seconds_count", {}),
+      MetricValue(before, "fovea_queue_wait_seconds_count", {}).value_or(-1) +
+          2);
+  EXPECT_EQ(MetricValue(after, "fovea_inflight_requests", {}), 0);
+}
+
+TEST_F(ServerTest, ShutdownLetsInFlightCallFinish) {
+  ServerConfig config = DefaultConfig();
+  config.concurrency = 1;
+  config.queue = 0;
+  StartServer(config);
+  gate_.Close();
+  std::future<grpc::Status> in_flight =
+      DetectAsync(MakeSyntheticRequest(1, false).request);
+  ASSERT_TRUE(WaitFor([this] { return gate_.entered() == 1; }, kCallTimeout));
+
+  std::thread shutdown([this] { server_->Shutdown(absl::Seconds(30)); });
+  // Once the server stops accepting, new calls fail; then let the held
+  // call go on: it must still complete.
+  ASSERT_TRUE(WaitFor(
+      [this] {
+        grpc::ClientContext context;
+        context.set_deadline(std::chrono::system_clock::now() +
+                             std::chrono::seconds(2));
+        v1::Capabilities capabilities;
+        return !stub_
+                    ->GetCapabilities(&context, v1::GetCapabilitiesRequest(),
+                                      &capabilities)
+                    .ok();
+      },
+      kCallTimeout));
+  gate_.Open();
+  EXPECT_TRUE(in_flight.get().ok());
+  shutdown.join();
+}
+
+TEST_F(ServerTest, ShutdownCancelsCallsPastTheGracePeriod) {
+  ServerConfig config = DefaultConfig();
+  config.concurrency = 1;
+  config.queue = 0;
+  StartServer(config);
+  gate_.Close();
+  std::future<grpc::Status> in_flight =
+      DetectAsync(MakeSyntheticRequest(1, false).request);
+  ASSERT_TRUE(WaitFor([this] { return gate_.entered() == 1; }, kCallTimeout));
+
+  const auto start = std::chrono::steady_clock::now();
+  std::thread shutdown([this] { server_->Shutdown(absl::Milliseconds(200)); });
+  // The held call is cancelled once the grace period is over, long before
+  // its own 30 s deadline.
+  ASSERT_EQ(in_flight.wait_for(kCallTimeout), std::future_status::ready);
+  const grpc::Status status = in_flight.get();
+  EXPECT_FALSE(status.ok());
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
+  gate_.Open();  // its job now sees CANCELLED and finishes
+  shutdown.join();
+}
+
+}  // namespace
+}  // namespace fovea::server
