@@ -1,0 +1,118 @@
+#include "client/fovea_client.h"
+
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "grpcpp/client_context.h"
+#include "grpcpp/create_channel.h"
+#include "grpcpp/security/credentials.h"
+#include "grpcpp/support/channel_arguments.h"
+
+namespace fovea::client {
+namespace {
+
+// gRPC and absl number the canonical codes alike (both follow
+// google.rpc.Code), so the code carries over unchanged.
+absl::Status ToAbslStatus(const grpc::Status& status) {
+  if (status.ok()) return absl::OkStatus();
+  return absl::Status(static_cast<absl::StatusCode>(status.error_code()),
+                      status.error_message());
+}
+
+// Prepares `context` for one call that must end within `deadline`.
+void PrepareContext(absl::Duration deadline, const ClientOptions& options,
+                    grpc::ClientContext& context) {
+  context.set_deadline(absl::ToChronoTime(absl::Now() + deadline));
+  context.set_wait_for_ready(options.wait_for_ready);
+}
+
+template <typename Reader>
+absl::Status DrainStream(Reader& reader, const SegmentCallback& on_message) {
+  fovea::v1::SegmentResponse message;
+  while (reader.Read(&message)) {
+    on_message(message);
+    message.Clear();
+  }
+  return ToAbslStatus(reader.Finish());
+}
+
+}  // namespace
+
+absl::StatusOr<std::unique_ptr<FoveaClient>> FoveaClient::Connect(
+    const std::string& target, const ClientOptions& options) {
+  if (target.empty()) {
+    return absl::InvalidArgumentError("server: empty target (want HOST:PORT)");
+  }
+  grpc::ChannelArguments arguments;
+  arguments.SetMaxReceiveMessageSize(options.max_message_bytes);
+  arguments.SetMaxSendMessageSize(options.max_message_bytes);
+  std::shared_ptr<grpc::Channel> channel = grpc::CreateCustomChannel(
+      target, grpc::InsecureChannelCredentials(), arguments);
+  if (channel == nullptr) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("server: cannot create a channel to \"", target, "\""));
+  }
+  return std::make_unique<FoveaClient>(std::move(channel), options);
+}
+
+FoveaClient::FoveaClient(std::shared_ptr<grpc::Channel> channel,
+                         const ClientOptions& options)
+    : options_(options),
+      channel_(std::move(channel)),
+      perception_(fovea::v1::Perception::NewStub(channel_)),
+      health_(grpc::health::v1::Health::NewStub(channel_)) {}
+
+absl::StatusOr<grpc::health::v1::HealthCheckResponse::ServingStatus>
+FoveaClient::Health(const std::string& service, absl::Duration deadline) {
+  grpc::ClientContext context;
+  PrepareContext(deadline, options_, context);
+  grpc::health::v1::HealthCheckRequest request;
+  request.set_service(service);
+  grpc::health::v1::HealthCheckResponse response;
+  const grpc::Status status = health_->Check(&context, request, &response);
+  if (!status.ok()) return ToAbslStatus(status);
+  return response.status();
+}
+
+absl::StatusOr<fovea::v1::Capabilities> FoveaClient::GetCapabilities(
+    absl::Duration deadline) {
+  grpc::ClientContext context;
+  PrepareContext(deadline, options_, context);
+  fovea::v1::Capabilities response;
+  const grpc::Status status = perception_->GetCapabilities(
+      &context, fovea::v1::GetCapabilitiesRequest(), &response);
+  if (!status.ok()) return ToAbslStatus(status);
+  return response;
+}
+
+absl::StatusOr<fovea::v1::DetectResponse> FoveaClient::Detect(
+    const fovea::v1::DetectRequest& request, absl::Duration deadline) {
+  grpc::ClientContext context;
+  PrepareContext(deadline, options_, context);
+  fovea::v1::DetectResponse response;
+  const grpc::Status status = perception_->Detect(&context, request, &response);
+  if (!status.ok()) return ToAbslStatus(status);
+  return response;
+}
+
+absl::Status FoveaClient::Segment(const fovea::v1::SegmentRequest& request,
+                                  absl::Duration deadline,
+                                  const SegmentCallback& on_message) {
+  grpc::ClientContext context;
+  PrepareContext(deadline, options_, context);
+  std::unique_ptr<grpc::ClientReader<fovea::v1::SegmentResponse>> reader =
+      perception_->Segment(&context, request);
+  return DrainStream(*reader, on_message);
+}
+
+absl::Status FoveaClient::SegmentIncremental(
+    const fovea::v1::SegmentIncrementalRequest& request,
+    absl::Duration deadline, const SegmentCallback& on_message) {
+  grpc::ClientContext context;
+  PrepareContext(deadline, options_, context);
+  std::unique_ptr<grpc::ClientReader<fovea::v1::SegmentResponse>> reader =
+      perception_->SegmentIncremental(&context, request);
+  return DrainStream(*reader, on_message);
+}
+
+}  // namespace fovea::client

@@ -1,0 +1,92 @@
+#ifndef FOVEA_CLIENT_FOVEA_CLIENT_H_
+#define FOVEA_CLIENT_FOVEA_CLIENT_H_
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/time/time.h"
+#include "fovea/v1/perception.grpc.pb.h"
+#include "grpc/health/v1/health.grpc.pb.h"
+#include "grpcpp/channel.h"
+
+// A small synchronous client for fovea.v1.Perception and grpc.health.v1.
+// The pieces to build requests live beside it: client/frame_builder.h
+// (frames from raw buffers or PNG/JPEG bytes), client/option_names.h (enum
+// names as typed on a command line), client/rle.h (object masks).
+
+namespace fovea::client {
+
+struct ClientOptions {
+  // Largest message sent or received, bytes. The server's default maximum
+  // receive size is 64 MiB (a 1280x720 raw frame is about 6 MiB).
+  int max_message_bytes = 64 * 1024 * 1024;
+  // Wait for the channel to become ready instead of failing at once with
+  // UNAVAILABLE while the server is not (yet) listening. The call deadline
+  // still bounds the wait.
+  bool wait_for_ready = false;
+};
+
+// Gets a fovea.v1.SegmentResponse as soon as it has been read off a
+// stream, on the calling thread.
+using SegmentCallback = std::function<void(const fovea::v1::SegmentResponse&)>;
+
+// One insecure channel to a server. Thread-safe: calls may run
+// concurrently. Every call takes a deadline measured from the moment it
+// starts; a failed call returns the server's (or gRPC's) status with the
+// same code (absl and gRPC share the canonical codes, so
+// absl::StatusCodeToString gives the gRPC name, e.g. "INVALID_ARGUMENT")
+// and its message.
+class FoveaClient {
+ public:
+  // Creates a channel to `target` ("HOST:PORT", or any gRPC target URI).
+  // Connecting is lazy: an unreachable server shows up as UNAVAILABLE on
+  // the first call. INVALID_ARGUMENT for an empty target.
+  static absl::StatusOr<std::unique_ptr<FoveaClient>> Connect(
+      const std::string& target, const ClientOptions& options = {});
+
+  // A client over an existing channel (e.g. an in-process one in tests).
+  FoveaClient(std::shared_ptr<grpc::Channel> channel,
+              const ClientOptions& options);
+
+  FoveaClient(const FoveaClient&) = delete;
+  FoveaClient& operator=(const FoveaClient&) = delete;
+
+  // grpc.health.v1.Health/Check for `service` ("" = the whole server,
+  // "fovea.v1.Perception" = the perception service). The serving status
+  // (SERVING, NOT_SERVING, ...) when the call succeeds; NOT_FOUND when the
+  // server does not know `service`.
+  absl::StatusOr<grpc::health::v1::HealthCheckResponse::ServingStatus> Health(
+      const std::string& service, absl::Duration deadline);
+
+  absl::StatusOr<fovea::v1::Capabilities> GetCapabilities(
+      absl::Duration deadline);
+
+  absl::StatusOr<fovea::v1::DetectResponse> Detect(
+      const fovea::v1::DetectRequest& request, absl::Duration deadline);
+
+  // Server-streaming calls: `on_message` runs once per message, in order,
+  // as each arrives. Returns the stream's final status: OK after the server
+  // closed it normally (the last message has `last` set), otherwise the
+  // error (UNIMPLEMENTED from a server that has not built the method,
+  // DEADLINE_EXCEEDED, ...), possibly after some messages.
+  absl::Status Segment(const fovea::v1::SegmentRequest& request,
+                       absl::Duration deadline,
+                       const SegmentCallback& on_message);
+  absl::Status SegmentIncremental(
+      const fovea::v1::SegmentIncrementalRequest& request,
+      absl::Duration deadline, const SegmentCallback& on_message);
+
+ private:
+  ClientOptions options_;
+  std::shared_ptr<grpc::Channel> channel_;
+  std::unique_ptr<fovea::v1::Perception::Stub> perception_;
+  std::unique_ptr<grpc::health::v1::Health::Stub> health_;
+};
+
+}  // namespace fovea::client
+
+#endif  // FOVEA_CLIENT_FOVEA_CLIENT_H_

@@ -1,0 +1,421 @@
+// fovea-client: calls a Fovea server from the command line.
+//
+//   fovea-client --server HOST:PORT health
+//   fovea-client --server HOST:PORT capabilities [--json]
+//   fovea-client --server HOST:PORT detect FRAME [options] [--json] [--out DIR]
+//   fovea-client --server HOST:PORT segment FRAME [--method cos|ebs] ...
+//   fovea-client --server HOST:PORT segment-incremental FRAME ...
+// where FRAME is --color C.png --depth D.png [--fx .. --fy .. --cx .. --cy ..]
+// or --pcd scene.pcd or --synthetic SEED.
+//
+// Exit codes: 0 success (health: SERVING), 1 health not SERVING or a local
+// failure (unreadable file, cannot write --out), 2 the call failed (the gRPC
+// code name and message go to stderr), 64 usage error.
+
+#include <cstdint>
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/flags/flag.h"
+#include "absl/flags/parse.h"
+#include "absl/flags/usage.h"
+#include "absl/flags/usage_config.h"
+#include "absl/status/status.h"
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/time/clock.h"
+#include "absl/time/time.h"
+#include "client/cli_frame.h"
+#include "client/cli_output.h"
+#include "client/fovea_client.h"
+#include "client/option_names.h"
+
+ABSL_FLAG(std::string, server, "127.0.0.1:50051", "gRPC server, HOST:PORT");
+ABSL_FLAG(int64_t, deadline_ms, 30000,
+          "deadline of the call, milliseconds from its start");
+ABSL_FLAG(bool, wait_for_ready, false,
+          "wait (within the deadline) for the server to come up instead of "
+          "failing with UNAVAILABLE at once");
+ABSL_FLAG(bool, json, false,
+          "print responses as protobuf JSON, one object per line (per stream "
+          "message)");
+ABSL_FLAG(std::string, out, "",
+          "directory for response JSON and PNGs (overlay, saliency maps, "
+          "masks); asks the server for the master saliency map");
+ABSL_FLAG(std::string, service, "",
+          "health: service to check (\"\" = the server, or "
+          "fovea.v1.Perception)");
+
+// The frame.
+ABSL_FLAG(std::string, color, "", "colour image file, PNG or JPEG, sent as is");
+ABSL_FLAG(std::string, depth, "",
+          "depth image file, 16-bit grey PNG in --depth_scale units, sent as "
+          "is");
+ABSL_FLAG(std::string, pcd, "",
+          "OSD PCD file, sent raw as rgb8 + 32FC1 (OSD Kinect intrinsics "
+          "unless --fx/--fy/--cx/--cy)");
+ABSL_FLAG(std::optional<uint64_t>, synthetic, std::nullopt,
+          "seed of a built-in synthetic table scene, sent raw");
+ABSL_FLAG(std::optional<double>, fx, std::nullopt,
+          "focal length x, pixels (default 525, OSD Kinect v1)");
+ABSL_FLAG(std::optional<double>, fy, std::nullopt,
+          "focal length y, pixels (default 525)");
+ABSL_FLAG(std::optional<double>, cx, std::nullopt,
+          "principal point column, pixels (default 319.5)");
+ABSL_FLAG(std::optional<double>, cy, std::nullopt,
+          "principal point row, pixels (default 239.5)");
+ABSL_FLAG(double, depth_scale, 0.001, "metres per unit of a 16-bit depth PNG");
+ABSL_FLAG(std::string, frame_id, "", "camera frame id, echoed back");
+ABSL_FLAG(std::string, request_id, "",
+          "request id, echoed back (default: generated)");
+
+// Detect options (empty = the server's default).
+ABSL_FLAG(std::string, saliency, "",
+          "saliency channels: ph, sh, rso, sym3d, itti, harel, hou, "
+          "kootstra, target_color, location_prior; combine with '+' (equal "
+          "weights) or give weights as name:w, e.g. ph+sh+rso, ph:2+rso:1");
+ABSL_FLAG(std::string, extract, "", "attention points: msr | wta | tj");
+ABSL_FLAG(std::string, pyramid, "", "pyramid: none | simple | itti");
+ABSL_FLAG(std::string, norm, "", "map normalisation: lin | nms | nlm");
+ABSL_FLAG(std::string, combine, "", "pyramid level combination: sum | max");
+ABSL_FLAG(std::string, fusion, "", "channel fusion: sum | max");
+ABSL_FLAG(bool, maps, false, "ask for each channel's saliency map");
+ABSL_FLAG(int32_t, points, 0,
+          "number of attention points, 0 = the server's default (10)");
+
+// Segmentation.
+ABSL_FLAG(std::string, method, "", "segment: cos | ebs");
+ABSL_FLAG(int32_t, max_objects, 0, "segment: most objects, 0 = no limit");
+ABSL_FLAG(double, time_budget_ms, 0.0,
+          "segment-incremental: time budget, milliseconds, 0 = none");
+
+namespace fovea::client {
+namespace {
+
+constexpr int kExitOk = 0;
+constexpr int kExitFailure = 1;
+constexpr int kExitCallFailed = 2;
+constexpr int kExitUsage = 64;  // EX_USAGE
+
+constexpr char kUsage[] =
+    R"(calls a Fovea perception server.
+
+usage: fovea-client [--server HOST:PORT] COMMAND [flags]
+
+commands:
+  health                 print the serving status; exit 0 when SERVING
+  capabilities           what the server accepts and offers
+  detect FRAME           attention points, most salient first
+  segment FRAME          object masks, streamed as each completes
+  segment-incremental FRAME
+                         anytime incremental segmentation, streamed
+
+FRAME is one of
+  --color C.png --depth D.png [--fx F --fy F --cx C --cy C] [--depth_scale S]
+  --pcd scene.pcd        (OSD Kinect intrinsics unless given)
+  --synthetic SEED       (a built-in synthetic table scene)
+
+examples:
+  fovea-client --server 127.0.0.1:50051 detect --synthetic 1 --out out/demo
+  fovea-client detect --pcd learn6.pcd --saliency ph+sh+rso --extract msr --json
+
+exit codes: 0 ok, 1 not SERVING or a local failure, 2 the call failed (gRPC
+code and message on stderr), 64 usage error. The flags: fovea-client --help)";
+
+int Fail(int code, const absl::Status& status) {
+  std::cerr << "fovea-client: " << absl::StatusCodeToString(status.code())
+            << ": " << status.message() << "\n";
+  return code;
+}
+
+// Exit code of a local error: bad flags are usage errors, the rest local
+// failures.
+int FailLocal(const absl::Status& status) {
+  return Fail(status.code() == absl::StatusCode::kInvalidArgument
+                  ? kExitUsage
+                  : kExitFailure,
+              status);
+}
+
+absl::Duration Deadline() {
+  return absl::Milliseconds(absl::GetFlag(FLAGS_deadline_ms));
+}
+
+absl::StatusOr<std::unique_ptr<FoveaClient>> MakeClient() {
+  ClientOptions options;
+  options.wait_for_ready = absl::GetFlag(FLAGS_wait_for_ready);
+  return FoveaClient::Connect(absl::GetFlag(FLAGS_server), options);
+}
+
+std::string RequestId() {
+  std::string id = absl::GetFlag(FLAGS_request_id);
+  if (id.empty()) id = absl::StrCat("cli-", absl::ToUnixMicros(absl::Now()));
+  return id;
+}
+
+absl::StatusOr<LoadedFrame> FrameFromFlags() {
+  FrameSource source;
+  source.color_path = absl::GetFlag(FLAGS_color);
+  source.depth_path = absl::GetFlag(FLAGS_depth);
+  source.pcd_path = absl::GetFlag(FLAGS_pcd);
+  source.synthetic_seed = absl::GetFlag(FLAGS_synthetic);
+  source.fx = absl::GetFlag(FLAGS_fx);
+  source.fy = absl::GetFlag(FLAGS_fy);
+  source.cx = absl::GetFlag(FLAGS_cx);
+  source.cy = absl::GetFlag(FLAGS_cy);
+  source.depth_scale = absl::GetFlag(FLAGS_depth_scale);
+  source.frame_id = absl::GetFlag(FLAGS_frame_id);
+  return LoadFrame(source);
+}
+
+// Detect options from the flags; INVALID_ARGUMENT naming a bad one.
+absl::StatusOr<fovea::v1::DetectOptions> DetectOptionsFromFlags() {
+  fovea::v1::DetectOptions options;
+  absl::StatusOr<std::vector<fovea::v1::WeightedOperator>> saliency =
+      ParseSaliency(absl::GetFlag(FLAGS_saliency));
+  if (!saliency.ok()) return saliency.status();
+  for (fovea::v1::WeightedOperator& op : *saliency) {
+    *options.add_saliency() = std::move(op);
+  }
+  // Each enum flag: parse when given, leave UNSPECIFIED otherwise.
+  auto set = [](const std::string& text, auto parse, auto setter) {
+    if (text.empty()) return absl::OkStatus();
+    auto value = parse(text);
+    if (!value.ok()) return value.status();
+    setter(*value);
+    return absl::OkStatus();
+  };
+  for (absl::Status status : {
+           set(absl::GetFlag(FLAGS_extract), ParseExtraction,
+               [&](auto v) { options.set_extraction(v); }),
+           set(absl::GetFlag(FLAGS_pyramid), ParsePyramid,
+               [&](auto v) { options.set_pyramid(v); }),
+           set(absl::GetFlag(FLAGS_norm), ParseNormalization,
+               [&](auto v) { options.set_normalization(v); }),
+           set(absl::GetFlag(FLAGS_combine), ParseLevelCombination,
+               [&](auto v) { options.set_level_combination(v); }),
+           set(absl::GetFlag(FLAGS_fusion), ParseFusion,
+               [&](auto v) { options.set_fusion(v); }),
+       }) {
+    if (!status.ok()) return status;
+  }
+  const int32_t points = absl::GetFlag(FLAGS_points);
+  if (points < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("points: must be >= 0, got ", points));
+  }
+  options.set_max_points(static_cast<uint32_t>(points));
+  options.set_return_channel_maps(absl::GetFlag(FLAGS_maps));
+  options.set_return_saliency_map(!absl::GetFlag(FLAGS_out).empty());
+  return options;
+}
+
+int RunHealth() {
+  absl::StatusOr<std::unique_ptr<FoveaClient>> client = MakeClient();
+  if (!client.ok()) return FailLocal(client.status());
+  absl::StatusOr<grpc::health::v1::HealthCheckResponse::ServingStatus> status =
+      (*client)->Health(absl::GetFlag(FLAGS_service), Deadline());
+  if (!status.ok()) return Fail(kExitCallFailed, status.status());
+  if (absl::GetFlag(FLAGS_json)) {
+    grpc::health::v1::HealthCheckResponse response;
+    response.set_status(*status);
+    std::cout << ToJson(response) << std::endl;
+  } else {
+    std::cout << grpc::health::v1::HealthCheckResponse::ServingStatus_Name(
+                     *status)
+              << std::endl;
+  }
+  return *status == grpc::health::v1::HealthCheckResponse::SERVING
+             ? kExitOk
+             : kExitFailure;
+}
+
+int RunCapabilities() {
+  absl::StatusOr<std::unique_ptr<FoveaClient>> client = MakeClient();
+  if (!client.ok()) return FailLocal(client.status());
+  absl::StatusOr<fovea::v1::Capabilities> capabilities =
+      (*client)->GetCapabilities(Deadline());
+  if (!capabilities.ok()) return Fail(kExitCallFailed, capabilities.status());
+  if (absl::GetFlag(FLAGS_json)) {
+    std::cout << ToJson(*capabilities) << std::endl;
+  } else {
+    PrintCapabilities(*capabilities, std::cout);
+  }
+  return kExitOk;
+}
+
+int RunDetect() {
+  absl::StatusOr<fovea::v1::DetectOptions> options = DetectOptionsFromFlags();
+  if (!options.ok()) return Fail(kExitUsage, options.status());
+  absl::StatusOr<LoadedFrame> frame = FrameFromFlags();
+  if (!frame.ok()) return FailLocal(frame.status());
+  absl::StatusOr<std::unique_ptr<FoveaClient>> client = MakeClient();
+  if (!client.ok()) return FailLocal(client.status());
+
+  fovea::v1::DetectRequest request;
+  request.set_request_id(RequestId());
+  *request.mutable_options() = *std::move(options);
+  const bool json = absl::GetFlag(FLAGS_json);
+  if (!json) {
+    std::cout << "detect on " << frame->description << " ("
+              << frame->frame.ByteSizeLong() / 1024 << " KiB) at "
+              << absl::GetFlag(FLAGS_server) << std::endl;
+  }
+  *request.mutable_frame() = std::move(frame->frame);
+
+  const absl::Time start = absl::Now();
+  absl::StatusOr<fovea::v1::DetectResponse> response =
+      (*client)->Detect(request, Deadline());
+  const absl::Duration round_trip = absl::Now() - start;
+  if (!response.ok()) return Fail(kExitCallFailed, response.status());
+
+  if (json) {
+    std::cout << ToJson(*response) << std::endl;
+  } else {
+    PrintDetectTable(*response, round_trip, std::cout);
+  }
+  const std::string out = absl::GetFlag(FLAGS_out);
+  if (!out.empty()) {
+    absl::StatusOr<std::vector<std::string>> written =
+        WriteDetectOutputs(out, *response, frame->color_bgr);
+    if (!written.ok()) return Fail(kExitFailure, written.status());
+    for (const std::string& path : *written)
+      std::cerr << "wrote " << path << "\n";
+  }
+  return kExitOk;
+}
+
+int RunSegment(bool incremental) {
+  absl::StatusOr<fovea::v1::DetectOptions> options = DetectOptionsFromFlags();
+  if (!options.ok()) return Fail(kExitUsage, options.status());
+  fovea::v1::SegmentationMethod method =
+      fovea::v1::SEGMENTATION_METHOD_UNSPECIFIED;
+  if (!absl::GetFlag(FLAGS_method).empty()) {
+    absl::StatusOr<fovea::v1::SegmentationMethod> parsed =
+        ParseSegmentationMethod(absl::GetFlag(FLAGS_method));
+    if (!parsed.ok()) return Fail(kExitUsage, parsed.status());
+    method = *parsed;
+  }
+  const int32_t max_objects = absl::GetFlag(FLAGS_max_objects);
+  const double time_budget_ms = absl::GetFlag(FLAGS_time_budget_ms);
+  if (max_objects < 0 || time_budget_ms < 0.0) {
+    return Fail(kExitUsage, absl::InvalidArgumentError(
+                                "max_objects, time_budget_ms: must be >= 0"));
+  }
+  absl::StatusOr<LoadedFrame> frame = FrameFromFlags();
+  if (!frame.ok()) return FailLocal(frame.status());
+  absl::StatusOr<std::unique_ptr<FoveaClient>> client = MakeClient();
+  if (!client.ok()) return FailLocal(client.status());
+
+  const bool json = absl::GetFlag(FLAGS_json);
+  const std::string out = absl::GetFlag(FLAGS_out);
+  if (!json) {
+    std::cout << (incremental ? "segment-incremental" : "segment") << " on "
+              << frame->description << " at " << absl::GetFlag(FLAGS_server)
+              << std::endl;
+  }
+  std::vector<fovea::v1::SegmentResponse> messages;  // kept for --out
+  int message_count = 0;
+  absl::Time start;
+  auto on_message = [&](const fovea::v1::SegmentResponse& message) {
+    ++message_count;
+    if (json) {
+      std::cout << ToJson(message) << std::endl;
+    } else {
+      std::cout << DescribeSegmentMessage(message, absl::Now() - start)
+                << std::endl;
+    }
+    if (!out.empty()) messages.push_back(message);
+  };
+
+  absl::Status status;
+  if (incremental) {
+    fovea::v1::SegmentIncrementalRequest request;
+    request.set_request_id(RequestId());
+    *request.mutable_frame() = std::move(frame->frame);
+    *request.mutable_detect_options() = *std::move(options);
+    request.set_max_objects(static_cast<uint32_t>(max_objects));
+    request.set_time_budget_seconds(time_budget_ms / 1e3);
+    start = absl::Now();
+    status = (*client)->SegmentIncremental(request, Deadline(), on_message);
+  } else {
+    fovea::v1::SegmentRequest request;
+    request.set_request_id(RequestId());
+    *request.mutable_frame() = std::move(frame->frame);
+    *request.mutable_detect_options() = *std::move(options);
+    request.set_method(method);
+    request.set_max_objects(static_cast<uint32_t>(max_objects));
+    start = absl::Now();
+    status = (*client)->Segment(request, Deadline(), on_message);
+  }
+  if (!json) {
+    std::cout << absl::StrFormat(
+                     "stream closed after %.1f ms, %d messages",
+                     absl::ToDoubleMilliseconds(absl::Now() - start),
+                     message_count)
+              << std::endl;
+  }
+  if (!out.empty() && !messages.empty()) {
+    absl::StatusOr<std::vector<std::string>> written =
+        WriteSegmentOutputs(out, messages, frame->color_bgr);
+    if (!written.ok()) {
+      Fail(kExitFailure, written.status());
+      if (status.ok()) return kExitFailure;
+    } else {
+      for (const std::string& path : *written)
+        std::cerr << "wrote " << path << "\n";
+    }
+  }
+  if (!status.ok()) return Fail(kExitCallFailed, status);
+  return kExitOk;
+}
+
+bool IsClientFlagFile(absl::string_view file) {
+  return absl::StrContains(file, "client/");
+}
+
+}  // namespace
+}  // namespace fovea::client
+
+int main(int argc, char** argv) {
+  using namespace fovea::client;  // NOLINT: main only
+  absl::SetProgramUsageMessage(kUsage);
+  absl::FlagsUsageConfig usage_config;
+  usage_config.contains_help_flags = IsClientFlagFile;
+  usage_config.contains_helpshort_flags = IsClientFlagFile;
+  usage_config.normalize_filename = [](absl::string_view file) {
+    const size_t at = file.rfind("client/");
+    return std::string(at == absl::string_view::npos ? file : file.substr(at));
+  };
+  absl::SetFlagsUsageConfig(usage_config);
+
+  std::vector<char*> positional = absl::ParseCommandLine(argc, argv);
+  if (positional.size() < 2) {
+    std::cerr << "fovea-client " << kUsage << "\n";
+    return kExitUsage;
+  }
+  const std::string command = positional[1];
+  if (positional.size() > 2) {
+    std::cerr << "fovea-client: unexpected argument \"" << positional[2]
+              << "\" after " << command << "\n";
+    return kExitUsage;
+  }
+  if (command == "health") return RunHealth();
+  if (command == "capabilities") return RunCapabilities();
+  if (command == "detect") return RunDetect();
+  if (command == "segment") return RunSegment(/*incremental=*/false);
+  if (command == "segment-incremental") return RunSegment(/*incremental=*/true);
+  if (command == "help") {
+    std::cout << "fovea-client " << kUsage << "\n";
+    return kExitOk;
+  }
+  std::cerr << "fovea-client: unknown command \"" << command
+            << "\" (health, capabilities, detect, segment, "
+               "segment-incremental)\n";
+  return kExitUsage;
+}

@@ -1,0 +1,115 @@
+// fovea-client against an in-process fovea server on a loopback port.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "absl/time/clock.h"
+#include "absl/time/time.h"
+#include "client/fovea_client.h"
+#include "fovea/v1/detect.pb.h"
+#include "gmock/gmock.h"
+#include "google/protobuf/util/json_util.h"
+#include "gtest/gtest.h"
+#include "server/server.h"
+#include "tests/client/cli_test_util.h"
+
+namespace fovea::client {
+namespace {
+
+using ::testing::AnyOf;
+using ::testing::HasSubstr;
+
+constexpr absl::Duration kServingWait = absl::Seconds(60);
+
+class FoveaClientCliE2eTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    server::ServerConfig config;
+    config.listen = "127.0.0.1:0";
+    config.metrics_listen = "";
+    config.concurrency = 1;
+    absl::StatusOr<std::unique_ptr<server::FoveaServer>> started =
+        server::FoveaServer::Start(config);
+    ASSERT_TRUE(started.ok()) << started.status();
+    server_ = started->release();
+    address_ = absl::StrCat("127.0.0.1:", server_->port());
+
+    // Bounded wait for SERVING (the server warms up first).
+    absl::StatusOr<std::unique_ptr<FoveaClient>> client =
+        FoveaClient::Connect(address_);
+    ASSERT_TRUE(client.ok()) << client.status();
+    const absl::Time give_up = absl::Now() + kServingWait;
+    while (absl::Now() < give_up) {
+      absl::StatusOr<grpc::health::v1::HealthCheckResponse::ServingStatus> s =
+          (*client)->Health("", absl::Seconds(1));
+      if (s.ok() && *s == grpc::health::v1::HealthCheckResponse::SERVING) {
+        return;
+      }
+      absl::SleepFor(absl::Milliseconds(50));
+    }
+    FAIL() << "server not SERVING after " << kServingWait;
+  }
+
+  static void TearDownTestSuite() {
+    if (server_ != nullptr) server_->Shutdown(absl::Seconds(5));
+    delete server_;
+    server_ = nullptr;
+  }
+
+  static server::FoveaServer* server_;  // owned by the suite
+  static std::string address_;
+};
+
+server::FoveaServer* FoveaClientCliE2eTest::server_ = nullptr;
+std::string FoveaClientCliE2eTest::address_;
+
+TEST_F(FoveaClientCliE2eTest, HealthPrintsServing) {
+  const CliRun run = RunCli(absl::StrCat("--server ", address_, " health"));
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.out, "SERVING\n");
+}
+
+TEST_F(FoveaClientCliE2eTest, DetectSyntheticJsonHasPoints) {
+  const CliRun run = RunCli(
+      absl::StrCat("--server ", address_, " detect --synthetic 3 --json"));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const std::vector<std::string> lines =
+      absl::StrSplit(run.out, '\n', absl::SkipEmpty());
+  ASSERT_EQ(lines.size(), 1u) << "one JSON object per line:\n" << run.out;
+  fovea::v1::DetectResponse response;
+  const auto parsed =
+      google::protobuf::util::JsonStringToMessage(lines[0], &response);
+  ASSERT_TRUE(parsed.ok()) << parsed.message() << "\n" << lines[0];
+  ASSERT_GT(response.points_size(), 0);
+  EXPECT_EQ(response.points(0).rank(), 0u);
+  EXPECT_LT(response.points(0).u(), 640u);
+  EXPECT_LT(response.points(0).v(), 480u);
+}
+
+TEST_F(FoveaClientCliE2eTest, FailedCallPrintsCodeAndExits2) {
+  // A negative focal length is bad input the server must refuse.
+  const CliRun run = RunCli(
+      absl::StrCat("--server ", address_, " detect --synthetic 3 --fx=-1"));
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.err, HasSubstr("INVALID_ARGUMENT"));
+}
+
+// Segment is UNIMPLEMENTED until segmentation lands; either way the client
+// must end cleanly: exit 0 after a last message, or exit 2 naming the code.
+TEST_F(FoveaClientCliE2eTest, SegmentEndsCleanly) {
+  const CliRun run =
+      RunCli(absl::StrCat("--server ", address_, " segment --synthetic 3"));
+  if (run.exit_code == 0) {
+    EXPECT_THAT(run.out, HasSubstr("last:"));
+  } else {
+    EXPECT_EQ(run.exit_code, 2);
+    EXPECT_THAT(run.err,
+                AnyOf(HasSubstr("UNIMPLEMENTED"), HasSubstr("fovea-client: ")));
+  }
+}
+
+}  // namespace
+}  // namespace fovea::client
