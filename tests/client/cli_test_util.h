@@ -2,9 +2,11 @@
 #define FOVEA_TESTS_CLIENT_CLI_TEST_UTIL_H_
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -23,8 +25,12 @@ struct CliRun {
 
 // Runs `FOVEA_CLIENT_BIN args` through the shell (args are pasted as is).
 inline CliRun RunCli(const std::string& args) {
-  const std::string err_path =
-      absl::StrCat(::testing::TempDir(), "/fovea_client_cli_stderr.txt");
+  // One file per run: ctest runs test binaries in parallel, and a shared
+  // file would mix their stderr.
+  std::string err_path =
+      absl::StrCat(::testing::TempDir(), "/fovea_client_cli_stderr_XXXXXX");
+  const int fd = mkstemp(err_path.data());
+  if (fd >= 0) close(fd);
   const std::string command =
       absl::StrCat(FOVEA_CLIENT_BIN, " ", args, " 2>", err_path);
   CliRun run;
@@ -40,6 +46,7 @@ inline CliRun RunCli(const std::string& args) {
   std::ifstream err(err_path);
   run.err.assign(std::istreambuf_iterator<char>(err),
                  std::istreambuf_iterator<char>());
+  std::remove(err_path.c_str());
   return run;
 }
 
