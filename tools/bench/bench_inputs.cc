@@ -1,0 +1,193 @@
+#include "tools/bench/bench_inputs.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string_view>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "core/frame/osd_pcd.h"
+#include "core/pipeline/detect.h"
+#include "core/saliency/rso.h"
+#include "core/synth/synth_scene.h"
+
+namespace fovea::bench {
+namespace {
+
+// Largest depth a 16UC1 millimetre pixel holds.
+constexpr float kMaxWireDepthUnits = 65535.0f;
+
+absl::string_view Abs(std::string_view s) { return {s.data(), s.size()}; }
+
+std::string_view View(const std::string& s) { return {s.data(), s.size()}; }
+
+std::string ToBytes(const std::vector<uint8_t>& bytes) {
+  return std::string(bytes.begin(), bytes.end());
+}
+
+// Row-major rgb8 bytes of a CV_8UC3 RGB image.
+std::string EncodeRgb8(const cv::Mat& rgb) {
+  const size_t row_bytes = static_cast<size_t>(rgb.cols) * 3;
+  std::string out(row_bytes * rgb.rows, '\0');
+  for (int v = 0; v < rgb.rows; ++v) {
+    std::memcpy(out.data() + v * row_bytes, rgb.ptr<uint8_t>(v), row_bytes);
+  }
+  return out;
+}
+
+// Depth in metres (NaN: no data) to 16-bit units of kWireDepthScale; 0 is
+// no data, as a Kinect driver writes it.
+cv::Mat ToDepthUnits(const cv::Mat& depth_m) {
+  cv::Mat units(depth_m.size(), CV_16UC1);
+  for (int v = 0; v < depth_m.rows; ++v) {
+    const float* in = depth_m.ptr<float>(v);
+    uint16_t* out = units.ptr<uint16_t>(v);
+    for (int u = 0; u < depth_m.cols; ++u) {
+      const float z = in[u];
+      out[u] = std::isfinite(z) && z > 0.0f
+                   ? static_cast<uint16_t>(std::min(
+                         std::round(z / static_cast<float>(kWireDepthScale)),
+                         kMaxWireDepthUnits))
+                   : 0;
+    }
+  }
+  return units;
+}
+
+// Little-endian row-major bytes of a CV_16UC1 image (x86 is little-endian,
+// as the wire requires).
+std::string EncodeDepth16(const cv::Mat& units) {
+  const size_t row_bytes = static_cast<size_t>(units.cols) * 2;
+  std::string out(row_bytes * units.rows, '\0');
+  for (int v = 0; v < units.rows; ++v) {
+    std::memcpy(out.data() + v * row_bytes, units.ptr<uint16_t>(v), row_bytes);
+  }
+  return out;
+}
+
+RawImage RawWire(uint32_t width, uint32_t height, std::string_view encoding,
+                 uint32_t step, std::string_view data) {
+  RawImage image;
+  image.width = width;
+  image.height = height;
+  image.encoding = encoding;
+  image.step = step;
+  image.data = data;
+  return image;
+}
+
+absl::Status StageError(const BenchScene& scene, std::string_view stage,
+                        const absl::Status& status) {
+  return absl::FailedPreconditionError(
+      absl::StrCat(scene.name, ": ", Abs(stage), ": ", status.ToString()));
+}
+
+void AddScene(std::string name, const RgbdFrame& frame, SceneList& scenes) {
+  auto scene = std::make_unique<BenchScene>();
+  scene->name = std::move(name);
+  const absl::Status status = PrepareScene(frame, *scene);
+  if (!status.ok()) {
+    std::fprintf(stderr, "fovea-bench: skipping scene: %s\n",
+                 status.ToString().c_str());
+    return;
+  }
+  scenes.push_back(std::move(scene));
+}
+
+}  // namespace
+
+absl::Status PrepareScene(const RgbdFrame& frame, BenchScene& scene) {
+  const uint32_t width = static_cast<uint32_t>(frame.width());
+  const uint32_t height = static_cast<uint32_t>(frame.height());
+
+  scene.color_rgb8 = EncodeRgb8(frame.color);
+  const cv::Mat depth_units = ToDepthUnits(frame.depth);
+  scene.depth_16uc1 = EncodeDepth16(depth_units);
+
+  cv::Mat bgr;
+  cv::cvtColor(frame.color, bgr, cv::COLOR_RGB2BGR);
+  std::vector<uint8_t> file;
+  if (!cv::imencode(".png", bgr, file)) {
+    return StageError(scene, "encode colour PNG",
+                      absl::InternalError("cv::imencode failed"));
+  }
+  scene.color_png = ToBytes(file);
+  if (!cv::imencode(".png", depth_units, file)) {
+    return StageError(scene, "encode depth PNG",
+                      absl::InternalError("cv::imencode failed"));
+  }
+  scene.depth_png = ToBytes(file);
+
+  scene.raw_wire = RawFrame{};
+  scene.raw_wire.color =
+      RawWire(width, height, "rgb8", width * 3, View(scene.color_rgb8));
+  scene.raw_wire.depth =
+      RawWire(width, height, "16UC1", width * 2, View(scene.depth_16uc1));
+  scene.raw_wire.intrinsics = frame.intrinsics;
+  scene.raw_wire.depth_scale = kWireDepthScale;
+
+  scene.png_wire = RawFrame{};
+  scene.png_wire.color.compressed = View(scene.color_png);
+  scene.png_wire.depth.compressed = View(scene.depth_png);
+  scene.png_wire.intrinsics = frame.intrinsics;
+  scene.png_wire.depth_scale = kWireDepthScale;
+
+  absl::StatusOr<RgbdFrame> decoded =
+      DecodeFrame(scene.raw_wire, BenchFrameLimits());
+  if (!decoded.ok()) return StageError(scene, "decode raw", decoded.status());
+  scene.frame = *std::move(decoded);
+  absl::StatusOr<RgbdFrame> from_png =
+      DecodeFrame(scene.png_wire, BenchFrameLimits());
+  if (!from_png.ok()) return StageError(scene, "decode PNG", from_png.status());
+
+  const DetectOptions options;
+  absl::StatusOr<OrganizedCloud> cloud =
+      BuildOrganizedCloud(scene.frame, options.normals);
+  if (!cloud.ok()) return StageError(scene, "cloud", cloud.status());
+  scene.cloud = *std::move(cloud);
+  absl::StatusOr<SupportPlane> plane =
+      FindSupportPlane(scene.cloud, options.support_plane);
+  if (!plane.ok()) return StageError(scene, "support plane", plane.status());
+  scene.plane = *std::move(plane);
+  scene.table =
+      PrepareTableScene(scene.cloud, scene.plane, options.table_scene);
+  absl::StatusOr<cv::Mat> rso =
+      ComputeRsoSaliency(scene.cloud, scene.plane, scene.table, options.rso);
+  if (!rso.ok()) return StageError(scene, "saliency.rso", rso.status());
+  scene.rso_map = *std::move(rso);
+  return absl::OkStatus();
+}
+
+void AddSyntheticScenes(const std::vector<uint64_t>& seeds, SceneList& scenes) {
+  for (const uint64_t seed : seeds) {
+    synth::SynthScene synth = synth::GenerateScene(seed);
+    AddScene(synth.frame.name, synth.frame.frame, scenes);
+  }
+}
+
+absl::Status AddOsdScenes(const std::string& osd_dir, int max_scenes,
+                          SceneList& scenes) {
+  absl::StatusOr<std::vector<std::string>> files =
+      ListPcdFiles(osd_dir + "/learn");
+  if (!files.ok()) return files.status();
+  int added = 0;
+  for (const std::string& path : *files) {
+    if (max_scenes > 0 && added >= max_scenes) break;
+    absl::StatusOr<LabelledFrame> loaded = LoadOsdPcd(path);
+    if (!loaded.ok()) {
+      std::fprintf(stderr, "fovea-bench: skipping %s: %s\n", path.c_str(),
+                   loaded.status().ToString().c_str());
+      continue;
+    }
+    const size_t before = scenes.size();
+    AddScene(loaded->name, loaded->frame, scenes);
+    if (scenes.size() > before) ++added;
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace fovea::bench

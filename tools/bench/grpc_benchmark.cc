@@ -1,0 +1,169 @@
+#include "tools/bench/grpc_benchmark.h"
+
+#include <grpcpp/grpcpp.h>
+
+#include <chrono>
+#include <memory>
+#include <string_view>
+#include <thread>
+#include <unordered_map>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/time/time.h"
+#include "core/pipeline/detect.h"
+#include "fovea/v1/perception.grpc.pb.h"
+#include "server/log.h"
+#include "server/server.h"
+
+namespace fovea::bench {
+namespace {
+
+absl::string_view Abs(std::string_view s) { return {s.data(), s.size()}; }
+
+// Rough cost per call, milliseconds (sizes the passes, see SweepIterations).
+constexpr double kGrpcDetectMs = 40.0;
+// How long to wait for the server's warm-up.
+constexpr auto kWarmUpTimeout = std::chrono::seconds(60);
+constexpr auto kWarmUpPoll = std::chrono::milliseconds(10);
+
+// The in-process server and a stub on a loopback channel to it.
+struct Loopback {
+  std::unique_ptr<server::FoveaServer> server;
+  std::unique_ptr<v1::Perception::Stub> stub;
+};
+
+std::unique_ptr<Loopback>& LoopbackInstance() {
+  static auto* loopback = new std::unique_ptr<Loopback>;
+  return *loopback;
+}
+
+absl::StatusOr<Loopback*> StartLoopback() {
+  std::unique_ptr<Loopback>& loopback = LoopbackInstance();
+  if (loopback != nullptr) return loopback.get();
+  server::SetLogLevel(server::LogLevel::kWarn);  // no line per call
+  server::ServerConfig config;
+  config.listen = "127.0.0.1:0";
+  config.concurrency = 1;
+  absl::StatusOr<std::unique_ptr<server::FoveaServer>> started =
+      server::FoveaServer::Start(config);
+  if (!started.ok()) return started.status();
+  const auto deadline = std::chrono::steady_clock::now() + kWarmUpTimeout;
+  while (!(*started)->warmed_up()) {
+    if (std::chrono::steady_clock::now() > deadline) {
+      return absl::DeadlineExceededError("server warm-up did not finish");
+    }
+    std::this_thread::sleep_for(kWarmUpPoll);
+  }
+  auto made = std::make_unique<Loopback>();
+  made->server = *std::move(started);
+  made->stub = v1::Perception::NewStub(
+      grpc::CreateChannel(absl::StrCat("127.0.0.1:", made->server->port()),
+                          grpc::InsecureChannelCredentials()));
+  loopback = std::move(made);
+  return loopback.get();
+}
+
+v1::Image ToProtoImage(const RawImage& image) {
+  v1::Image out;
+  out.set_width(image.width);
+  out.set_height(image.height);
+  out.set_encoding(std::string(image.encoding));
+  out.set_step(image.step);
+  out.set_data(std::string(image.data));
+  return out;
+}
+
+v1::SaliencyOperator ToProtoOperator(SaliencyOp op) {
+  switch (op) {
+    case SaliencyOp::kPh:
+      return v1::PH;
+    case SaliencyOp::kSh:
+      return v1::SH;
+    case SaliencyOp::kRso:
+      return v1::RSO;
+    default:  // not benchmarked; the server answers UNIMPLEMENTED
+      return v1::SALIENCY_OPERATOR_UNSPECIFIED;
+  }
+}
+
+v1::DetectRequest MakeRequest(const BenchScene& scene,
+                              const std::vector<SaliencyOp>& ops) {
+  v1::DetectRequest request;
+  request.set_request_id(scene.name);
+  v1::Frame& frame = *request.mutable_frame();
+  *frame.mutable_color() = ToProtoImage(scene.raw_wire.color);
+  *frame.mutable_depth() = ToProtoImage(scene.raw_wire.depth);
+  frame.mutable_intrinsics()->set_fx(scene.raw_wire.intrinsics.fx);
+  frame.mutable_intrinsics()->set_fy(scene.raw_wire.intrinsics.fy);
+  frame.mutable_intrinsics()->set_cx(scene.raw_wire.intrinsics.cx);
+  frame.mutable_intrinsics()->set_cy(scene.raw_wire.intrinsics.cy);
+  frame.set_depth_scale(scene.raw_wire.depth_scale);
+  frame.set_frame_id("camera");
+  v1::DetectOptions& options = *request.mutable_options();
+  for (const SaliencyOp op : ops) {
+    v1::WeightedOperator& weighted = *options.add_saliency();
+    weighted.set_op(ToProtoOperator(op));
+    weighted.set_weight(1.0);
+  }
+  options.set_extraction(v1::MSR);
+  options.set_max_points(DetectOptions{}.max_points);
+  return request;
+}
+
+void BenchmarkGrpcDetect(benchmark::State& state, const SceneList& scenes,
+                         const std::string& set_name,
+                         const std::vector<SaliencyOp>& ops) {
+  absl::StatusOr<Loopback*> loopback = StartLoopback();
+  if (!loopback.ok()) {
+    state.SkipWithError(loopback.status().ToString().c_str());
+    return;
+  }
+  // Requests are built outside the timing; serialising them is timed.
+  std::unordered_map<const BenchScene*, v1::DetectRequest> requests;
+  for (const auto& scene : scenes) {
+    requests.emplace(scene.get(), MakeRequest(*scene, ops));
+  }
+  SweepScenes(state, scenes, set_name, [&](const BenchScene& scene) {
+    grpc::ClientContext context;
+    v1::DetectResponse response;
+    const grpc::Status status =
+        (*loopback)->stub->Detect(&context, requests.at(&scene), &response);
+    if (!status.ok()) {
+      return absl::Status(static_cast<absl::StatusCode>(status.error_code()),
+                          status.error_message());
+    }
+    benchmark::DoNotOptimize(response.points_size());
+    return absl::OkStatus();
+  });
+}
+
+}  // namespace
+
+void RegisterGrpcBenchmarks(const SceneList* scenes,
+                            const std::string& set_name,
+                            const std::string& suffix,
+                            const SweepOptions& sweep) {
+  if (scenes->empty()) return;
+  for (const std::string_view channels : kDetectChannelSets) {
+    const std::vector<SaliencyOp> ops = ParseSaliencyOps(channels).value();
+    benchmark::RegisterBenchmark(
+        absl::StrCat("BM_DetectGrpc/", Abs(channels), suffix).c_str(),
+        [scenes, set_name, ops](benchmark::State& state) {
+          BenchmarkGrpcDetect(state, *scenes, set_name, ops);
+        })
+        ->Iterations(SweepIterations(sweep, static_cast<int>(scenes->size()),
+                                     kGrpcDetectMs))
+        ->Unit(benchmark::kMillisecond);
+  }
+}
+
+void StopGrpcServer() {
+  std::unique_ptr<Loopback>& loopback = LoopbackInstance();
+  if (loopback == nullptr) return;
+  loopback->stub.reset();
+  loopback->server->Shutdown(absl::Seconds(1));
+  loopback.reset();
+}
+
+}  // namespace fovea::bench

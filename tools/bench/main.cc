@@ -1,0 +1,156 @@
+// fovea-bench: Google Benchmark cases for the stages of Detect on 640x480
+// frames, one core.
+//
+//   fovea-bench [--passes=N] [--osd_scenes=N] [--benchmark_* flags]
+//
+// Inputs: synthetic scenes (core/synth, seeds kSynthSeeds) and, when
+// FOVEA_OSD_DIR names the OSD data (learn/learn*.pcd), the same cases on
+// the real scenes with an "/osd" suffix. Each iteration handles one frame,
+// round-robin over the set, and a repetition is a whole number of passes
+// over it (see SweepOptions), so a case's time is the mean per frame over
+// the set and the reported median is over repetitions. Defaults
+// --benchmark_repetitions=5 --benchmark_report_aggregates_only=true come
+// before the caller's flags, which override them.
+//   --passes=N      passes over the scene set per repetition (default: as
+//                   many as make a repetition last about 0.5 s)
+//   --osd_scenes=N  use only the first N OSD scenes (default: all 45)
+
+#include <benchmark/benchmark.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <opencv2/core.hpp>
+#include <string>
+#include <string_view>
+#include <tuple>
+#include <vector>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "tools/bench/bench_inputs.h"
+#include "tools/bench/stage_benchmarks.h"
+#ifdef FOVEA_BENCH_GRPC
+#include "tools/bench/grpc_benchmark.h"
+#endif
+
+namespace {
+
+using fovea::bench::SceneList;
+using fovea::bench::SweepOptions;
+
+// Synthetic scenes timed; GenerateScene gives 2-6 objects for 1..20.
+constexpr uint64_t kSynthSeeds[] = {1, 2, 3, 4};
+
+constexpr const char* kDefaultFlags[] = {
+    "--benchmark_repetitions=5",
+    "--benchmark_report_aggregates_only=true",
+};
+
+struct BenchFlags {
+  SweepOptions sweep;
+  int osd_scenes = 0;  // 0: all
+};
+
+// Takes "--name=N" when `arg` is that flag; false otherwise. Exits on a
+// malformed value.
+bool TakeIntFlag(std::string_view arg, std::string_view name, int& value) {
+  const std::string prefix =
+      absl::StrCat("--", absl::string_view(name.data(), name.size()), "=");
+  if (arg.substr(0, prefix.size()) != prefix) return false;
+  const std::string_view text = arg.substr(prefix.size());
+  if (!absl::SimpleAtoi(absl::string_view(text.data(), text.size()), &value) ||
+      value < 0) {
+    std::fprintf(stderr, "fovea-bench: %s: expected a whole number >= 0\n",
+                 std::string(arg).c_str());
+    std::exit(2);
+  }
+  return true;
+}
+
+// Removes fovea-bench's own flags from `args` and puts the default
+// benchmark flags right after the program name.
+BenchFlags ParseFlags(int argc, char** argv, std::vector<char*>& args) {
+  BenchFlags flags;
+  args.push_back(argv[0]);
+  for (const char* flag : kDefaultFlags) {
+    args.push_back(const_cast<char*>(flag));
+  }
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view arg = argv[i];
+    if (TakeIntFlag(arg, "passes", flags.sweep.passes) ||
+        TakeIntFlag(arg, "osd_scenes", flags.osd_scenes)) {
+      continue;
+    }
+    if (arg == "--help" || arg == "-h") {
+      std::printf(
+          "fovea-bench: Detect stage benchmarks on 640x480 frames, one core.\n"
+          "  --passes=N      passes over the scene set per repetition\n"
+          "                  (default: enough for about 0.5 s)\n"
+          "  --osd_scenes=N  first N OSD scenes only (default: all)\n"
+          "  FOVEA_OSD_DIR   OSD data folder; adds the \"/osd\" cases\n"
+          "Defaults before your flags: --benchmark_repetitions=5 "
+          "--benchmark_report_aggregates_only=true\n\n");
+    }
+    args.push_back(argv[i]);
+  }
+  args.push_back(nullptr);
+  return flags;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<char*> args;
+  const BenchFlags flags = ParseFlags(argc, argv, args);
+  int bench_argc = static_cast<int>(args.size()) - 1;
+  benchmark::Initialize(&bench_argc, args.data());
+  if (benchmark::ReportUnrecognizedArguments(bench_argc, args.data())) {
+    return 2;
+  }
+  // One core: OpenCV runs its parallel loops on the calling thread alone.
+  cv::setNumThreads(1);
+
+  // Registered cases keep pointers to these: they live until the end.
+  static SceneList synthetic;
+  static SceneList osd;
+  fovea::bench::AddSyntheticScenes(
+      std::vector<uint64_t>(std::begin(kSynthSeeds), std::end(kSynthSeeds)),
+      synthetic);
+  const char* osd_dir = std::getenv("FOVEA_OSD_DIR");
+  if (osd_dir != nullptr && *osd_dir != '\0') {
+    std::fprintf(stderr, "fovea-bench: loading OSD scenes from %s\n", osd_dir);
+    const absl::Status status =
+        fovea::bench::AddOsdScenes(osd_dir, flags.osd_scenes, osd);
+    if (!status.ok()) {
+      std::fprintf(stderr, "fovea-bench: no OSD cases: %s\n",
+                   status.ToString().c_str());
+    }
+  }
+  benchmark::AddCustomContext("synthetic_frames",
+                              std::to_string(synthetic.size()));
+  benchmark::AddCustomContext("osd_frames", std::to_string(osd.size()));
+  benchmark::AddCustomContext("opencv_threads",
+                              std::to_string(cv::getNumThreads()));
+
+  // Synthetic cases first, then the OSD ones; in each, the gRPC cases come
+  // right after the in-process Detect cases they compare with.
+  for (const auto& [scenes, set_name, suffix] :
+       {std::tuple<const SceneList*, std::string, std::string>{&synthetic,
+                                                               "synthetic", ""},
+        {&osd, "OSD", "/osd"}}) {
+    fovea::bench::RegisterStageBenchmarks(scenes, set_name, suffix,
+                                          flags.sweep);
+#ifdef FOVEA_BENCH_GRPC
+    fovea::bench::RegisterGrpcBenchmarks(scenes, set_name, suffix, flags.sweep);
+#endif
+  }
+
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+#ifdef FOVEA_BENCH_GRPC
+  fovea::bench::StopGrpcServer();
+#endif
+  return 0;
+}

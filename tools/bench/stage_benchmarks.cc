@@ -1,0 +1,212 @@
+#include "tools/bench/stage_benchmarks.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "core/attention/msr.h"
+#include "core/frame/frame_decode.h"
+#include "core/frame/organized_cloud.h"
+#include "core/frame/support_plane.h"
+#include "core/frame/table_scene.h"
+#include "core/pipeline/detect.h"
+#include "core/saliency/ph.h"
+#include "core/saliency/rso.h"
+#include "core/saliency/sh.h"
+
+namespace fovea::bench {
+namespace {
+
+absl::string_view Abs(std::string_view s) { return {s.data(), s.size()}; }
+
+// Rough per-frame cost of each case on one core, milliseconds; only sizes
+// the number of passes per repetition (SweepIterations).
+constexpr double kDecodeRawMs = 2.0;
+constexpr double kDecodePngMs = 12.0;
+constexpr double kBackProjectMs = 1.0;
+constexpr double kNormalsMs = 8.0;
+constexpr double kSupportPlaneMs = 5.0;
+constexpr double kFramePrepMs = 15.0;
+constexpr double kSaliencyMs = 3.0;
+constexpr double kMsrMs = 2.0;
+constexpr double kDetectMs = 30.0;
+
+using SceneBody = std::function<absl::Status(const BenchScene&)>;
+
+void Register(const std::string& name, const SceneList* scenes,
+              const std::string& set_name, const SweepOptions& sweep,
+              double expected_ms, SceneBody body) {
+  benchmark::RegisterBenchmark(
+      name.c_str(),
+      [scenes, set_name, body = std::move(body)](benchmark::State& state) {
+        SweepScenes(state, *scenes, set_name, body);
+      })
+      ->Iterations(
+          SweepIterations(sweep, static_cast<int>(scenes->size()), expected_ms))
+      ->Unit(benchmark::kMillisecond);
+}
+
+// The stages before saliency, as RunDetect runs them, from the raw wire
+// frame: decode, back-projection and normals, support plane, table scene.
+absl::Status PrepareFrame(const BenchScene& scene,
+                          const DetectOptions& options) {
+  absl::StatusOr<RgbdFrame> frame =
+      DecodeFrame(scene.raw_wire, BenchFrameLimits());
+  if (!frame.ok()) return frame.status();
+  absl::StatusOr<OrganizedCloud> cloud =
+      BuildOrganizedCloud(*frame, options.normals);
+  if (!cloud.ok()) return cloud.status();
+  absl::StatusOr<SupportPlane> plane =
+      FindSupportPlane(*cloud, options.support_plane);
+  if (!plane.ok()) return plane.status();
+  TableScene table = PrepareTableScene(*cloud, *plane, options.table_scene);
+  benchmark::DoNotOptimize(table.candidate_count);
+  return absl::OkStatus();
+}
+
+void RegisterFrameCases(const SceneList* scenes, const std::string& set,
+                        const std::string& suffix, const SweepOptions& sweep) {
+  const DetectOptions defaults;
+  Register("BM_DecodeRaw" + suffix, scenes, set, sweep, kDecodeRawMs,
+           [](const BenchScene& scene) {
+             absl::StatusOr<RgbdFrame> frame =
+                 DecodeFrame(scene.raw_wire, BenchFrameLimits());
+             benchmark::DoNotOptimize(frame);
+             return frame.status();
+           });
+  Register("BM_DecodePng" + suffix, scenes, set, sweep, kDecodePngMs,
+           [](const BenchScene& scene) {
+             absl::StatusOr<RgbdFrame> frame =
+                 DecodeFrame(scene.png_wire, BenchFrameLimits());
+             benchmark::DoNotOptimize(frame);
+             return frame.status();
+           });
+  Register("BM_BackProject" + suffix, scenes, set, sweep, kBackProjectMs,
+           [](const BenchScene& scene) {
+             OrganizedCloud cloud = BackProject(scene.frame);
+             benchmark::DoNotOptimize(cloud.xyz.data);
+             return absl::OkStatus();
+           });
+  Register("BM_Normals" + suffix, scenes, set, sweep, kNormalsMs,
+           [options = defaults.normals](const BenchScene& scene) {
+             // Shares the prepared points (read only); the normals are
+             // allocated afresh, as in BuildOrganizedCloud.
+             OrganizedCloud cloud;
+             cloud.xyz = scene.cloud.xyz;
+             cloud.color = scene.cloud.color;
+             cloud.intrinsics = scene.cloud.intrinsics;
+             EstimateNormals(options, cloud);
+             benchmark::DoNotOptimize(cloud.normals.data);
+             return absl::OkStatus();
+           });
+  Register("BM_SupportPlane" + suffix, scenes, set, sweep, kSupportPlaneMs,
+           [defaults](const BenchScene& scene) {
+             absl::StatusOr<SupportPlane> plane =
+                 FindSupportPlane(scene.cloud, defaults.support_plane);
+             if (!plane.ok()) return plane.status();
+             TableScene table =
+                 PrepareTableScene(scene.cloud, *plane, defaults.table_scene);
+             benchmark::DoNotOptimize(table.candidate_count);
+             return absl::OkStatus();
+           });
+  Register("BM_FramePrep" + suffix, scenes, set, sweep, kFramePrepMs,
+           [defaults](const BenchScene& scene) {
+             return PrepareFrame(scene, defaults);
+           });
+}
+
+void RegisterSaliencyCases(const SceneList* scenes, const std::string& set,
+                           const std::string& suffix,
+                           const SweepOptions& sweep) {
+  const DetectOptions defaults;
+  Register("BM_SaliencyPh" + suffix, scenes, set, sweep, kSaliencyMs,
+           [options = defaults.ph](const BenchScene& scene) {
+             absl::StatusOr<cv::Mat> map =
+                 ComputePhSaliency(scene.table, options);
+             benchmark::DoNotOptimize(map);
+             return map.status();
+           });
+  Register("BM_SaliencySh" + suffix, scenes, set, sweep, kSaliencyMs,
+           [options = defaults.sh](const BenchScene& scene) {
+             absl::StatusOr<cv::Mat> map = ComputeShSaliency(
+                 scene.cloud, scene.plane, scene.table, options);
+             benchmark::DoNotOptimize(map);
+             return map.status();
+           });
+  Register("BM_SaliencyRso" + suffix, scenes, set, sweep, kSaliencyMs,
+           [options = defaults.rso](const BenchScene& scene) {
+             absl::StatusOr<cv::Mat> map = ComputeRsoSaliency(
+                 scene.cloud, scene.plane, scene.table, options);
+             benchmark::DoNotOptimize(map);
+             return map.status();
+           });
+  Register("BM_Msr" + suffix, scenes, set, sweep, kMsrMs,
+           [defaults](const BenchScene& scene) {
+             absl::StatusOr<std::vector<AttentionPoint>> points =
+                 ExtractMsrPoints(scene.rso_map, defaults.max_points,
+                                  defaults.msr);
+             benchmark::DoNotOptimize(points);
+             return points.status();
+           });
+}
+
+void RegisterDetectCases(const SceneList* scenes, const std::string& set,
+                         const std::string& suffix, const SweepOptions& sweep) {
+  for (const std::string_view channels : kDetectChannelSets) {
+    const absl::StatusOr<std::vector<SaliencyOp>> ops =
+        ParseSaliencyOps(channels);
+    DetectOptions options;
+    options.channels.clear();
+    for (const SaliencyOp op : ops.value()) {
+      options.channels.push_back({op, 1.0f});
+    }
+    Register(absl::StrCat("BM_Detect/", Abs(channels), suffix), scenes, set,
+             sweep, kDetectMs, [options](const BenchScene& scene) {
+               absl::StatusOr<DetectResult> result =
+                   RunDetect(scene.frame, options);
+               benchmark::DoNotOptimize(result);
+               return result.status();
+             });
+  }
+}
+
+}  // namespace
+
+int64_t SweepIterations(const SweepOptions& sweep, int scene_count,
+                        double expected_ms) {
+  const double pass_seconds = scene_count * expected_ms * 1e-3;
+  const int passes =
+      sweep.passes > 0
+          ? sweep.passes
+          : std::max(1, static_cast<int>(std::ceil(
+                            sweep.target_repetition_seconds / pass_seconds)));
+  return static_cast<int64_t>(passes) * scene_count;
+}
+
+void SweepScenes(benchmark::State& state, const SceneList& scenes,
+                 std::string_view set_name, const SceneBody& body) {
+  size_t next = 0;
+  for (auto _ : state) {
+    const absl::Status status = body(*scenes[next]);
+    if (!status.ok()) {
+      state.SkipWithError(
+          absl::StrCat(scenes[next]->name, ": ", status.ToString()).c_str());
+      break;
+    }
+    if (++next == scenes.size()) next = 0;
+  }
+  state.SetLabel(absl::StrCat(scenes.size(), " ", Abs(set_name), " frames"));
+}
+
+void RegisterStageBenchmarks(const SceneList* scenes,
+                             const std::string& set_name,
+                             const std::string& suffix,
+                             const SweepOptions& sweep) {
+  if (scenes->empty()) return;
+  RegisterFrameCases(scenes, set_name, suffix, sweep);
+  RegisterSaliencyCases(scenes, set_name, suffix, sweep);
+  RegisterDetectCases(scenes, set_name, suffix, sweep);
+}
+
+}  // namespace fovea::bench
