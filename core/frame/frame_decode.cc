@@ -362,15 +362,15 @@ cv::Mat DecodeFile(absl::string_view file, int flags) {
   }
 }
 
-float DepthFromUnits(uint32_t units, double scale) {
-  return units == 0 ? std::numeric_limits<float>::quiet_NaN()
-                    : static_cast<float>(units * scale);
-}
-
 float DepthFromMetres(float metres) {
-  return metres > 0.0f && metres < std::numeric_limits<float>::infinity()
+  return metres > 0.0f && metres <= kMaxDepthMetres
              ? metres
              : std::numeric_limits<float>::quiet_NaN();
+}
+
+float DepthFromUnits(uint32_t units, double scale) {
+  return units == 0 ? std::numeric_limits<float>::quiet_NaN()
+                    : DepthFromMetres(static_cast<float>(units * scale));
 }
 
 cv::Mat ColorFromRaw(const RawImage& image, const Layout& layout) {
@@ -553,6 +553,13 @@ absl::Status ValidateIntrinsics(const Intrinsics& intrinsics,
       return absl::InvalidArgumentError(
           absl::StrCat(field, ".", parameter.name, ": ", parameter.value,
                        " must be > 0 (a focal length in pixels)"));
+    }
+    if (parameter.positive && (parameter.value < kMinFocalPixels ||
+                               parameter.value > kMaxFocalPixels)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, ".", parameter.name, ": ", parameter.value,
+                       " is not a plausible focal length; expected [",
+                       kMinFocalPixels, ", ", kMaxFocalPixels, "] pixels"));
     }
   }
   return absl::OkStatus();

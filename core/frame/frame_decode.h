@@ -33,6 +33,15 @@ struct RawFrame {
   double depth_scale = 0.0;  // metres per 16-bit depth unit; 0 means 0.001
 };
 
+// Depths beyond this are no data: no RGB-D sensor measures that far, and
+// unbounded coordinates would make every metric grid unbounded, metres.
+inline constexpr float kMaxDepthMetres = 100.0f;
+// Plausible pinhole focal lengths, pixels. 10 px on a 640-px image is a
+// 176-degree field of view, wider than any pinhole depth camera; 1e6 px is
+// a 0.04-degree telescope.
+inline constexpr double kMinFocalPixels = 10.0;
+inline constexpr double kMaxFocalPixels = 1e6;
+
 struct FrameLimits {
   uint32_t max_width = 1920;   // pixels; larger frames are refused
   uint32_t max_height = 1080;  // pixels; larger frames are refused
@@ -48,8 +57,10 @@ absl::Status Validate(const FrameLimits& limits);
 // colour and depth of different sizes, zero/negative/non-finite
 // intrinsics, non-finite or non-positive depth_scale, a frame above the
 // limits, no valid depth pixel, undecodable PNG/JPEG.
-// On success the depth is in metres with NaN for no data (0, NaN and
-// non-finite or negative values all become NaN).
+// On success the depth is in metres with NaN for no data (0, NaN,
+// negative values and values beyond kMaxDepthMetres all become NaN).
+// fx and fy must lie in [kMinFocalPixels, kMaxFocalPixels]; cx and cy may be
+// any finite value (a crop can put the principal point outside the image).
 absl::StatusOr<RgbdFrame> DecodeFrame(const RawFrame& raw,
                                       const FrameLimits& limits);
 

@@ -211,14 +211,14 @@ std::vector<Eigen::Vector2f> HullInPlane(const OrganizedCloud& cloud,
 }  // namespace
 
 bool SupportPlane::ProjectsInsideHull(const Eigen::Vector3f& p) const {
-  if (hull.size() < 3) return false;
+  if (hull.size() < 3 || !p.allFinite()) return false;
   const Eigen::Vector2f q = ToPlane(p);
   for (size_t i = 0; i < hull.size(); ++i) {
     const Eigen::Vector2f& a = hull[i];
     const Eigen::Vector2f& b = hull[(i + 1) % hull.size()];
     const float cross =
         (b.x() - a.x()) * (q.y() - a.y()) - (b.y() - a.y()) * (q.x() - a.x());
-    if (cross < 0.0f) return false;
+    if (!(cross >= 0.0f)) return false;  // NaN is outside too
   }
   return true;
 }

@@ -2,6 +2,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <exception>
+#include <new>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -10,8 +12,6 @@
 
 namespace fovea {
 namespace {
-
-constexpr int kMaxPoints = 100;
 
 // Debian 12's abseil has its own string_view (ABSL_OPTION_USE_STD_STRING_VIEW
 // is 0), which StrCat and StrSplit need.
@@ -161,6 +161,16 @@ absl::Status Validate(const DetectOptions& options) {
   if (options.channels.empty()) {
     return absl::InvalidArgumentError("options.saliency: no channel given");
   }
+  for (size_t i = 0; i < options.channels.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      if (options.channels[j].op == options.channels[i].op) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "options.saliency: '", Abs(SaliencyOpName(options.channels[i].op)),
+            "' is given more than once; give each operator once with its "
+            "weight"));
+      }
+    }
+  }
   for (const WeightedChannel& c : options.channels) {
     if (!(c.weight >= 0.0f) || !std::isfinite(c.weight)) {
       return absl::InvalidArgumentError(absl::StrCat(
@@ -173,9 +183,9 @@ absl::Status Validate(const DetectOptions& options) {
                                                    "' is not implemented yet"));
     }
   }
-  if (options.max_points < 1 || options.max_points > kMaxPoints) {
+  if (options.max_points < 1 || options.max_points > kMaxAttentionPoints) {
     return absl::InvalidArgumentError(
-        absl::StrCat("options.max_points must be in [1, ", kMaxPoints,
+        absl::StrCat("options.max_points must be in [1, ", kMaxAttentionPoints,
                      "], got ", options.max_points));
   }
   if (options.pyramid != PyramidKind::kNone) {
@@ -200,9 +210,50 @@ absl::Status Validate(const DetectOptions& options) {
   return Validate(options.msr);
 }
 
+namespace {
+absl::StatusOr<DetectResult> RunDetectUnguarded(
+    const RgbdFrame& frame, const DetectOptions& options,
+    const InterruptCheck& interrupt);
+}  // namespace
+
+std::vector<std::string> DetectStageNames() {
+  std::vector<std::string> names = {"cloud", "normals", "support_plane",
+                                    "fusion"};
+  for (const NamedOp& n : kOps) {
+    if (IsImplemented(n.op)) {
+      names.push_back(absl::StrCat("saliency.", Abs(n.name)));
+    }
+  }
+  for (ExtractionKind kind :
+       {ExtractionKind::kMsr, ExtractionKind::kWta, ExtractionKind::kTj}) {
+    DetectOptions probe;
+    probe.extraction = kind;
+    if (Validate(probe).ok()) {
+      names.push_back(absl::StrCat("extract.", Abs(ExtractionName(kind))));
+    }
+  }
+  return names;
+}
+
 absl::StatusOr<DetectResult> RunDetect(const RgbdFrame& frame,
                                        const DetectOptions& options,
                                        const InterruptCheck& interrupt) {
+  // Nothing throws out of core/: OpenCV and the standard library can.
+  try {
+    return RunDetectUnguarded(frame, options, interrupt);
+  } catch (const std::bad_alloc&) {
+    return absl::ResourceExhaustedError("detect: out of memory");
+  } catch (const std::exception& e) {
+    return absl::InternalError(absl::StrCat("detect: ", e.what()));
+  }
+}
+
+namespace {
+
+// RunDetect without the exception guard.
+absl::StatusOr<DetectResult> RunDetectUnguarded(
+    const RgbdFrame& frame, const DetectOptions& options,
+    const InterruptCheck& interrupt) {
   if (absl::Status s = Validate(options); !s.ok()) return s;
   const auto start = std::chrono::steady_clock::now();
   DetectResult result;
@@ -248,5 +299,7 @@ absl::StatusOr<DetectResult> RunDetect(const RgbdFrame& frame,
           .count();
   return result;
 }
+
+}  // namespace
 
 }  // namespace fovea

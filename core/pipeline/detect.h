@@ -46,6 +46,9 @@ std::string_view ExtractionName(ExtractionKind kind);  // "msr", "wta", "tj"
 absl::StatusOr<std::vector<SaliencyOp>> ParseSaliencyOps(std::string_view text);
 absl::StatusOr<ExtractionKind> ParseExtraction(std::string_view text);
 
+// Most attention points one request may ask for.
+inline constexpr int kMaxAttentionPoints = 100;
+
 struct WeightedChannel {
   SaliencyOp op = SaliencyOp::kRso;
   float weight = 1.0f;  // >= 0; renormalised so the weights sum to 1
@@ -96,6 +99,11 @@ struct DetectResult {
   double total_seconds = 0.0;
 };
 
+// Every stage name RunDetect can report with the options it accepts today
+// ("cloud", "normals", "support_plane", "saliency.<op>", "fusion",
+// "extract.<kind>"), for metrics that must exist before the first call.
+std::vector<std::string> DetectStageNames();
+
 // Called between stages; a non-OK status (e.g. DEADLINE_EXCEEDED,
 // CANCELLED) stops the pipeline and is returned as is.
 using InterruptCheck = std::function<absl::Status()>;
@@ -103,7 +111,9 @@ using InterruptCheck = std::function<absl::Status()>;
 // The whole Detect path on a decoded frame: organized cloud and normals,
 // support plane, table scene, each channel's map, fusion, extraction.
 // Errors: INVALID_ARGUMENT / UNIMPLEMENTED from Validate; NOT_FOUND when
-// there is no support plane; whatever `interrupt` returns.
+// there is no support plane; whatever `interrupt` returns;
+// RESOURCE_EXHAUSTED when memory runs out and INTERNAL for any other
+// exception from a library underneath (nothing throws out of core/).
 absl::StatusOr<DetectResult> RunDetect(const RgbdFrame& frame,
                                        const DetectOptions& options,
                                        const InterruptCheck& interrupt = {});
