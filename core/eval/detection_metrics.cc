@@ -91,25 +91,33 @@ DetectionScore ScoreAttentionPoints(const std::vector<AttentionPoint>& points,
   seen.clear();
   double dc_sum = 0.0, dc_thesis_sum = 0.0;
   int on_object = 0;
-  for (int i = 0; i < std::min<int>(k, points.size()); ++i) {
-    const int id = hit_ids[i];
-    if (id == 0) continue;
-    if (seen.insert(id).second) ++score.hits;
-    const auto it = objects.find(id);
-    const ObjectGeometry& g = it->second;
-    const cv::Vec3f& q = xyz.at<cv::Vec3f>(points[i].v, points[i].u);
-    if (std::isnan(q[2]) || g.count == 0 || !(g.r_max > 0.0f)) continue;
-    const float r = (Eigen::Vector3f(q[0], q[1], q[2]) - g.centroid).norm();
-    const float span = g.r_max - g.r_min;
-    dc_sum += span > 0.0f ? std::clamp((r - g.r_min) / span, 0.0f, 1.0f) : 0.0;
-    dc_thesis_sum += std::min(r / g.r_max, 1.0f);
-    ++on_object;
+  for (int i = 0; i < k; ++i) {
+    const int id = i < static_cast<int>(hit_ids.size()) ? hit_ids[i] : 0;
+    double thesis = -1.0;  // < 0: no 3D distance for this point
+    double dc = 1.0;       // a miss
+    if (id != 0) {
+      const ObjectGeometry& g = objects.at(id);
+      const cv::Vec3f& q = xyz.at<cv::Vec3f>(points[i].v, points[i].u);
+      if (!std::isnan(q[2]) && g.count > 0 && g.r_max > 0.0f) {
+        const float r = (Eigen::Vector3f(q[0], q[1], q[2]) - g.centroid).norm();
+        const float span = g.r_max - g.r_min;
+        thesis = std::min(r / g.r_max, 1.0f);
+        if (seen.count(id) == 0) {
+          dc = span > 0.0f ? std::clamp((r - g.r_min) / span, 0.0f, 1.0f) : 0.0;
+        }
+      }
+      if (seen.insert(id).second) ++score.hits;
+    }
+    dc_sum += dc;
+    if (thesis >= 0.0) {
+      dc_thesis_sum += thesis;
+      ++on_object;
+    }
   }
   score.hit_ratio = static_cast<double>(score.hits) / k;
-  if (on_object > 0) {
-    score.distance_to_center = dc_sum / on_object;
+  score.distance_to_center = dc_sum / k;
+  if (on_object > 0)
     score.distance_to_center_thesis = dc_thesis_sum / on_object;
-  }
   return score;
 }
 

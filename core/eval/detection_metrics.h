@@ -20,15 +20,18 @@ struct DetectionScore {
   // or on nothing, a second point on an already-hit object and a point that
   // was not returned are all misses. 1 only for a perfect detector.
   double hit_ratio = 0.0;
-  // Mean, over the first K points that lie on an object, of
-  //   (|p - c| - r_min) / (r_max - r_min)
-  // with c the 3D centroid of the object's visible points and r_min, r_max
-  // the smallest and largest distance of a visible point from c. 0 only
-  // when every point is the visible point nearest its object's centre;
-  // 1 when no point lies on an object (silence does not score well).
+  // Mean over the K slots of the first K points. A slot whose point hits a
+  // new object scores (|p - c| - r_min) / (r_max - r_min), with c the 3D
+  // centroid of the object's visible points and r_min, r_max the smallest
+  // and largest distance of a visible point from c; every miss (as for
+  // hit_ratio) scores 1. So DC is 0 only for a perfect detector: K points
+  // on K distinct objects, each the visible point nearest its object's
+  // centre. (The r_min offset is what lets a perfect detector reach 0: the
+  // centroid of a curved object's visible surface lies inside it.)
   double distance_to_center = 1.0;
-  // The thesis's ratio |p - c| / r_max over the same points, for comparison
-  // with Table 2.5 (its best value is above 0 for curved objects).
+  // The thesis's ratio |p - c| / r_max (section 2.6.1), averaged over the
+  // points among the first K that lie on an object, misses left out, as
+  // Table 2.5 reports it; 1 when no point lies on an object.
   double distance_to_center_thesis = 1.0;
   // hit_ratio_at[N-1] = distinct objects hit among the first N points / N.
   std::array<double, kHitRatioAtMax> hit_ratio_at{};

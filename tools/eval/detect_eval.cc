@@ -20,6 +20,11 @@ std::string ResolveDataDir(const std::string& dir) {
   return dir;
 }
 
+// Drawing of the attention points on the evaluation PNGs.
+constexpr int kPointRadiusPx = 6;
+const cv::Point kLabelOffset(7, -7);
+constexpr double kLabelScale = 0.5;
+
 double Median(std::vector<double> values) {
   if (values.empty()) return 0.0;
   const size_t mid = values.size() / 2;
@@ -41,24 +46,32 @@ void WriteScenePng(const std::string& out_dir, const LabelledFrame& scene,
   cv::applyColorMap(map8, heat, cv::COLORMAP_JET);
   cv::Mat bgr;
   cv::cvtColor(scene.frame.color, bgr, cv::COLOR_RGB2BGR);
-  cv::Mat objects = scene.labels >= 20;
+  // One outline per ground-truth object (all of its labelled parts).
+  cv::Mat ids(scene.labels.size(), CV_32SC1);
+  int max_id = 0;
+  for (int v = 0; v < ids.rows; ++v) {
+    for (int u = 0; u < ids.cols; ++u) {
+      const int id = ObjectId(scene.labels.at<int>(v, u));
+      ids.at<int>(v, u) = id;
+      max_id = std::max(max_id, id);
+    }
+  }
   std::vector<std::vector<cv::Point>> contours;
-  cv::Mat ids;
-  scene.labels.convertTo(ids, CV_32S, 0.1);
-  for (int id = 2; id < 100; ++id) {
-    cv::Mat mask = (ids == id) & objects;
+  for (int id = 1; id <= max_id; ++id) {
+    const cv::Mat mask = ids == id;
     if (cv::countNonZero(mask) == 0) continue;
     std::vector<std::vector<cv::Point>> c;
     cv::findContours(mask, c, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
     contours.insert(contours.end(), c.begin(), c.end());
   }
   cv::drawContours(bgr, contours, -1, cv::Scalar(255, 255, 255), 1);
+  const cv::Scalar white(255, 255, 255);
   for (size_t i = 0; i < result.points.size(); ++i) {
     const cv::Point p(result.points[i].u, result.points[i].v);
     for (cv::Mat* img : {&heat, &bgr}) {
-      cv::circle(*img, p, 6, cv::Scalar(255, 255, 255), 2);
-      cv::putText(*img, std::to_string(i), p + cv::Point(7, -7),
-                  cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1);
+      cv::circle(*img, p, kPointRadiusPx, white, 2);
+      cv::putText(*img, std::to_string(i), p + kLabelOffset,
+                  cv::FONT_HERSHEY_SIMPLEX, kLabelScale, white, 1);
     }
   }
   cv::Mat both;

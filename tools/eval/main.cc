@@ -42,15 +42,15 @@ constexpr int kUsageError = 64;
 constexpr int kRunError = 1;
 
 void PrintTable(const std::vector<SceneResult>& scenes) {
-  std::printf("%-12s %-10s %7s %5s %6s %6s %8s\n", "kind", "", "scenes", "",
-              "HR", "DC", "ms(med)");
+  std::printf("%-12s %7s %7s %7s %11s %9s\n", "kind", "scenes", "HR", "DC",
+              "DC(thesis)", "ms(med)");
   for (const char* kind :
        {"boxes", "stacked", "occluded", "cylindric", "other", ""}) {
     const DetectEvalSummary s = Summarize(scenes, kind);
     if (s.scenes.empty()) continue;
-    std::printf("%-12s %-10s %7zu %5s %6.3f %6.3f %8.1f\n",
-                kind[0] ? kind : "all", "", s.scenes.size(), "", s.hit_ratio,
-                s.distance_to_center, s.detect_ms_median);
+    std::printf("%-12s %7zu %7.3f %7.3f %11.3f %9.1f\n", kind[0] ? kind : "all",
+                s.scenes.size(), s.hit_ratio, s.distance_to_center,
+                s.distance_to_center_thesis, s.detect_ms_median);
   }
 }
 

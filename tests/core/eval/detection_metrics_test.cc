@@ -71,6 +71,20 @@ TEST(DetectionMetricsTest, TableRepeatsAndSilenceAreMisses) {
   EXPECT_DOUBLE_EQ(silent.distance_to_center, 1.0);
 }
 
+TEST(DetectionMetricsTest, OneCentredPointAndAMissIsNotAPerfectDistance) {
+  Scene s;
+  // Object 2 hit at its centre, then a table point: DC = (0 + 1) / 2, while
+  // the thesis's ratio, which leaves misses out, is 0.
+  const DetectionScore score =
+      ScoreAttentionPoints({At(4, 4), At(0, 0)}, s.labels, s.xyz);
+  EXPECT_DOUBLE_EQ(score.distance_to_center, 0.5);
+  EXPECT_DOUBLE_EQ(score.distance_to_center_thesis, 0.0);
+  // A repeat on the same object is a miss for DC too.
+  EXPECT_DOUBLE_EQ(ScoreAttentionPoints({At(4, 4), At(4, 4)}, s.labels, s.xyz)
+                       .distance_to_center,
+                   0.5);
+}
+
 TEST(DetectionMetricsTest, OnlyTheFirstKPointsCountForHitRatio) {
   Scene s;
   const DetectionScore score =

@@ -246,6 +246,16 @@ TEST(FrameDecodeTest, RefusesZeroFx) {
   ExpectInvalid(raw, "frame.intrinsics.fx");
 }
 
+TEST(FrameDecodeTest, RefusesImplausiblyShortAndLongFocalLengths) {
+  FrameBytes bytes;
+  RawFrame raw = ValidFrame(bytes);
+  raw.intrinsics.fx = 1e-5;  // would spread a frame over kilometres
+  ExpectInvalid(raw, "frame.intrinsics.fx");
+  raw = ValidFrame(bytes);
+  raw.intrinsics.fy = 1e9;
+  ExpectInvalid(raw, "frame.intrinsics.fy");
+}
+
 TEST(FrameDecodeTest, RefusesNegativeFy) {
   FrameBytes bytes;
   RawFrame raw = ValidFrame(bytes);
@@ -488,13 +498,18 @@ TEST(FrameDecodeTest, Depth16IsScaledToMetresWithZeroAsNaN) {
   const absl::StatusOr<RgbdFrame> frame = DecodeFrame(raw, FrameLimits());
   ASSERT_TRUE(frame.ok()) << frame.status();
   EXPECT_FLOAT_EQ(frame->depth.at<float>(2, 3), 0.531f);
+  // A scale that puts depths beyond kMaxDepthMetres makes them no data.
+  raw.depth_scale = 1.0;
+  const absl::StatusOr<RgbdFrame> far = DecodeFrame(raw, FrameLimits());
+  ASSERT_FALSE(far.ok());  // every pixel is now > 100 m: no valid depth
+  EXPECT_THAT(std::string(far.status().message()), HasSubstr("frame.depth"));
 }
 
 TEST(FrameDecodeTest, Depth32FKeepsMetresAndMarksInvalidAsNaN) {
   FrameBytes bytes;
   RawFrame raw = ValidFrame(bytes);
   cv::Mat depth(1, 6, CV_32FC1);
-  const float values[] = {1.25f, kNaN, 0.0f, -2.0f, kInf, 0.5f};
+  const float values[] = {1.25f, kNaN, 0.0f, -2.0f, 3e38f, 0.5f};
   std::copy(std::begin(values), std::end(values), depth.ptr<float>(0));
   const std::string depth_bytes = Bytes(depth);
   const cv::Mat color = TestRgb(6, 1);

@@ -117,3 +117,20 @@ TEST(TableSceneTest, BoxPixelsAreCandidatesAndTablePixelsAreNot) {
 
 }  // namespace
 }  // namespace fovea
+
+namespace fovea {
+namespace {
+
+TEST(SupportPlaneTest, NonFinitePointsNeverProjectInsideTheHull) {
+  SupportPlane plane;
+  plane.hull = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+  EXPECT_TRUE(plane.ProjectsInsideHull({0.0f, 0.0f, 0.5f}));
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  EXPECT_FALSE(plane.ProjectsInsideHull({nan, 0.0f, 0.5f}));
+  EXPECT_FALSE(plane.ProjectsInsideHull({inf, 0.0f, 0.5f}));
+  EXPECT_FALSE(plane.ProjectsInsideHull({0.0f, 0.0f, inf}));
+}
+
+}  // namespace
+}  // namespace fovea

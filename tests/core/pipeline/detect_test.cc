@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "core/synth/synth_scene.h"
 
 namespace fovea {
@@ -87,6 +89,37 @@ TEST(DetectTest, ParsesSaliencyNamesAndCombinations) {
   EXPECT_NE(bad.message().find("bogus"), std::string::npos);
   EXPECT_EQ(*ParseExtraction("msr"), ExtractionKind::kMsr);
   EXPECT_FALSE(ParseExtraction("xyz").ok());
+}
+
+}  // namespace
+}  // namespace fovea
+
+namespace fovea {
+namespace {
+
+TEST(DetectTest, DuplicateChannelsAreRefusedNamingTheOperator) {
+  DetectOptions options;
+  options.channels = {
+      {SaliencyOp::kPh, 1}, {SaliencyOp::kRso, 1}, {SaliencyOp::kPh, 2}};
+  const absl::Status s = Validate(options);
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(s.message().find("'ph'"), std::string::npos);
+}
+
+TEST(DetectTest, StageNamesCoverEveryStageARunReports) {
+  const std::vector<std::string> names = DetectStageNames();
+  const synth::SynthScene scene = synth::GenerateScene(2);
+  DetectOptions options;
+  options.channels = {
+      {SaliencyOp::kPh, 1}, {SaliencyOp::kSh, 1}, {SaliencyOp::kRso, 1}};
+  absl::StatusOr<DetectResult> result = RunDetect(scene.frame.frame, options);
+  ASSERT_TRUE(result.ok());
+  for (const StageTiming& t : result->timings) {
+    EXPECT_NE(std::find(names.begin(), names.end(), t.stage), names.end())
+        << t.stage;
+  }
+  EXPECT_EQ(std::find(names.begin(), names.end(), "saliency.sym3d"),
+            names.end());
 }
 
 }  // namespace

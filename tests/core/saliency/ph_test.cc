@@ -5,16 +5,17 @@
 namespace fovea {
 namespace {
 
-// A 4x3 table scene: row 0 table, rows 1-2 two objects 0.1 m and 0.2 m tall.
+// A 4x3 table scene: row 0 table (height 0; marked candidate so that PH
+// itself must give it 0), rows 1-2 two objects 0.1 m and 0.2 m tall.
 TableScene TinyScene() {
   TableScene scene;
-  scene.height = (cv::Mat_<float>(3, 4) << 0.0f, 0.002f, -0.001f, 0.0f,  //
-                  0.05f, 0.1f, 0.1f, 0.05f,                              //
+  scene.height = (cv::Mat_<float>(3, 4) << 0.0f, 0.0f, 0.0f, 0.0f,  //
+                  0.05f, 0.1f, 0.1f, 0.05f,                         //
                   0.1f, 0.2f, 0.15f, 0.05f);
-  scene.candidate = (cv::Mat_<uint8_t>(3, 4) << 0, 0, 0, 0,  //
-                     255, 255, 255, 255,                     //
+  scene.candidate = (cv::Mat_<uint8_t>(3, 4) << 255, 255, 255, 255,  //
+                     255, 255, 255, 255,                             //
                      255, 255, 255, 255);
-  scene.candidate_count = 8;
+  scene.candidate_count = 12;
   return scene;
 }
 
@@ -43,6 +44,7 @@ TEST(PhSaliencyTest, TopOffsetMovesThePeakDown) {
 TEST(PhSaliencyTest, EmptySceneIsAllZero) {
   TableScene scene = TinyScene();
   scene.candidate.setTo(0);
+  scene.candidate_count = 0;
   absl::StatusOr<cv::Mat> map = ComputePhSaliency(scene, {});
   ASSERT_TRUE(map.ok());
   EXPECT_EQ(cv::countNonZero(*map), 0);

@@ -79,3 +79,34 @@ TEST(ShSaliencyTest, ValidateNamesTheField) {
 
 }  // namespace
 }  // namespace fovea
+
+namespace fovea {
+namespace {
+
+// Two candidate points 10 km apart on the plane z = 0: the grid would need
+// 4e12 dense cells, so it must hash them, and each point still sees only
+// itself.
+TEST(ShSaliencyTest, ATableKilometresWideStaysBoundedAndCorrect) {
+  OrganizedCloud cloud;
+  cloud.xyz = cv::Mat(1, 3, CV_32FC3);
+  cloud.xyz.at<cv::Vec3f>(0, 0) = {0.0f, 0.0f, 0.1f};
+  cloud.xyz.at<cv::Vec3f>(0, 1) = {1e4f, 0.0f, 0.2f};
+  cloud.xyz.at<cv::Vec3f>(0, 2) = {1e4f, 0.003f, 0.05f};  // 3 mm from #1
+  cloud.normals = cv::Mat(1, 3, CV_32FC3, cv::Scalar::all(0));
+  SupportPlane plane;  // z = 0, axes x and y
+  plane.normal = Eigen::Vector3f::UnitZ();
+  plane.axis_u = Eigen::Vector3f::UnitX();
+  plane.axis_v = Eigen::Vector3f::UnitY();
+  TableScene scene;
+  scene.height = (cv::Mat_<float>(1, 3) << 0.1f, 0.2f, 0.05f);
+  scene.candidate = cv::Mat(1, 3, CV_8UC1, cv::Scalar(255));
+  scene.candidate_count = 3;
+  absl::StatusOr<cv::Mat> map = ComputeShSaliency(cloud, plane, scene, {});
+  ASSERT_TRUE(map.ok());
+  EXPECT_FLOAT_EQ(map->at<float>(0, 0), 0.5f);
+  EXPECT_FLOAT_EQ(map->at<float>(0, 1), 1.0f);
+  EXPECT_FLOAT_EQ(map->at<float>(0, 2), 1.0f);  // takes its neighbour's
+}
+
+}  // namespace
+}  // namespace fovea

@@ -1,0 +1,122 @@
+// fovea-eval end to end on synthetic scenes written as OSD-style PCDs.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_types.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "core/synth/synth_scene.h"
+#include "tools/eval/scene_kind.h"
+
+namespace fovea {
+namespace {
+
+using ::testing::HasSubstr;
+
+struct EvalRun {
+  int exit_code = -1;
+  std::string out;
+};
+
+EvalRun RunEval(const std::string& args) {
+  const std::string command =
+      std::string(FOVEA_EVAL_BIN) + " " + args + " 2>&1";
+  EvalRun run;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return run;
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) {
+    run.out.append(buffer.data(), n);
+  }
+  const int status = pclose(pipe);
+  if (WIFEXITED(status)) run.exit_code = WEXITSTATUS(status);
+  return run;
+}
+
+// Writes synthetic scene `seed` as an organized PCD with label and rgba.
+void WritePcd(const std::filesystem::path& path, uint64_t seed) {
+  const synth::SynthScene scene = synth::GenerateScene(seed);
+  const RgbdFrame& f = scene.frame.frame;
+  pcl::PointCloud<pcl::PointXYZRGBL> cloud(f.width(), f.height());
+  for (int v = 0; v < f.height(); ++v) {
+    for (int u = 0; u < f.width(); ++u) {
+      pcl::PointXYZRGBL& p = cloud.at(u, v);
+      const float z = f.depth.at<float>(v, u);
+      p.z = z;
+      p.x = static_cast<float>((u - f.intrinsics.cx) * z / f.intrinsics.fx);
+      p.y = static_cast<float>((v - f.intrinsics.cy) * z / f.intrinsics.fy);
+      const cv::Vec3b c = f.color.at<cv::Vec3b>(v, u);
+      p.r = c[0];
+      p.g = c[1];
+      p.b = c[2];
+      p.label = static_cast<uint32_t>(scene.frame.labels.at<int>(v, u));
+    }
+  }
+  cloud.is_dense = false;
+  ASSERT_EQ(pcl::io::savePCDFileBinaryCompressed(path.string(), cloud), 0);
+}
+
+std::filesystem::path SyntheticDataDir() {
+  const std::filesystem::path dir =
+      std::filesystem::path(::testing::TempDir()) / "fovea_eval_test_data";
+  std::filesystem::create_directories(dir / "learn");
+  for (int i = 0; i < 3; ++i) {
+    WritePcd(dir / "learn" / ("learn" + std::to_string(i) + ".pcd"), i + 1);
+  }
+  return dir;
+}
+
+TEST(FoveaEvalTest, DetectPrintsATableAndAJsonLastLine) {
+  const std::filesystem::path dir = SyntheticDataDir();
+  const EvalRun run = RunEval("detect --data " + dir.string() + " --json");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_THAT(run.out, HasSubstr("boxes"));  // learn0-2 are box scenes
+  const std::string last =
+      run.out.substr(run.out.rfind('\n', run.out.size() - 2) + 1);
+  EXPECT_THAT(last, HasSubstr("\"scenes\": 3"));
+  EXPECT_THAT(last, HasSubstr("\"hit_ratio\": "));
+  EXPECT_THAT(last, HasSubstr("\"distance_to_center\": "));
+  EXPECT_THAT(last, HasSubstr("\"detect_ms_median\": "));
+  // Ten HR(N) values, HR(1) first.
+  const size_t at = last.find("\"hit_ratio_at\": [");
+  ASSERT_NE(at, std::string::npos);
+  const std::string list = last.substr(at, last.find(']', at) - at);
+  EXPECT_EQ(std::count(list.begin(), list.end(), ','), 9) << list;
+  // Synthetic objects on a clean table: most are found.
+  const size_t hr = last.find("\"hit_ratio\": ") + 13;
+  EXPECT_GE(std::stod(last.substr(hr)), 0.6) << last;
+}
+
+TEST(FoveaEvalTest, UnknownSaliencyIsAUsageErrorNamingIt) {
+  const EvalRun run = RunEval("detect --data /nonexistent --saliency ph+bogus");
+  EXPECT_EQ(run.exit_code, 64);
+  EXPECT_THAT(run.out, HasSubstr("bogus"));
+}
+
+TEST(FoveaEvalTest, MissingDataIsAnErrorNotACrash) {
+  const EvalRun run = RunEval("detect --data /nonexistent/osd");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_THAT(run.out, HasSubstr("/nonexistent/osd"));
+}
+
+TEST(SceneKindTest, FollowsTheOsdLearnNumbering) {
+  EXPECT_EQ(eval::SceneKind("learn0"), "boxes");
+  EXPECT_EQ(eval::SceneKind("learn16"), "boxes");
+  EXPECT_EQ(eval::SceneKind("learn17"), "stacked");
+  EXPECT_EQ(eval::SceneKind("learn32"), "occluded");
+  EXPECT_EQ(eval::SceneKind("learn44"), "cylindric");
+  EXPECT_EQ(eval::SceneKind("learn45"), "other");
+  EXPECT_EQ(eval::SceneKind("test3"), "other");
+  EXPECT_EQ(eval::SceneKind("learnx"), "other");
+}
+
+}  // namespace
+}  // namespace fovea
