@@ -210,15 +210,20 @@ std::vector<Eigen::Vector2f> HullInPlane(const OrganizedCloud& cloud,
 
 }  // namespace
 
-bool SupportPlane::ProjectsInsideHull(const Eigen::Vector3f& p) const {
+bool SupportPlane::ProjectsInsideHull(const Eigen::Vector3f& p,
+                                      float margin) const {
   if (hull.size() < 3 || !p.allFinite()) return false;
   const Eigen::Vector2f q = ToPlane(p);
   for (size_t i = 0; i < hull.size(); ++i) {
     const Eigen::Vector2f& a = hull[i];
-    const Eigen::Vector2f& b = hull[(i + 1) % hull.size()];
-    const float cross =
-        (b.x() - a.x()) * (q.y() - a.y()) - (b.y() - a.y()) * (q.x() - a.x());
-    if (!(cross >= 0.0f)) return false;  // NaN is outside too
+    const Eigen::Vector2f edge = hull[(i + 1) % hull.size()] - a;
+    const float length = edge.norm();
+    if (!(length > 0.0f)) continue;
+    // Signed distance of q from the edge's line, positive inside (the hull
+    // is counter-clockwise).
+    const float inside =
+        (edge.x() * (q.y() - a.y()) - edge.y() * (q.x() - a.x())) / length;
+    if (!(inside >= margin)) return false;  // NaN is outside too
   }
   return true;
 }

@@ -31,8 +31,9 @@ struct SupportPlane {
   Eigen::Vector2f ToPlane(const Eigen::Vector3f& p) const {
     return {axis_u.dot(p), axis_v.dot(p)};
   }
-  // True when p's orthogonal projection lies inside the convex hull.
-  bool ProjectsInsideHull(const Eigen::Vector3f& p) const;
+  // True when p's orthogonal projection lies inside the convex hull, at
+  // least `margin` metres from its boundary. False for non-finite p.
+  bool ProjectsInsideHull(const Eigen::Vector3f& p, float margin = 0.0f) const;
 };
 
 struct SupportPlaneOptions {

@@ -18,6 +18,10 @@ absl::Status Validate(const TableSceneOptions& options) {
         "table_scene.max_object_height must exceed min_object_height, got ",
         options.max_object_height));
   }
+  if (!(options.hull_margin >= 0.0f)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "table_scene.hull_margin must be >= 0, got ", options.hull_margin));
+  }
   return absl::OkStatus();
 }
 
@@ -45,7 +49,8 @@ TableScene PrepareTableScene(const OrganizedCloud& cloud,
       if (hgt <= options.min_object_height || hgt > options.max_object_height) {
         continue;
       }
-      if (plane.ProjectsInsideHull({p[u][0], p[u][1], p[u][2]})) {
+      if (plane.ProjectsInsideHull({p[u][0], p[u][1], p[u][2]},
+                                   options.hull_margin)) {
         cand[u] = 255;
         ++scene.candidate_count;
       }

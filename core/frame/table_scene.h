@@ -14,7 +14,8 @@ namespace fovea {
 //   height:    CV_32FC1, metres above the plane; NaN where there is no point.
 //   candidate: CV_8UC1, 255 where a point stands on the table: height above
 //              `min_object_height` and its projection inside the table's
-//              convex hull (thesis section 2.3.1). Only these get saliency.
+//              convex hull (thesis section 2.3.1), `hull_margin` from its
+//              boundary. Only these get saliency.
 struct TableScene {
   cv::Mat height;
   cv::Mat candidate;
@@ -28,6 +29,11 @@ struct TableSceneOptions {
   // Points higher than this above the plane are not on the table (people,
   // shelves), metres.
   float max_object_height = 0.6f;
+  // A candidate's projection must lie this far inside the table's convex
+  // hull, metres. Walls and shelves rising at the table's edge project onto
+  // the hull's boundary (within sensor noise); objects on the table keep
+  // all but their outermost 2 cm.
+  float hull_margin = 0.02f;
 };
 
 absl::Status Validate(const TableSceneOptions& options);

@@ -134,3 +134,17 @@ TEST(SupportPlaneTest, NonFinitePointsNeverProjectInsideTheHull) {
 
 }  // namespace
 }  // namespace fovea
+
+namespace fovea {
+namespace {
+
+TEST(SupportPlaneTest, MarginKeepsPointsNearTheHullEdgeOut) {
+  SupportPlane plane;
+  plane.hull = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};  // 2 m square
+  EXPECT_TRUE(plane.ProjectsInsideHull({0.99f, 0.0f, 0.5f}));
+  EXPECT_FALSE(plane.ProjectsInsideHull({0.99f, 0.0f, 0.5f}, 0.02f));
+  EXPECT_TRUE(plane.ProjectsInsideHull({0.97f, 0.0f, 0.5f}, 0.02f));
+}
+
+}  // namespace
+}  // namespace fovea

@@ -83,6 +83,15 @@ TEST(DetectOsdTest, PngFrameGivesThePointsOfItsPcd) {
         << "point " << i << ": pcd (" << a.u << ", " << a.v << ") png (" << b.u
         << ", " << b.v << ")";
   }
+  // The uncropped frame shows the floor and a wall rising at the table's
+  // far edge (label 0 in the cropped PCD): no point may land there.
+  options.max_points = 10;
+  absl::StatusOr<DetectResult> all = RunDetect(*frame, options);
+  ASSERT_TRUE(all.ok());
+  for (const AttentionPoint& p : all->points) {
+    EXPECT_NE(pcd->labels.at<int>(p.v, p.u), 0)
+        << "point at (" << p.u << ", " << p.v << ") is off the table";
+  }
   // And the support planes agree.
   EXPECT_GT(from_pcd->plane.normal.dot(from_png->plane.normal), 0.9995f);
   EXPECT_NEAR(from_pcd->plane.d, from_png->plane.d, 0.01f);
