@@ -50,18 +50,21 @@ cv::Mat SmoothValidPoints(const cv::Mat& xyz, int half) {
   return points;
 }
 
-int HalfWindow(const NormalOptions& options, float z) {
-  const int r = static_cast<int>(std::lround(options.smoothing_px_at_1m / z));
+// Focal length the pixel options are given for (Kinect v1).
+constexpr double kReferenceFocalPx = 525.0;
+
+int HalfWindow(const NormalOptions& options, float focal_px, float z) {
+  const int r =
+      static_cast<int>(std::lround(options.baseline_m * focal_px / z));
   return std::clamp(r, options.min_half_window, options.max_half_window);
 }
 
 }  // namespace
 
 absl::Status Validate(const NormalOptions& options) {
-  if (!(options.smoothing_px_at_1m > 0.0f)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("normals.smoothing_px_at_1m must be > 0, got ",
-                     options.smoothing_px_at_1m));
+  if (!(options.baseline_m > 0.0f)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "normals.baseline_m must be > 0, got ", options.baseline_m));
   }
   if (options.smoothing_half_window < 0) {
     return absl::InvalidArgumentError(
@@ -114,8 +117,12 @@ OrganizedCloud BackProject(const RgbdFrame& frame) {
 void EstimateNormals(const NormalOptions& options, OrganizedCloud& cloud) {
   const int w = cloud.width(), h = cloud.height();
   cloud.normals.create(h, w, CV_32FC3);
-  const cv::Mat smooth =
-      SmoothValidPoints(cloud.xyz, options.smoothing_half_window);
+  const float focal_px =
+      static_cast<float>(0.5 * (cloud.intrinsics.fx + cloud.intrinsics.fy));
+  const cv::Mat smooth = SmoothValidPoints(
+      cloud.xyz,
+      static_cast<int>(std::lround(options.smoothing_half_window *
+                                   cloud.intrinsics.fx / kReferenceFocalPx)));
   for (int v = 0; v < h; ++v) {
     const cv::Vec3f* row = cloud.xyz.ptr<cv::Vec3f>(v);
     cv::Vec3f* out = cloud.normals.ptr<cv::Vec3f>(v);
@@ -123,7 +130,7 @@ void EstimateNormals(const NormalOptions& options, OrganizedCloud& cloud) {
       out[u] = {kNaN, kNaN, kNaN};
       const float z = row[u][2];
       if (std::isnan(z)) continue;
-      const int r = HalfWindow(options, z);
+      const int r = HalfWindow(options, focal_px, z);
       if (u - r < 0 || u + r >= w || v - r < 0 || v + r >= h) continue;
       // The four samples must lie on the same surface as the centre.
       const float max_change = options.max_depth_change_factor * z * r;

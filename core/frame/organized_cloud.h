@@ -31,20 +31,24 @@ struct OrganizedCloud {
   }
 };
 
+// Normal estimation works in metres, so the same options fit every
+// resolution (a pyramid level has a smaller focal length in pixels).
 struct NormalOptions {
-  // Half-size of the gradient baseline at 1 m, pixels; it shrinks as 1/z so
-  // that it spans about the same metric size at every depth:
-  // 1 m * 5 px / 525 px ~ 1 cm (Holzer et al. 2012, as PCL's
-  // IntegralImageNormalEstimation scales its window with depth).
-  float smoothing_px_at_1m = 5.0f;
+  // Half-length of the gradient baseline, metres: pixels at depth z and
+  // focal length f are baseline_m * f / z. 9.5 mm is 5 px at 1 m on a
+  // Kinect (f = 525 px), the scale PCL's IntegralImageNormalEstimation
+  // uses with depth-dependent smoothing (Holzer et al. 2012).
+  float baseline_m = 0.0095f;
   // Smallest and largest gradient half baseline, pixels.
-  int min_half_window = 2;
+  int min_half_window = 1;
   int max_half_window = 8;
-  // Half-size of the box the cloud is smoothed with before the gradients
-  // are taken, pixels (5x5: averages Kinect's disparity quantisation).
+  // Half-size of the box the cloud is smoothed with before the gradients,
+  // pixels at a 525 px focal length, scaled by f / 525 (2: a 5x5 box on a
+  // Kinect frame, averaging its disparity quantisation; 0 at level 2).
   int smoothing_half_window = 2;
   // Depth change above which a neighbour is not on the same surface,
-  // as a fraction of depth (PCL's max_depth_change_factor).
+  // as a fraction of depth per pixel of baseline (PCL's
+  // max_depth_change_factor).
   float max_depth_change_factor = 0.02f;
 };
 
