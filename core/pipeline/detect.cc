@@ -201,6 +201,7 @@ absl::Status Validate(const DetectOptions& options) {
         "options.extraction: '", Abs(ExtractionName(options.extraction)),
         "' is not implemented yet"));
   }
+  if (absl::Status s = Validate(options.hole_filling); !s.ok()) return s;
   if (absl::Status s = Validate(options.normals); !s.ok()) return s;
   if (absl::Status s = Validate(options.support_plane); !s.ok()) return s;
   if (absl::Status s = Validate(options.table_scene); !s.ok()) return s;
@@ -217,8 +218,8 @@ absl::StatusOr<DetectResult> RunDetectUnguarded(
 }  // namespace
 
 std::vector<std::string> DetectStageNames() {
-  std::vector<std::string> names = {"cloud", "normals", "support_plane",
-                                    "fusion"};
+  std::vector<std::string> names = {"fill_holes", "cloud", "normals",
+                                    "support_plane", "fusion"};
   for (const NamedOp& n : kOps) {
     if (IsImplemented(n.op)) {
       names.push_back(absl::StrCat("saliency.", Abs(n.name)));
@@ -259,7 +260,19 @@ absl::StatusOr<DetectResult> RunDetectUnguarded(
   DetectResult result;
   StageClock clock(result.timings);
 
-  OrganizedCloud cloud = BackProject(frame);
+  RgbdFrame filled_frame;
+  const RgbdFrame* input = &frame;
+  if (options.fill_holes) {
+    absl::StatusOr<FilledDepth> filled =
+        FillDepthHoles(frame, options.hole_filling);
+    if (!filled.ok()) return filled.status();
+    filled_frame.color = frame.color;  // shares the pixels
+    filled_frame.depth = std::move(filled->depth);
+    filled_frame.intrinsics = frame.intrinsics;
+    input = &filled_frame;
+    clock.Lap("fill_holes");
+  }
+  OrganizedCloud cloud = BackProject(*input);
   clock.Lap("cloud");
   EstimateNormals(options.normals, cloud);
   clock.Lap("normals");

@@ -27,6 +27,9 @@ ABSL_FLAG(int, points, 10, "Attention points per scene (HR uses the first K).");
 ABSL_FLAG(bool, msr_inhibit_slope, true,
           "MSR also inhibits the slope around each region (false = exactly "
           "the thesis's MSR).");
+ABSL_FLAG(bool, fill_holes, false,
+          "Fill small depth holes by colour-guided diffusion first "
+          "(thesis section 2.2).");
 ABSL_FLAG(bool, json, false,
           "Print a last line of JSON: scenes, hit_ratio, distance_to_center, "
           "hit_ratio_at, detect_ms_median.");
@@ -94,6 +97,7 @@ int RunDetectEval() {
   options.detect.extraction = *extract;
   options.detect.max_points = absl::GetFlag(FLAGS_points);
   options.detect.msr.inhibit_slope = absl::GetFlag(FLAGS_msr_inhibit_slope);
+  options.detect.fill_holes = absl::GetFlag(FLAGS_fill_holes);
   options.out_dir = absl::GetFlag(FLAGS_out);
   options.verbose = absl::GetFlag(FLAGS_verbose);
 
