@@ -9,6 +9,8 @@
 
 #include "core/frame/organized_cloud.h"
 #include "core/frame/osd_pcd.h"
+#include "core/frame/support_plane.h"
+#include "core/frame/table_scene.h"
 #include "tools/eval/scene_kind.h"
 
 namespace fovea::eval {
@@ -79,6 +81,28 @@ void WriteScenePng(const std::string& out_dir, const LabelledFrame& scene,
   cv::imwrite(out_dir + "/" + scene.name + ".png", both);
 }
 
+// The pcl-clusters peer in DetectResult form (no saliency map: the master
+// map is the candidate mask, for the PNGs).
+absl::StatusOr<DetectResult> RunPclClusters(const RgbdFrame& frame,
+                                            const DetectEvalOptions& options) {
+  absl::StatusOr<OrganizedCloud> cloud =
+      BuildOrganizedCloud(frame, options.detect.normals);
+  if (!cloud.ok()) return cloud.status();
+  absl::StatusOr<SupportPlane> plane =
+      FindSupportPlane(*cloud, options.detect.support_plane);
+  if (!plane.ok()) return plane.status();
+  const TableScene scene =
+      PrepareTableScene(*cloud, *plane, options.detect.table_scene);
+  absl::StatusOr<std::vector<AttentionPoint>> points = DetectPclClusters(
+      *cloud, scene, options.detect.max_points, options.clusters);
+  if (!points.ok()) return points.status();
+  DetectResult result;
+  result.points = *std::move(points);
+  scene.candidate.convertTo(result.master, CV_32FC1, 1.0 / 255.0);
+  result.plane = *std::move(plane);
+  return result;
+}
+
 }  // namespace
 
 DetectEvalSummary Summarize(const std::vector<SceneResult>& scenes,
@@ -125,7 +149,8 @@ absl::StatusOr<DetectEvalSummary> EvaluateDetect(
     if (!scene.ok()) return scene.status();
     const auto start = std::chrono::steady_clock::now();
     absl::StatusOr<DetectResult> result =
-        RunDetect(scene->frame, options.detect);
+        options.pcl_clusters ? RunPclClusters(scene->frame, options)
+                             : RunDetect(scene->frame, options.detect);
     const double ms = std::chrono::duration<double, std::milli>(
                           std::chrono::steady_clock::now() - start)
                           .count();

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/baseline/pcl_clusters.h"
 #include "core/eval/detection_metrics.h"
 #include "core/pipeline/detect.h"
 
@@ -31,6 +32,10 @@ struct DetectEvalSummary {
 struct DetectEvalOptions {
   std::string data_dir;  // an OSD folder (or its learn/ subfolder)
   DetectOptions detect;
+  // Run the pcl-clusters peer instead of the attention system (uses the
+  // support plane and table scene options of `detect` only).
+  bool pcl_clusters = false;
+  PclClustersOptions clusters;
   std::string out_dir;   // when set, PNGs of maps and points per scene
   bool verbose = false;  // one line per scene on stderr
 };

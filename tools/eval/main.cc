@@ -21,7 +21,8 @@ ABSL_FLAG(std::string, data, "",
           "Defaults to $FOVEA_OSD_DIR.");
 ABSL_FLAG(std::string, saliency, "rso",
           "Saliency channels: ph, sh, rso, or a combination like ph+sh+rso "
-          "(equal weights).");
+          "(equal weights); or pcl-clusters, the peer: Euclidean clusters on "
+          "the support plane, largest first (ignores --extract).");
 ABSL_FLAG(std::string, extract, "msr", "Attention-point extraction: msr.");
 ABSL_FLAG(int, points, 10, "Attention points per scene (HR uses the first K).");
 ABSL_FLAG(bool, msr_inhibit_slope, true,
@@ -79,8 +80,10 @@ int RunDetectEval() {
     std::fprintf(stderr, "fovea-eval: --data (or FOVEA_OSD_DIR) is required\n");
     return kUsageError;
   }
+  const std::string saliency = absl::GetFlag(FLAGS_saliency);
+  options.pcl_clusters = saliency == "pcl-clusters";
   absl::StatusOr<std::vector<SaliencyOp>> ops =
-      ParseSaliencyOps(absl::GetFlag(FLAGS_saliency));
+      ParseSaliencyOps(options.pcl_clusters ? "rso" : saliency);
   if (!ops.ok()) {
     std::fprintf(stderr, "fovea-eval: --%s\n", ops.status().ToString().c_str());
     return kUsageError;
