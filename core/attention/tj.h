@@ -1,0 +1,75 @@
+#ifndef FOVEA_CORE_ATTENTION_TJ_H_
+#define FOVEA_CORE_ATTENTION_TJ_H_
+
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/attention/attention_point.h"
+
+namespace fovea {
+
+struct TjOptions {
+  // theta_sal: components whose mean saliency is below this fraction of the
+  // map's global maximum are dropped (thesis sections 2.5.3 and 3.2.1:
+  // 10 %); range [0, 1].
+  float min_mean_fraction = 0.1f;
+};
+
+absl::Status Validate(const TjOptions& options);
+
+// T-junction attention points (thesis sections 2.5.3 and 3.2.1).
+//
+// `map` is CV_32FC1; pixels with saliency > 0 are foreground (NaN is
+// background). Steps:
+//  1. 8-connected components of the foreground.
+//  2. Drop components whose mean saliency is below
+//     theta_sal = min_mean_fraction * (global maximum of the map).
+//  3. Skeleton of each kept component (see ThinToSkeleton).
+//  4. The component's point is a junction of its skeleton, a skeleton pixel
+//     with SkeletonBranchCount >= 3. With several junctions, the one with
+//     the highest map saliency (the most salient place where parts meet);
+//     ties go to the junction nearest the component's saliency-weighted
+//     centroid, then to the first in row-major order. Without a junction,
+//     the point is the middle of the skeleton's longest path: the path
+//     between the two ends of a double breadth-first search (8-connected
+//     steps), and the pixel on it whose Euclidean arc length from one end
+//     is nearest half the path's length. A one-pixel skeleton gives that
+//     pixel; a loop gives a pixel on the loop.
+//  5. Points are ranked by their component's mean saliency, highest first
+//     (ties: the component whose first pixel comes first in row-major
+//     order), and cut to `max_points`. A point's saliency is its
+//     component's mean.
+// Work is one pass over the map plus, per kept component, work bounded by
+// its area (thinning visits only the component's border pixels).
+// An all-zero map gives no points.
+// Errors: empty map or wrong type, an infinite map value, max_points < 0,
+// invalid options.
+absl::StatusOr<std::vector<AttentionPoint>> ExtractTjPoints(
+    const cv::Mat& map, int max_points, const TjOptions& options);
+
+// Skeleton of a binary image, as ExtractTjPoints makes it (exposed for
+// tests and pictures). `mask` is CV_8UC1, non-zero = foreground. Each
+// 8-connected component is thinned by Guo & Hall's parallel algorithm A1
+// (Guo & Hall 1989, "Parallel thinning with two-subiteration algorithms"),
+// which keeps every component connected (never deletes one whole) and keeps
+// holes as loops, then staircase corners are removed one pixel at a time: a
+// pixel with two perpendicular 4-neighbours set whose opposite two
+// 4-neighbours and the diagonal between those are clear is redundant in
+// 8-connectivity. The result is a one-pixel-wide, 8-connected skeleton per
+// component. Returns CV_8UC1, 255 on the skeleton, 0 elsewhere.
+// Errors: empty mask or wrong type.
+absl::StatusOr<cv::Mat> ThinToSkeleton(const cv::Mat& mask);
+
+// Number of skeleton branches leaving pixel (u, v) of `skeleton` (CV_8UC1,
+// non-zero = skeleton; pixels outside the image count as 0): the number of
+// 0 -> 1 transitions going once round its eight neighbours N, NE, E, SE, S,
+// SW, W, NW, N (Rutovitz's crossing number). 1 at the end of a line, 2 on
+// a line (also on a diagonal staircase, where a naive count of neighbours
+// gives 3 or 4), >= 3 at a junction. Returns 0 for a pixel outside the
+// image.
+int SkeletonBranchCount(const cv::Mat& skeleton, int u, int v);
+
+}  // namespace fovea
+
+#endif  // FOVEA_CORE_ATTENTION_TJ_H_
