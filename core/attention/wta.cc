@@ -194,6 +194,9 @@ absl::StatusOr<std::vector<AttentionPoint>> ExtractWtaPoints(
   const Layer layer = BuildLayer(map, options.level);
   const float max_mean =
       *std::max_element(layer.mean.begin(), layer.mean.end());
+  if (!std::isfinite(max_mean)) {
+    return absl::InvalidArgumentError("wta: map has an infinite value");
+  }
   if (!(max_mean > 0.0f)) return points;
   std::vector<float> current(layer.mean.size());
   for (size_t i = 0; i < current.size(); ++i) {

@@ -68,7 +68,8 @@ absl::Status Validate(const WtaOptions& options);
 // is bounded by max_points * (max_time_s / dt) steps over the layer.
 // Deterministic (unlike the SaliencyToolbox, no input noise).
 // Fewer points come back when the map runs out; an all-zero map gives none.
-// Errors: empty map or wrong type, max_points < 0, invalid options.
+// Errors: empty map or wrong type, an infinite map value, max_points < 0,
+// invalid options.
 absl::StatusOr<std::vector<AttentionPoint>> ExtractWtaPoints(
     const cv::Mat& map, int max_points, const WtaOptions& options);
 

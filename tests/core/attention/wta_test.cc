@@ -151,6 +151,9 @@ TEST(WtaTest, RejectsBadInputNamingTheField) {
             absl::StatusCode::kInvalidArgument);
   EXPECT_EQ(ExtractWtaPoints(map, -1, {}).status().code(),
             absl::StatusCode::kInvalidArgument);
+  map.at<float>(3, 3) = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(ExtractWtaPoints(map, 3, {}).status().code(),
+            absl::StatusCode::kInvalidArgument);
 }
 
 // A 640x480 map like a table scene's: Gaussian blobs and rectangles. Prints
