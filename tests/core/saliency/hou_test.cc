@@ -1,0 +1,112 @@
+#include "core/saliency/hou.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <string>
+
+namespace fovea {
+namespace {
+
+const cv::Vec3b kGrey(128, 128, 128);
+const cv::Vec3b kRed(255, 0, 0);
+
+// A red disc of radius 12 px on a grey 256 x 192 background, off centre so
+// that a map peaking at the image centre fails.
+cv::Mat RedDiscOnGrey(cv::Point center) {
+  cv::Mat image(192, 256, CV_8UC3, cv::Scalar(kGrey));
+  cv::circle(image, center, 12, cv::Scalar(kRed), cv::FILLED);
+  return image;
+}
+
+void ExpectIsSaliencyMap(const cv::Mat& map, cv::Size size) {
+  ASSERT_EQ(map.type(), CV_32FC1);
+  ASSERT_EQ(map.size(), size);
+  double lo = 0.0, hi = 0.0;
+  cv::minMaxLoc(map, &lo, &hi);
+  EXPECT_GE(lo, 0.0);
+  EXPECT_LE(hi, 1.0);
+}
+
+TEST(HouSaliencyTest, RedDiscOnGreyIsTheMostSalientSpot) {
+  const cv::Point center(184, 64);
+  absl::StatusOr<cv::Mat> map =
+      ComputeHouSaliency(RedDiscOnGrey(center), HouOptions{});
+  ASSERT_TRUE(map.ok()) << map.status();
+  ExpectIsSaliencyMap(*map, cv::Size(256, 192));
+  cv::Point peak;
+  double hi = 0.0;
+  cv::minMaxLoc(*map, nullptr, &hi, nullptr, &peak);
+  EXPECT_FLOAT_EQ(hi, 1.0f);
+  // The spectrum is taken at 64 px width (4 px cells): the peak lies on the
+  // disc or within two cells of its rim.
+  EXPECT_LT(cv::norm(peak - center), 12.0 + 8.0) << peak;
+  // Far from the disc (the opposite half of the image) nothing stands out.
+  double far_max = 0.0;
+  cv::minMaxLoc((*map)(cv::Rect(0, 0, 96, 192)), nullptr, &far_max);
+  EXPECT_LT(far_max, 0.2);
+}
+
+TEST(HouSaliencyTest, UniformImageGivesAnAllZeroMap) {
+  const cv::Mat image(96, 128, CV_8UC3, cv::Scalar(40, 160, 90));
+  absl::StatusOr<cv::Mat> map = ComputeHouSaliency(image, HouOptions{});
+  ASSERT_TRUE(map.ok()) << map.status();
+  ExpectIsSaliencyMap(*map, image.size());
+  EXPECT_EQ(cv::countNonZero(*map), 0);
+}
+
+TEST(HouSaliencyTest, OddSizedNoiseGivesAMapInUnitRangeAtInputSize) {
+  cv::Mat image(77, 101, CV_8UC3);
+  cv::randu(image, cv::Scalar::all(0), cv::Scalar::all(256));
+  absl::StatusOr<cv::Mat> map = ComputeHouSaliency(image, HouOptions{});
+  ASSERT_TRUE(map.ok()) << map.status();
+  ExpectIsSaliencyMap(*map, image.size());
+  double hi = 0.0;
+  cv::minMaxLoc(*map, nullptr, &hi);
+  EXPECT_FLOAT_EQ(hi, 1.0f);
+}
+
+TEST(HouSaliencyTest, TinyImageStillGivesAMap) {
+  cv::Mat image(3, 2, CV_8UC3, cv::Scalar(kGrey));
+  image.at<cv::Vec3b>(1, 1) = kRed;
+  absl::StatusOr<cv::Mat> map = ComputeHouSaliency(image, HouOptions{});
+  ASSERT_TRUE(map.ok()) << map.status();
+  ExpectIsSaliencyMap(*map, image.size());
+}
+
+TEST(HouSaliencyTest, EmptyOrWrongTypeColorIsInvalidArgumentNamingColor) {
+  absl::Status s = ComputeHouSaliency(cv::Mat(), HouOptions{}).status();
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(s.message(), "color: empty");
+  s = ComputeHouSaliency(cv::Mat(4, 4, CV_8UC1, cv::Scalar(0)), HouOptions{})
+          .status();
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(std::string(s.message()).find("color:"), std::string::npos);
+}
+
+TEST(HouSaliencyTest, ValidateNamesTheField) {
+  const auto expect_rejected = [](HouOptions options, const char* field) {
+    const absl::Status s = Validate(options);
+    EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument) << field;
+    EXPECT_NE(std::string(s.message()).find(field), std::string::npos)
+        << s.message();
+  };
+  EXPECT_TRUE(Validate(HouOptions{}).ok());
+  HouOptions o;
+  o.working_width = 4;
+  expect_rejected(o, "hou.working_width");
+  o = {};
+  o.average_size = 4;
+  expect_rejected(o, "hou.average_size");
+  o = {};
+  o.blur_sigma_px = 0.0;
+  expect_rejected(o, "hou.blur_sigma_px");
+  o = {};
+  o.average_size = 1;
+  EXPECT_EQ(ComputeHouSaliency(RedDiscOnGrey({64, 64}), o).status().code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace fovea

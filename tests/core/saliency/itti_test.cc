@@ -1,0 +1,164 @@
+#include "core/saliency/itti.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <string>
+
+namespace fovea {
+namespace {
+
+const cv::Vec3b kGrey(128, 128, 128);
+const cv::Vec3b kRed(255, 0, 0);
+
+// A red disc of radius 12 px on a grey 256 x 192 background, off centre so
+// that a map peaking at the image centre fails.
+cv::Mat RedDiscOnGrey(cv::Point center) {
+  cv::Mat image(192, 256, CV_8UC3, cv::Scalar(kGrey));
+  cv::circle(image, center, 12, cv::Scalar(kRed), cv::FILLED);
+  return image;
+}
+
+// Black bars on grey, 6 x 4 of them at 640 x 480, all horizontal but one
+// vertical at (476, 184): the classic orientation pop-out (Treisman;
+// shown by Itti 1998). Bar 60 x 12 px, about the size level 2-4 filters see.
+constexpr int kOddBarX = 476, kOddBarY = 184;
+cv::Mat OddBarOut() {
+  cv::Mat image(480, 640, CV_8UC3, cv::Scalar(kGrey));
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 4; ++j) {
+      const cv::Point c(60 + i * 104, 70 + j * 114);
+      const bool odd = c.x == kOddBarX && c.y == kOddBarY;
+      const cv::Point half = odd ? cv::Point(6, 30) : cv::Point(30, 6);
+      cv::rectangle(image, c - half, c + half, cv::Scalar(0, 0, 0), cv::FILLED);
+    }
+  }
+  return image;
+}
+
+void ExpectIsSaliencyMap(const cv::Mat& map, cv::Size size) {
+  ASSERT_EQ(map.type(), CV_32FC1);
+  ASSERT_EQ(map.size(), size);
+  double lo = 0.0, hi = 0.0;
+  cv::minMaxLoc(map, &lo, &hi);
+  EXPECT_GE(lo, 0.0);
+  EXPECT_LE(hi, 1.0);
+}
+
+TEST(IttiSaliencyTest, RedDiscOnGreyIsTheMostSalientSpot) {
+  const cv::Point center(184, 64);
+  absl::StatusOr<cv::Mat> map =
+      ComputeIttiSaliency(RedDiscOnGrey(center), IttiOptions{});
+  ASSERT_TRUE(map.ok()) << map.status();
+  ExpectIsSaliencyMap(*map, cv::Size(256, 192));
+  cv::Point peak;
+  double hi = 0.0;
+  cv::minMaxLoc(*map, nullptr, &hi, nullptr, &peak);
+  EXPECT_FLOAT_EQ(hi, 1.0f);
+  // Level 4 (the map level) has 16 px cells: the peak lies on the disc or
+  // within one cell of its rim.
+  EXPECT_LT(cv::norm(peak - center), 12.0 + 16.0) << peak;
+  // Far from the disc (the opposite half of the image) nothing stands out.
+  double far_max = 0.0;
+  cv::minMaxLoc((*map)(cv::Rect(0, 0, 96, 192)), nullptr, &far_max);
+  EXPECT_LT(far_max, 0.2);
+}
+
+TEST(IttiSaliencyTest, OddOrientationPopsOut) {
+  // N(.) must suppress the 23 equal peaks of the horizontal bars and keep
+  // the single one of the vertical bar.
+  absl::StatusOr<cv::Mat> map = ComputeIttiSaliency(OddBarOut(), {});
+  ASSERT_TRUE(map.ok()) << map.status();
+  cv::Point peak;
+  cv::minMaxLoc(*map, nullptr, nullptr, nullptr, &peak);
+  EXPECT_LT(cv::norm(peak - cv::Point(kOddBarX, kOddBarY)), 30.0) << peak;
+}
+
+TEST(IttiSaliencyTest, UniformImageGivesAnAllZeroMap) {
+  const cv::Mat image(96, 128, CV_8UC3, cv::Scalar(40, 160, 90));
+  absl::StatusOr<cv::Mat> map = ComputeIttiSaliency(image, IttiOptions{});
+  ASSERT_TRUE(map.ok()) << map.status();
+  ExpectIsSaliencyMap(*map, image.size());
+  EXPECT_EQ(cv::countNonZero(*map), 0);
+}
+
+TEST(IttiSaliencyTest, OddSizedNoiseGivesAMapInUnitRangeAtInputSize) {
+  cv::Mat image(77, 101, CV_8UC3);
+  cv::randu(image, cv::Scalar::all(0), cv::Scalar::all(256));
+  absl::StatusOr<cv::Mat> map = ComputeIttiSaliency(image, IttiOptions{});
+  ASSERT_TRUE(map.ok()) << map.status();
+  ExpectIsSaliencyMap(*map, image.size());
+  double hi = 0.0;
+  cv::minMaxLoc(*map, nullptr, &hi);
+  EXPECT_FLOAT_EQ(hi, 1.0f);
+}
+
+TEST(IttiSaliencyTest, TinyImageStillGivesAMap) {
+  cv::Mat image(3, 2, CV_8UC3, cv::Scalar(kGrey));
+  image.at<cv::Vec3b>(1, 1) = kRed;
+  absl::StatusOr<cv::Mat> map = ComputeIttiSaliency(image, IttiOptions{});
+  ASSERT_TRUE(map.ok()) << map.status();
+  ExpectIsSaliencyMap(*map, image.size());
+}
+
+TEST(IttiSaliencyTest, EmptyOrWrongTypeColorIsInvalidArgumentNamingColor) {
+  absl::Status s = ComputeIttiSaliency(cv::Mat(), IttiOptions{}).status();
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(s.message(), "color: empty");
+  s = ComputeIttiSaliency(cv::Mat(4, 4, CV_8UC1, cv::Scalar(0)), IttiOptions{})
+          .status();
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(std::string(s.message()).find("color:"), std::string::npos);
+}
+
+TEST(IttiSaliencyTest, ValidateNamesTheField) {
+  const auto expect_rejected = [](IttiOptions options, const char* field) {
+    const absl::Status s = Validate(options);
+    EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument) << field;
+    EXPECT_NE(std::string(s.message()).find(field), std::string::npos)
+        << s.message();
+  };
+  EXPECT_TRUE(Validate(IttiOptions{}).ok());
+  IttiOptions o;
+  o.min_center_level = 5;  // above max_center_level 4
+  expect_rejected(o, "itti.min_center_level");
+  o = {};
+  o.min_delta = 0;
+  expect_rejected(o, "itti.min_delta");
+  o = {};
+  o.max_delta = 9;
+  expect_rejected(o, "itti.max_delta");
+  o = {};
+  o.map_level = -1;
+  expect_rejected(o, "itti.map_level");
+  o = {};
+  o.gabor_wavelength_px = 0.0;
+  expect_rejected(o, "itti.gabor_wavelength_px");
+  o = {};
+  o.gabor_sigma_px = -1.0;
+  expect_rejected(o, "itti.gabor_sigma_px");
+  o = {};
+  o.gabor_kernel_size = 8;
+  expect_rejected(o, "itti.gabor_kernel_size");
+  o = {};
+  o.color_intensity_threshold = 1.0f;
+  expect_rejected(o, "itti.color_intensity_threshold");
+  o = {};
+  o.local_max_threshold = NAN;
+  expect_rejected(o, "itti.local_max_threshold");
+  o = {};
+  o.color_weight = -1.0f;
+  expect_rejected(o, "itti.color_weight");
+  o = {};
+  o.intensity_weight = o.color_weight = o.orientation_weight = 0.0f;
+  expect_rejected(o, "itti.intensity_weight");
+  // ComputeIttiSaliency checks the options too.
+  o = {};
+  o.gabor_kernel_size = 2;
+  EXPECT_EQ(ComputeIttiSaliency(RedDiscOnGrey({64, 64}), o).status().code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace fovea
