@@ -305,10 +305,10 @@ absl::StatusOr<DetectOptions> ToDetectOptions(
         CheckTopDownCues(options)}) {
     if (!status.ok()) return status;
   }
-  if (options.max_points() > static_cast<uint32_t>(kMaxPointsLimit)) {
+  if (options.max_points() > static_cast<uint32_t>(kMaxAttentionPoints)) {
     return absl::InvalidArgumentError(
         absl::StrCat("options.max_points: ", options.max_points(), " is above ",
-                     kMaxPointsLimit));
+                     kMaxAttentionPoints));
   }
   if (options.max_points() != 0) {
     out.max_points = static_cast<int>(options.max_points());

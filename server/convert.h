@@ -15,9 +15,6 @@ namespace fovea::server {
 // Conversions between the wire contract (fovea.v1) and core/'s types. No
 // gRPC here: every function is tested on its own.
 
-// Largest `max_points` a request may ask for (detect.proto).
-inline constexpr int kMaxPointsLimit = 100;
-
 // The wire frame as core's RawFrame. Non-owning: the views point into
 // `frame`'s strings, which must outlive the result. Nothing is checked
 // here; DecodeFrame validates and names the wire fields.
@@ -43,8 +40,8 @@ v1::Frame ToProtoFrame(const RgbdFrame& frame, DepthEncoding depth_encoding,
 //     is INVALID_ARGUMENT naming "options.saliency[i]...";
 //   - an UNSPECIFIED enum means core's default; a value outside the enum
 //     (proto3 enums are open) is INVALID_ARGUMENT naming the field;
-//   - max_points 0 means 10; above kMaxPointsLimit is INVALID_ARGUMENT
-//     naming "options.max_points";
+//   - max_points 0 means 10; above core's kMaxAttentionPoints is
+//     INVALID_ARGUMENT naming "options.max_points";
 //   - target_color_rgb must be empty or 3 values of at most 255, and
 //     location_prior_sigma_px finite and >= 0 (INVALID_ARGUMENT);
 //   - finally core's Validate(DetectOptions): an operator or strategy not

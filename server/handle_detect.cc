@@ -1,25 +1,17 @@
 #include "server/handle_detect.h"
 
-#include <chrono>
 #include <string>
 
+#include "server/clock.h"
 #include "server/convert.h"
 
 namespace fovea::server {
-namespace {
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-      .count();
-}
-
-}  // namespace
 
 absl::StatusOr<v1::DetectResponse> HandleDetect(
     const v1::DetectRequest& request, const DetectOptions& options,
     const FrameLimits& limits, const InterruptCheck& interrupt,
     double queue_seconds) {
-  auto start = std::chrono::steady_clock::now();
+  Clock::time_point start = Clock::now();
   absl::StatusOr<RgbdFrame> frame =
       DecodeFrame(ToRawFrame(request.frame()), limits);
   if (!frame.ok()) return frame.status();
@@ -31,7 +23,7 @@ absl::StatusOr<v1::DetectResponse> HandleDetect(
   absl::StatusOr<DetectResult> result = RunDetect(*frame, options, interrupt);
   if (!result.ok()) return result.status();
 
-  start = std::chrono::steady_clock::now();
+  start = Clock::now();
   absl::StatusOr<v1::DetectResponse> response =
       ToDetectResponse(*result, request);
   if (!response.ok()) return response.status();

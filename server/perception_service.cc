@@ -1,6 +1,8 @@
 #include "server/perception_service.h"
 
 #include <chrono>
+#include <exception>
+#include <new>
 #include <string>
 #include <utility>
 
@@ -9,6 +11,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "server/capabilities.h"
+#include "server/clock.h"
 #include "server/convert.h"
 #include "server/handle_detect.h"
 #include "server/log.h"
@@ -20,12 +23,6 @@ namespace {
 
 // Longest request_id written to the log; the id comes from the client.
 constexpr size_t kMaxLoggedRequestId = 128;
-
-using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // The metrics and the log line of one call: started when constructed,
 // handled at End*. Each call ends exactly once.
@@ -112,27 +109,48 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
   void OnDone() override { delete this; }
 
  private:
-  // On a worker thread.
+  // On a worker thread. Completes the call exactly once, whatever
+  // happens: an exception from anywhere in the job (core catches its own,
+  // but decoding, conversion and the test hooks run outside it) becomes
+  // RESOURCE_EXHAUSTED (out of memory) or INTERNAL instead of leaving the
+  // call unfinished or reaching the WorkQueue.
   void Run() {
+    absl::Status status;
+    try {
+      status = Compute();
+    } catch (const std::bad_alloc&) {
+      status = absl::ResourceExhaustedError("Detect: out of memory");
+    } catch (const std::exception& e) {
+      status = absl::InternalError(
+          absl::StrCat("Detect: unexpected exception: ", e.what()));
+    } catch (...) {
+      status = absl::InternalError(
+          "Detect: unexpected exception of a non-standard type");
+    }
+    Complete(status);
+  }
+
+  // The job's work; fills *response_ when OK. May throw.
+  absl::Status Compute() {
     const double queue_seconds = SecondsSince(submitted_);
     RecordQueueWait(queue_seconds);
     if (config_.before_detect_job) config_.before_detect_job();
     if (absl::Status status = CheckInterrupt(*context_); !status.ok()) {
-      Complete(status);
-      return;
+      return status;
     }
     absl::StatusOr<v1::DetectResponse> response = HandleDetect(
         *request_, options_, config_.limits,
-        [this] { return CheckInterrupt(*context_); }, queue_seconds);
-    if (!response.ok()) {
-      Complete(response.status());
-      return;
-    }
+        [this] {
+          if (config_.at_stage_boundary) config_.at_stage_boundary();
+          return CheckInterrupt(*context_);
+        },
+        queue_seconds);
+    if (!response.ok()) return response.status();
     for (const v1::StageTiming& timing : response->timings()) {
       RecordStage(timing.stage(), timing.seconds());
     }
     *response_ = *std::move(response);
-    Complete(absl::OkStatus());
+    return absl::OkStatus();
   }
 
   // The last thing the reactor does: OnDone may delete it right after.

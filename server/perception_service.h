@@ -19,6 +19,11 @@ struct ServiceConfig {
   // start of every Detect job, before the deadline check. Tests block it
   // to fill the queue deterministically.
   std::function<void()> before_detect_job;
+  // Test hook, null in production: called on the worker thread at every
+  // stage boundary of a Detect job (after decoding, and between core's
+  // stages), right before the deadline and cancellation check there.
+  // Tests block it to let a deadline pass in the middle of the pipeline.
+  std::function<void()> at_stage_boundary;
 };
 
 // fovea.v1.Perception on gRPC's callback API. Handlers are thin: they
@@ -34,7 +39,8 @@ struct ServiceConfig {
 // when the job starts (a job that expired while queued is not computed)
 // and between stages: DEADLINE_EXCEEDED once it passed, CANCELLED when
 // the call was cancelled (by the client, or by a shutdown past its grace
-// period).
+// period). An exception thrown in the job completes the call with INTERNAL
+// (RESOURCE_EXHAUSTED when out of memory); the server goes on.
 // Segment, SegmentIncremental: UNIMPLEMENTED until their issues land.
 // GetCapabilities: BuildCapabilities, computed once.
 class PerceptionService final : public v1::Perception::CallbackService {

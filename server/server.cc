@@ -3,7 +3,6 @@
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/health_check_service_interface.h>
 
-#include <chrono>
 #include <utility>
 #include <vector>
 
@@ -11,6 +10,7 @@
 #include "absl/strings/str_format.h"
 #include "core/synth/synth_scene.h"
 #include "server/capabilities.h"
+#include "server/clock.h"
 #include "server/convert.h"
 #include "server/handle_detect.h"
 #include "server/log.h"
@@ -49,16 +49,11 @@ v1::DetectRequest WarmUpRequest() {
   return request;
 }
 
-// Stage names known before any call: the server's own, and core's
-// "saliency.<op>" and "extract.<strategy>" for what core implements. The
-// warm-up adds the rest of core's (cloud, normals, ...).
-std::vector<std::string> KnownStages() {
+// Every stage a Detect response can time: the server's own and core's.
+std::vector<std::string> DetectStages() {
   std::vector<std::string> stages = {"queue", "decode", "encode"};
-  for (SaliencyOp op : ImplementedSaliencyOps()) {
-    stages.push_back("saliency." + std::string(SaliencyOpName(op)));
-  }
-  for (ExtractionKind kind : ImplementedExtractions()) {
-    stages.push_back("extract." + std::string(ExtractionName(kind)));
+  for (std::string& stage : DetectStageNames()) {
+    stages.push_back(std::move(stage));
   }
   return stages;
 }
@@ -93,7 +88,7 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
     ServerConfig config) {
   if (absl::Status status = Validate(config); !status.ok()) return status;
   InitMetrics(ServerVersion());
-  InitStageSeries(KnownStages());
+  InitStageSeries(DetectStages());
 
   std::unique_ptr<FoveaServer> server(new FoveaServer);
   if (!config.metrics_listen.empty()) {
@@ -106,7 +101,7 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
   server->service_ = std::make_unique<PerceptionService>(
       ServiceConfig{config.limits,
                     static_cast<uint64_t>(config.max_message_bytes),
-                    config.before_detect_job},
+                    config.before_detect_job, config.at_stage_boundary},
       server->work_.get());
 
   grpc::EnableDefaultHealthCheckService(true);
@@ -139,9 +134,11 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
 
   if (config.warm_up) {
     FoveaServer* self = server.get();
-    const FrameLimits limits = config.limits;
     server->warm_up_thread_ =
-        std::thread([self, limits] { self->WarmUp(limits); });
+        std::thread([self, limits = config.limits,
+                     before_warm_up = std::move(config.before_warm_up)] {
+          self->WarmUp(limits, before_warm_up);
+        });
   } else {
     {
       absl::MutexLock lock(&server->mu_);
@@ -172,22 +169,17 @@ void FoveaServer::SetServing(bool serving) {
   }
 }
 
-void FoveaServer::WarmUp(const FrameLimits& limits) {
-  const auto start = std::chrono::steady_clock::now();
+void FoveaServer::WarmUp(const FrameLimits& limits,
+                         const std::function<void()>& before_warm_up) {
+  if (before_warm_up) before_warm_up();
+  const Clock::time_point start = Clock::now();
   const v1::DetectRequest request = WarmUpRequest();
   absl::StatusOr<DetectOptions> options = ToDetectOptions(request.options());
   absl::StatusOr<v1::DetectResponse> response =
       options.ok() ? HandleDetect(request, *options, limits, {}, 0.0)
                    : absl::StatusOr<v1::DetectResponse>(options.status());
-  const double ms = std::chrono::duration<double, std::milli>(
-                        std::chrono::steady_clock::now() - start)
-                        .count();
+  const double ms = SecondsSince(start) * 1e3;
   if (response.ok()) {
-    std::vector<std::string> stages;
-    for (const v1::StageTiming& timing : response->timings()) {
-      stages.push_back(timing.stage());
-    }
-    InitStageSeries(stages);
     LogInfo(absl::StrFormat("warm-up Detect done in %.1f ms, %d points", ms,
                             response->points_size()));
   } else {
@@ -221,12 +213,10 @@ void FoveaServer::Shutdown(absl::Duration grace) {
   if (server_ != nullptr) {
     LogInfo(absl::StrCat("shutting down: in-flight calls have ",
                          absl::FormatDuration(grace)));
-    const auto start = std::chrono::steady_clock::now();
+    const Clock::time_point start = Clock::now();
     server_->Shutdown(absl::ToChronoTime(absl::Now() + grace));
     LogInfo(absl::StrFormat("gRPC server stopped after %.1f ms",
-                            std::chrono::duration<double, std::milli>(
-                                std::chrono::steady_clock::now() - start)
-                                .count()));
+                            SecondsSince(start) * 1e3));
   }
   if (work_ != nullptr) work_->Stop();
   if (warm_up_thread_.joinable()) warm_up_thread_.join();

@@ -31,8 +31,13 @@ struct ServerConfig {
   int max_message_bytes = kDefaultMaxMessageBytes;  // largest request, > 0
   FrameLimits limits;                               // largest frame
   bool warm_up = true;  // run one Detect before reporting SERVING
-  // Test hook, see ServiceConfig::before_detect_job.
+  // Test hooks, null in production: see ServiceConfig::before_detect_job
+  // and ServiceConfig::at_stage_boundary.
   std::function<void()> before_detect_job;
+  std::function<void()> at_stage_boundary;
+  // Test hook, null in production: called on the warm-up thread before the
+  // warm-up Detect; tests block it to observe health before warm-up ends.
+  std::function<void()> before_warm_up;
 };
 
 // Names the flag of the first bad field (--concurrency, ...).
@@ -41,6 +46,10 @@ absl::Status Validate(const ServerConfig& config);
 // The running server: the Perception service, the grpc.health.v1 service
 // (for "" and "fovea.v1.Perception"), server reflection, the worker pool
 // and the /metrics endpoint.
+//
+// Metrics: every fovea_stage_duration_seconds series a Detect can report
+// (core's DetectStageNames plus "queue", "decode", "encode") exists at zero
+// from Start on, warm-up or not.
 //
 // Health: NOT_SERVING from start until the warm-up (one Detect on a small
 // synthetic frame, on its own thread) is done, then SERVING; NOT_SERVING
@@ -83,7 +92,8 @@ class FoveaServer {
  private:
   FoveaServer() = default;
   void SetServing(bool serving);
-  void WarmUp(const FrameLimits& limits);
+  void WarmUp(const FrameLimits& limits,
+              const std::function<void()>& before_warm_up);
 
   int port_ = 0;
   std::unique_ptr<WorkQueue> work_;

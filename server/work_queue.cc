@@ -1,10 +1,30 @@
 #include "server/work_queue.h"
 
+#include <exception>
 #include <utility>
 
+#include "absl/strings/str_cat.h"
 #include "core/base/check.h"
+#include "server/log.h"
 
 namespace fovea::server {
+namespace {
+
+// Runs `job`; logs and swallows anything it throws, so the worker lives on.
+void RunGuarded(absl::AnyInvocable<void() &&> job) {
+  try {
+    std::move(job)();
+  } catch (const std::exception& e) {
+    LogError(
+        absl::StrCat("work queue: a job threw (worker goes on): ", e.what()));
+  } catch (...) {
+    LogError(
+        "work queue: a job threw a non-standard exception (worker goes "
+        "on)");
+  }
+}
+
+}  // namespace
 
 WorkQueue::WorkQueue(int workers, int queue_capacity)
     : queue_capacity_(queue_capacity) {
@@ -29,6 +49,7 @@ bool WorkQueue::TrySubmit(absl::AnyInvocable<void() &&> job) {
 }
 
 void WorkQueue::Stop() {
+  absl::MutexLock stop_lock(&stop_mu_);
   {
     absl::MutexLock lock(&mu_);
     stopping_ = true;
@@ -60,7 +81,7 @@ void WorkQueue::WorkerLoop() {
       jobs_.pop_front();
       ++running_;
     }
-    std::move(job)();
+    RunGuarded(std::move(job));
     absl::MutexLock lock(&mu_);
     --running_;
   }

@@ -19,6 +19,12 @@ namespace fovea::server {
 // TrySubmit refuses a job beyond that, so the caller can answer
 // RESOURCE_EXHAUSTED at once instead of letting work pile up. Jobs run in
 // submission order.
+//
+// A job that throws is logged as an error and its worker goes on with the
+// next job: an exception never takes the process down. The queue cannot
+// finish a call on a job's behalf, so a job that owns a call catches what
+// it can itself and finishes the call (PerceptionService's Detect job
+// answers INTERNAL); what still escapes is only logged.
 class WorkQueue {
  public:
   // `workers` >= 1, `queue_capacity` >= 0 (checked: FOVEA_CHECK).
@@ -34,8 +40,10 @@ class WorkQueue {
   bool TrySubmit(absl::AnyInvocable<void() &&> job);
 
   // Refuses new jobs, runs every job already accepted, joins the workers.
-  // Idempotent. Accepted jobs always run: each one owns a call that must
-  // be finished.
+  // Idempotent and safe to call from several threads at once: every caller
+  // returns once the workers are joined. Accepted jobs always run: each one
+  // owns a call that must be finished. Not from a job (a worker cannot
+  // join itself).
   void Stop();
 
   int workers() const { return static_cast<int>(threads_.size()); }
@@ -50,6 +58,11 @@ class WorkQueue {
 
   const int queue_capacity_;
   std::vector<std::thread> threads_;
+
+  // Held by Stop while it joins `threads_`, so concurrent Stops neither
+  // join a thread twice nor return before the workers are gone. Taken
+  // before mu_, never while holding it.
+  absl::Mutex stop_mu_;
 
   mutable absl::Mutex mu_;
   std::deque<absl::AnyInvocable<void() &&>> jobs_ ABSL_GUARDED_BY(mu_);

@@ -66,11 +66,11 @@ TEST(ToDetectOptionsTest, ChannelWithoutOperatorIsInvalid) {
   EXPECT_THAT(status.message(), HasSubstr("options.saliency[0].op"));
 }
 
-TEST(ToDetectOptionsTest, MaxPointsAboveHundredIsInvalid) {
+TEST(ToDetectOptionsTest, MaxPointsAboveCoresLimitIsInvalid) {
   v1::DetectOptions in;
-  in.set_max_points(100);
+  in.set_max_points(kMaxAttentionPoints);
   EXPECT_TRUE(ToDetectOptions(in).ok());
-  in.set_max_points(101);
+  in.set_max_points(kMaxAttentionPoints + 1);
   absl::Status status = ToDetectOptions(in).status();
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(status.message(), HasSubstr("options.max_points"));

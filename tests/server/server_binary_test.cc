@@ -1,5 +1,5 @@
 // The fovea-server executable: --help, bad flags, and a clean exit on
-// SIGTERM.
+// SIGTERM, idle or with calls in flight.
 
 #include <grpcpp/grpcpp.h>
 #include <signal.h>
@@ -8,9 +8,12 @@
 
 #include <chrono>
 #include <cstdio>
+#include <future>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "fovea/v1/perception.grpc.pb.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/server/test_util.h"
@@ -24,6 +27,9 @@ namespace {
 
 using ::fovea::server::testing::FreePort;
 using ::fovea::server::testing::HealthStatus;
+using ::fovea::server::testing::HttpGet;
+using ::fovea::server::testing::MakeSyntheticRequest;
+using ::fovea::server::testing::MetricValue;
 using ::fovea::server::testing::WaitFor;
 using ::testing::HasSubstr;
 
@@ -85,39 +91,132 @@ TEST(ServerBinaryTest, BadFlagValueExitsNonZeroNamingIt) {
   EXPECT_THAT(output, HasSubstr("--concurrency"));
 }
 
-TEST(ServerBinaryTest, ExitsZeroOnSigtermAfterServing) {
+// A fovea-server process on loopback, started with `flags` plus --listen
+// and --metrics_listen on free ports.
+struct ServerProcess {
+  pid_t pid = -1;
+  std::string target;  // host:port of the gRPC server
+  int metrics_port = 0;
+};
+
+// Starts fovea-server and waits (up to 60 s) for health SERVING on both
+// names. Fails the test (ADD_FAILURE) and returns pid -1 when it exits
+// early or never serves.
+ServerProcess StartServing(const std::vector<std::string>& flags) {
+  ServerProcess server;
   const int port = FreePort();
-  const pid_t pid =
-      Spawn({"--listen=127.0.0.1:" + std::to_string(port),
-             "--metrics_listen=127.0.0.1:" + std::to_string(FreePort()),
-             "--concurrency=1", "--grace_period_s=5"});
-  ASSERT_GT(pid, 0);
-  const std::string target = "127.0.0.1:" + std::to_string(port);
+  server.metrics_port = FreePort();
+  server.target = "127.0.0.1:" + std::to_string(port);
+  std::vector<std::string> args = flags;
+  args.push_back("--listen=" + server.target);
+  args.push_back("--metrics_listen=127.0.0.1:" +
+                 std::to_string(server.metrics_port));
+  server.pid = Spawn(args);
+  if (server.pid <= 0) {
+    ADD_FAILURE() << "fork failed";
+    return server;
+  }
   // A fresh channel per attempt: a channel that tried before the server
   // listened may wait out gRPC's reconnect backoff (seconds).
-  auto health = [&target](const std::string& service) {
+  auto health = [&server](const std::string& service) {
     return HealthStatus(
-        grpc::CreateChannel(target, grpc::InsecureChannelCredentials()),
+        grpc::CreateChannel(server.target, grpc::InsecureChannelCredentials()),
         service);
   };
   int status = 0;
   bool exited = false;
   const bool serving = WaitFor(
       [&] {
-        exited = waitpid(pid, &status, WNOHANG) == pid;
+        exited = waitpid(server.pid, &status, WNOHANG) == server.pid;
         return exited || health("fovea.v1.Perception") == "SERVING";
       },
       std::chrono::seconds(60));
-  ASSERT_FALSE(exited) << "exited early, wait status " << status;
-  ASSERT_TRUE(serving);
-  EXPECT_EQ(health(""), "SERVING");
+  if (exited || !serving || health("") != "SERVING") {
+    ADD_FAILURE() << (exited ? "exited early, wait status " +
+                                   std::to_string(status)
+                             : std::string("not SERVING within 60 s"));
+    if (!exited) {
+      kill(server.pid, SIGKILL);
+      waitpid(server.pid, &status, 0);
+    }
+    server.pid = -1;
+  }
+  return server;
+}
 
+// Sends SIGTERM and expects exit code 0 within 30 s.
+void ExpectCleanExitOnSigterm(pid_t pid) {
   ASSERT_EQ(kill(pid, SIGTERM), 0);
-  status = WaitExit(pid, std::chrono::seconds(30));
-  if (status == -1) kill(pid, SIGKILL);
+  const int status = WaitExit(pid, std::chrono::seconds(30));
+  if (status == -1) {
+    kill(pid, SIGKILL);
+    waitpid(pid, nullptr, 0);
+  }
   ASSERT_NE(status, -1) << "did not exit within 30 s of SIGTERM";
-  EXPECT_TRUE(WIFEXITED(status));
+  EXPECT_TRUE(WIFEXITED(status)) << "wait status " << status;
   EXPECT_EQ(WEXITSTATUS(status), 0);
+}
+
+TEST(ServerBinaryTest, ExitsZeroOnSigtermAfterServing) {
+  const ServerProcess server =
+      StartServing({"--concurrency=1", "--grace_period_s=5"});
+  ASSERT_GT(server.pid, 0);
+  ExpectCleanExitOnSigterm(server.pid);
+}
+
+// Several Detects at once on one worker, so that some are computing or
+// queued when SIGTERM arrives: each ends OK (finished within the grace
+// period) or UNAVAILABLE / CANCELLED (refused or cut off by the shutdown),
+// never another error, and the process exits 0.
+TEST(ServerBinaryTest, SigtermWithCallsInFlightLetsThemEndAndExitsZero) {
+  constexpr int kCalls = 12;
+  const ServerProcess server =
+      StartServing({"--concurrency=1", "--queue=" + std::to_string(kCalls),
+                    "--grace_period_s=20", "--log_level=warn"});
+  ASSERT_GT(server.pid, 0);
+  auto channel =
+      grpc::CreateChannel(server.target, grpc::InsecureChannelCredentials());
+  auto stub = v1::Perception::NewStub(channel);
+  const v1::DetectRequest request = MakeSyntheticRequest(1, false).request;
+  std::vector<std::future<grpc::Status>> calls;
+  for (int i = 0; i < kCalls; ++i) {
+    calls.push_back(std::async(std::launch::async, [&stub, &request] {
+      grpc::ClientContext context;
+      context.set_deadline(std::chrono::system_clock::now() +
+                           std::chrono::seconds(60));
+      v1::DetectResponse response;
+      return stub->Detect(&context, request, &response);
+    }));
+  }
+  // Signal once the server holds several calls (computing or queued).
+  double inflight = 0;
+  const bool busy = WaitFor(
+      [&] {
+        const std::optional<std::string> text =
+            HttpGet(server.metrics_port, "/metrics");
+        inflight =
+            text.has_value()
+                ? MetricValue(*text, "fovea_inflight_requests", {}).value_or(0)
+                : 0;
+        return inflight >= 2;
+      },
+      std::chrono::seconds(30));
+  EXPECT_TRUE(busy) << "the server never held 2 calls at once";
+  ExpectCleanExitOnSigterm(server.pid);
+
+  int ok = 0;
+  for (std::future<grpc::Status>& call : calls) {
+    const grpc::Status status = call.get();
+    if (status.ok()) ++ok;
+    EXPECT_TRUE(status.ok() ||
+                status.error_code() == grpc::StatusCode::UNAVAILABLE ||
+                status.error_code() == grpc::StatusCode::CANCELLED)
+        << status.error_code() << ": " << status.error_message();
+  }
+  // The calls in flight at the signal had 20 s to finish: they did.
+  EXPECT_GE(ok, static_cast<int>(inflight));
+  RecordProperty("inflight_at_sigterm", static_cast<int>(inflight));
+  RecordProperty("ok", ok);
 }
 
 }  // namespace

@@ -2,14 +2,12 @@
 
 #include <grpcpp/grpcpp.h>
 
-#include <atomic>
 #include <chrono>
 #include <future>
 #include <memory>
 #include <string>
 #include <thread>
 
-#include "absl/synchronization/mutex.h"
 #include "core/synth/synth_scene.h"
 #include "fovea/v1/perception.grpc.pb.h"
 #include "gmock/gmock.h"
@@ -17,125 +15,28 @@
 #include "server/capabilities.h"
 #include "server/convert.h"
 #include "server/server.h"
+#include "tests/server/server_fixture.h"
 #include "tests/server/test_util.h"
 
 namespace fovea::server {
 namespace {
 
-using ::fovea::server::testing::FreePort;
 using ::fovea::server::testing::HealthStatus;
-using ::fovea::server::testing::HttpGet;
+using ::fovea::server::testing::kCallTimeout;
 using ::fovea::server::testing::MakeSyntheticRequest;
 using ::fovea::server::testing::MetricValue;
+using ::fovea::server::testing::ServerTest;
 using ::fovea::server::testing::SyntheticRequest;
 using ::fovea::server::testing::WaitFor;
 using ::testing::HasSubstr;
 
-constexpr auto kStartTimeout = std::chrono::seconds(60);
-constexpr auto kCallTimeout = std::chrono::seconds(30);
-
-// Holds every Detect job at its start while closed; tests use it to keep a
-// worker busy and fill the queue without sleeping.
-class WorkerGate {
- public:
-  void Close() {
-    absl::MutexLock lock(&mu_);
-    open_ = false;
-  }
-  void Open() {
-    absl::MutexLock lock(&mu_);
-    open_ = true;
-  }
-  int entered() const {
-    absl::MutexLock lock(&mu_);
-    return entered_;
-  }
-  // ServiceConfig::before_detect_job: waits while the gate is closed.
-  void Pass() {
-    absl::MutexLock lock(&mu_);
-    ++entered_;
-    mu_.Await(absl::Condition(&open_));
-  }
-
- private:
-  mutable absl::Mutex mu_;
-  bool open_ = true;
-  int entered_ = 0;
-};
-
-class ServerTest : public ::testing::Test {
- protected:
-  // Starts a server with `config` adjusted for the test (ports, gate) and
-  // waits for health SERVING.
-  void StartServer(ServerConfig config = DefaultConfig()) {
-    config.listen = "127.0.0.1:" + std::to_string(FreePort());
-    config.metrics_listen = "127.0.0.1:" + std::to_string(FreePort());
-    config.before_detect_job = [this] { gate_.Pass(); };
-    absl::StatusOr<std::unique_ptr<FoveaServer>> server =
-        FoveaServer::Start(config);
-    ASSERT_TRUE(server.ok()) << server.status();
-    server_ = *std::move(server);
-    channel_ =
-        grpc::CreateChannel("127.0.0.1:" + std::to_string(server_->port()),
-                            grpc::InsecureChannelCredentials());
-    stub_ = v1::Perception::NewStub(channel_);
-    ASSERT_TRUE(
-        WaitFor([this] { return HealthStatus(channel_, "") == "SERVING"; },
-                kStartTimeout));
-  }
-
-  void TearDown() override {
-    gate_.Open();
-    if (server_ != nullptr) server_->Shutdown(absl::Seconds(5));
-  }
-
-  static ServerConfig DefaultConfig() {
-    ServerConfig config;
-    config.concurrency = 2;
-    config.queue = 4;
-    return config;
-  }
-
-  grpc::Status Detect(
-      const v1::DetectRequest& request, v1::DetectResponse* response,
-      std::chrono::milliseconds deadline =
-          std::chrono::duration_cast<std::chrono::milliseconds>(kCallTimeout)) {
-    grpc::ClientContext context;
-    context.set_deadline(std::chrono::system_clock::now() + deadline);
-    return stub_->Detect(&context, request, response);
-  }
-
-  // Detect on its own thread.
-  std::future<grpc::Status> DetectAsync(
-      v1::DetectRequest request,
-      std::chrono::milliseconds deadline =
-          std::chrono::duration_cast<std::chrono::milliseconds>(kCallTimeout)) {
-    return std::async(std::launch::async, [this, request, deadline] {
-      v1::DetectResponse response;
-      return Detect(request, &response, deadline);
-    });
-  }
-
-  std::string Scrape() {
-    std::optional<std::string> text =
-        HttpGet(server_->metrics_port(), "/metrics");
-    EXPECT_TRUE(text.has_value());
-    return text.value_or("");
-  }
-
-  double Handled(const std::string& text, const std::string& method,
-                 const std::string& code) {
-    return MetricValue(
-               text, "grpc_server_handled_total",
-               {"grpc_method=\"" + method + "\"", "grpc_code=\"" + code + "\""})
-        .value_or(-1);
-  }
-
-  WorkerGate gate_;
-  std::unique_ptr<FoveaServer> server_;
-  std::shared_ptr<grpc::Channel> channel_;
-  std::unique_ptr<v1::Perception::Stub> stub_;
-};
+// One worker and no queue: a held call is the only one the server takes.
+ServerConfig OneWorkerNoQueue() {
+  ServerConfig config;
+  config.concurrency = 1;
+  config.queue = 0;
+  return config;
+}
 
 TEST_F(ServerTest, DetectFirstPointLiesOnAnObject) {
   StartServer();
@@ -264,9 +165,8 @@ TEST_F(ServerTest, JobWhoseDeadlinePassedInTheQueueIsNotComputed) {
                   {"stage=\"decode\""})
           .value_or(-1);
 
-  gate_.Close();
-  std::future<grpc::Status> held = DetectAsync(request);
-  ASSERT_TRUE(WaitFor([this] { return gate_.entered() == 1; }, kCallTimeout));
+  std::future<grpc::Status> held = StartHeldDetect(request);
+  ASSERT_EQ(gate_.entered(), 1);
   std::future<grpc::Status> expiring =
       DetectAsync(request, std::chrono::milliseconds(1000));
   ASSERT_TRUE(
@@ -288,6 +188,57 @@ TEST_F(ServerTest, JobWhoseDeadlinePassedInTheQueueIsNotComputed) {
   EXPECT_EQ(decodes_after, decodes_before + 1);
 }
 
+// ShortDeadlineIsDeadlineExceeded passes even against a server that
+// ignores deadlines (the client gives up on its own). Here the job is held
+// at core's first stage boundary (after the cloud and normals) until the
+// deadline has passed: the server must stop it there, before saliency,
+// and answer DEADLINE_EXCEEDED itself.
+// How much later than the client's the server's copy of a deadline may
+// be (the request's transit time, generously on a loaded machine).
+constexpr auto kServerDeadlineMargin = std::chrono::milliseconds(500);
+
+TEST_F(ServerTest, DeadlinePassingMidPipelineStopsTheJobBeforeSaliency) {
+  ServerConfig config = DefaultConfig();
+  config.concurrency = 1;
+  StartServer(config);
+  const std::string before = Scrape();
+  // Boundary 1 is the server's, after decoding; 2 is core's first.
+  constexpr int kCoreFirstBoundary = 2;
+  stage_gate_.CloseAtPass(kCoreFirstBoundary);
+  std::future<grpc::Status> call = DetectAsync(
+      MakeSyntheticRequest(1, false).request, std::chrono::seconds(3));
+  ASSERT_TRUE(
+      WaitFor([this] { return stage_gate_.entered() == kCoreFirstBoundary; },
+              kCallTimeout));
+  EXPECT_EQ(call.get().error_code(), grpc::StatusCode::DEADLINE_EXCEEDED);
+  // The server's copy of the deadline is re-based on the request's arrival,
+  // so it can lie a little after the client's; until it passes, the check
+  // sees only the client's cancellation (CANCELLED). Hold a while longer so
+  // that the server's deadline check decides.
+  std::this_thread::sleep_for(kServerDeadlineMargin);
+  stage_gate_.Open();
+
+  // The server itself answers DEADLINE_EXCEEDED once released (the client
+  // has given up already: wait for the call to be counted and finished)...
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        const std::string text = Scrape();
+        return Handled(text, "Detect", "DeadlineExceeded") ==
+                   Handled(before, "Detect", "DeadlineExceeded") + 1 &&
+               MetricValue(text, "fovea_inflight_requests", {}) == 0;
+      },
+      kCallTimeout));
+  const std::string after = Scrape();
+  EXPECT_EQ(Handled(after, "Detect", "OK"), Handled(before, "Detect", "OK"));
+  // ...at the boundary where it was held: a job that went on would pass
+  // the boundary after its saliency channel too.
+  EXPECT_EQ(stage_gate_.entered(), kCoreFirstBoundary);
+  EXPECT_EQ(MetricValue(after, "fovea_stage_duration_seconds_count",
+                        {"stage=\"saliency.rso\""}),
+            MetricValue(before, "fovea_stage_duration_seconds_count",
+                        {"stage=\"saliency.rso\""}));
+}
+
 TEST_F(ServerTest, FullQueueIsResourceExhausted) {
   ServerConfig config = DefaultConfig();
   config.concurrency = 1;
@@ -295,9 +246,8 @@ TEST_F(ServerTest, FullQueueIsResourceExhausted) {
   StartServer(config);
   const v1::DetectRequest request = MakeSyntheticRequest(1, false).request;
 
-  gate_.Close();
-  std::future<grpc::Status> running = DetectAsync(request);
-  ASSERT_TRUE(WaitFor([this] { return gate_.entered() == 1; }, kCallTimeout));
+  std::future<grpc::Status> running = StartHeldDetect(request);
+  ASSERT_EQ(gate_.entered(), 1);
   std::future<grpc::Status> queued = DetectAsync(request);
   ASSERT_TRUE(
       WaitFor([this] { return server_->queued_jobs() == 1; }, kCallTimeout));
@@ -456,14 +406,10 @@ TEST_F(ServerTest, MetricsScrapeShowsCountersWithGrpcLabels) {
 }
 
 TEST_F(ServerTest, ShutdownLetsInFlightCallFinish) {
-  ServerConfig config = DefaultConfig();
-  config.concurrency = 1;
-  config.queue = 0;
-  StartServer(config);
-  gate_.Close();
+  StartServer(OneWorkerNoQueue());
   std::future<grpc::Status> in_flight =
-      DetectAsync(MakeSyntheticRequest(1, false).request);
-  ASSERT_TRUE(WaitFor([this] { return gate_.entered() == 1; }, kCallTimeout));
+      StartHeldDetect(MakeSyntheticRequest(1, false).request);
+  ASSERT_EQ(gate_.entered(), 1);
 
   std::thread shutdown([this] { server_->Shutdown(absl::Seconds(30)); });
   // Once the server stops accepting, new calls fail; then let the held
@@ -486,14 +432,10 @@ TEST_F(ServerTest, ShutdownLetsInFlightCallFinish) {
 }
 
 TEST_F(ServerTest, ShutdownCancelsCallsPastTheGracePeriod) {
-  ServerConfig config = DefaultConfig();
-  config.concurrency = 1;
-  config.queue = 0;
-  StartServer(config);
-  gate_.Close();
+  StartServer(OneWorkerNoQueue());
   std::future<grpc::Status> in_flight =
-      DetectAsync(MakeSyntheticRequest(1, false).request);
-  ASSERT_TRUE(WaitFor([this] { return gate_.entered() == 1; }, kCallTimeout));
+      StartHeldDetect(MakeSyntheticRequest(1, false).request);
+  ASSERT_EQ(gate_.entered(), 1);
 
   const auto start = std::chrono::steady_clock::now();
   std::thread shutdown([this] { server_->Shutdown(absl::Milliseconds(200)); });

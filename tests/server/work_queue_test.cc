@@ -3,6 +3,11 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
+#include <thread>
+#include <vector>
 
 #include "absl/synchronization/mutex.h"
 #include "absl/synchronization/notification.h"
@@ -25,6 +30,17 @@ bool Eventually(Condition condition) {
   return true;
 }
 
+// Submits a job that waits for `release`, then counts itself in `ran`,
+// and waits until a worker runs it. False when refused or never started.
+bool SubmitHeldJob(WorkQueue& queue, absl::Notification& release,
+                   std::atomic<int>& ran) {
+  const int running = queue.running();
+  return queue.TrySubmit([&release, &ran] {
+    release.WaitForNotification();
+    ran.fetch_add(1);
+  }) && Eventually([&] { return queue.running() == running + 1; });
+}
+
 TEST(WorkQueueTest, RunsEveryAcceptedJob) {
   std::atomic<int> ran{0};
   {
@@ -41,11 +57,7 @@ TEST(WorkQueueTest, RefusesBeyondWorkersPlusQueue) {
   WorkQueue queue(1, 1);
   absl::Notification release;
   std::atomic<int> ran{0};
-  ASSERT_TRUE(queue.TrySubmit([&] {
-    release.WaitForNotification();
-    ran.fetch_add(1);
-  }));
-  ASSERT_TRUE(Eventually([&] { return queue.running() == 1; }));
+  ASSERT_TRUE(SubmitHeldJob(queue, release, ran));
   EXPECT_TRUE(queue.TrySubmit([&] { ran.fetch_add(1); }));
   EXPECT_EQ(queue.waiting(), 1);
   EXPECT_FALSE(queue.TrySubmit([&] { ran.fetch_add(100); }));
@@ -95,10 +107,7 @@ TEST(WorkQueueTest, StopRunsQueuedJobsAndRefusesNewOnes) {
   std::atomic<int> ran{0};
   WorkQueue queue(1, 5);
   absl::Notification release;
-  ASSERT_TRUE(queue.TrySubmit([&] {
-    release.WaitForNotification();
-    ran.fetch_add(1);
-  }));
+  ASSERT_TRUE(SubmitHeldJob(queue, release, ran));
   for (int i = 0; i < 5; ++i) {
     ASSERT_TRUE(queue.TrySubmit([&] { ran.fetch_add(1); }));
   }
@@ -107,6 +116,52 @@ TEST(WorkQueueTest, StopRunsQueuedJobsAndRefusesNewOnes) {
   EXPECT_EQ(ran.load(), 6);
   EXPECT_FALSE(queue.TrySubmit([&] { ran.fetch_add(1); }));
   queue.Stop();  // idempotent
+}
+
+TEST(WorkQueueTest, JobThatThrowsDoesNotStopItsWorker) {
+  std::atomic<int> ran{0};
+  WorkQueue queue(1, 5);
+  ASSERT_TRUE(queue.TrySubmit([] { throw std::runtime_error("job failed"); }));
+  ASSERT_TRUE(queue.TrySubmit([] { throw 42; }));
+  ASSERT_TRUE(queue.TrySubmit([&ran] { ran.fetch_add(1); }));
+  // The only worker survived both throws and ran the third job.
+  ASSERT_TRUE(Eventually([&] { return ran.load() == 1; }));
+  EXPECT_EQ(queue.running(), 0);
+  EXPECT_TRUE(queue.TrySubmit([&ran] { ran.fetch_add(1); }));
+  queue.Stop();
+  EXPECT_EQ(ran.load(), 2);
+}
+
+TEST(WorkQueueTest, ConcurrentStopsJoinOnceAndReturnAfterTheJobs) {
+  constexpr int kStoppers = 4;
+  WorkQueue queue(2, 2);
+  absl::Notification release;
+  std::atomic<int> ran{0};
+  ASSERT_TRUE(SubmitHeldJob(queue, release, ran));
+  // Every stopper reaches the joins while the job is held.
+  std::vector<int> ran_when_stopped(kStoppers, -1);
+  std::atomic<int> stopped{0};
+  std::vector<std::thread> stoppers;
+  for (int i = 0; i < kStoppers; ++i) {
+    stoppers.emplace_back([&, i] {
+      queue.Stop();
+      ran_when_stopped[i] = ran.load();
+      stopped.fetch_add(1);
+    });
+  }
+  absl::SleepFor(absl::Milliseconds(100));
+  release.Notify();
+  if (!Eventually([&] { return stopped.load() == kStoppers; })) {
+    // Two threads joining one worker can block for ever: fail now rather
+    // than hang (the stuck threads cannot be joined or destroyed).
+    ADD_FAILURE() << "a concurrent Stop never returned";
+    std::fflush(nullptr);
+    std::_Exit(1);
+  }
+  for (std::thread& stopper : stoppers) stopper.join();
+  // No Stop returned before the accepted job had run.
+  for (int i = 0; i < kStoppers; ++i) EXPECT_EQ(ran_when_stopped[i], 1) << i;
+  EXPECT_FALSE(queue.TrySubmit([] {}));
 }
 
 }  // namespace

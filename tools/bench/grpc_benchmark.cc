@@ -13,6 +13,7 @@
 #include "absl/time/time.h"
 #include "core/pipeline/detect.h"
 #include "fovea/v1/perception.grpc.pb.h"
+#include "server/convert.h"
 #include "server/log.h"
 #include "server/server.h"
 
@@ -64,46 +65,19 @@ absl::StatusOr<Loopback*> StartLoopback() {
   return loopback.get();
 }
 
-v1::Image ToProtoImage(const RawImage& image) {
-  v1::Image out;
-  out.set_width(image.width);
-  out.set_height(image.height);
-  out.set_encoding(std::string(image.encoding));
-  out.set_step(image.step);
-  out.set_data(std::string(image.data));
-  return out;
-}
-
-v1::SaliencyOperator ToProtoOperator(SaliencyOp op) {
-  switch (op) {
-    case SaliencyOp::kPh:
-      return v1::PH;
-    case SaliencyOp::kSh:
-      return v1::SH;
-    case SaliencyOp::kRso:
-      return v1::RSO;
-    default:  // not benchmarked; the server answers UNIMPLEMENTED
-      return v1::SALIENCY_OPERATOR_UNSPECIFIED;
-  }
-}
-
 v1::DetectRequest MakeRequest(const BenchScene& scene,
                               const std::vector<SaliencyOp>& ops) {
   v1::DetectRequest request;
   request.set_request_id(scene.name);
-  v1::Frame& frame = *request.mutable_frame();
-  *frame.mutable_color() = ToProtoImage(scene.raw_wire.color);
-  *frame.mutable_depth() = ToProtoImage(scene.raw_wire.depth);
-  frame.mutable_intrinsics()->set_fx(scene.raw_wire.intrinsics.fx);
-  frame.mutable_intrinsics()->set_fy(scene.raw_wire.intrinsics.fy);
-  frame.mutable_intrinsics()->set_cx(scene.raw_wire.intrinsics.cx);
-  frame.mutable_intrinsics()->set_cy(scene.raw_wire.intrinsics.cy);
-  frame.set_depth_scale(scene.raw_wire.depth_scale);
-  frame.set_frame_id("camera");
+  // The same bytes as `scene.raw_wire`: rgb8 and 16UC1 in the wire unit
+  // (scene.frame was decoded from it, so the rounding is exact).
+  *request.mutable_frame() = server::ToProtoFrame(
+      scene.frame, server::DepthEncoding::k16UC1, kWireDepthScale);
+  request.mutable_frame()->set_frame_id("camera");
   v1::DetectOptions& options = *request.mutable_options();
   for (const SaliencyOp op : ops) {
     v1::WeightedOperator& weighted = *options.add_saliency();
-    weighted.set_op(ToProtoOperator(op));
+    weighted.set_op(server::ToProtoEnum(op));
     weighted.set_weight(1.0);
   }
   options.set_extraction(v1::MSR);
