@@ -192,6 +192,41 @@ absl::Status CheckTopDownCues(const v1::DetectOptions& options) {
   return absl::OkStatus();
 }
 
+bool Uses(const DetectOptions& options, SaliencyOp op) {
+  for (const WeightedChannel& c : options.channels) {
+    if (c.op == op) return true;
+  }
+  return false;
+}
+
+// Copies the top-down cues (checked by CheckTopDownCues) into `out`; a cue
+// channel without its cue is INVALID_ARGUMENT naming the missing field.
+absl::Status ApplyTopDownCues(const v1::DetectOptions& options,
+                              DetectOptions& out) {
+  if (options.target_color_rgb_size() == 3) {
+    for (int i = 0; i < 3; ++i) {
+      out.target_color.rgb[i] =
+          static_cast<uint8_t>(options.target_color_rgb(i));
+    }
+  } else if (Uses(out, SaliencyOp::kTargetColor)) {
+    return absl::InvalidArgumentError(
+        "options.target_color_rgb: TARGET_COLOR needs the colour, 3 values");
+  }
+  if (options.has_location_prior()) {
+    out.location_prior.u = static_cast<float>(options.location_prior().u());
+    out.location_prior.v = static_cast<float>(options.location_prior().v());
+    if (options.location_prior_sigma_px() > 0.0) {
+      out.location_prior.sigma_px =
+          static_cast<float>(options.location_prior_sigma_px());
+    }
+  } else if (Uses(out, SaliencyOp::kLocationPrior)) {
+    return absl::InvalidArgumentError(
+        "options.location_prior: LOCATION_PRIOR needs the pixel it is "
+        "centred on");
+  }
+  return absl::OkStatus();
+}
+
 v1::Point3 ToPoint3(const Eigen::Vector3f& p) {
   v1::Point3 out;
   out.set_x(p.x());
@@ -314,9 +349,12 @@ absl::StatusOr<DetectOptions> ToDetectOptions(
     out.max_points = static_cast<int>(options.max_points());
   }
   out.keep_channel_maps = options.return_channel_maps();
+  if (absl::Status status = ApplyTopDownCues(options, out); !status.ok()) {
+    return status;
+  }
 
-  // Core names the field itself ("options.saliency: 'sym3d' is not
-  // implemented yet").
+  // Core names the field itself ("options.saliency: 'ph' is given more
+  // than once ...").
   if (absl::Status status = Validate(out); !status.ok()) return status;
   return out;
 }

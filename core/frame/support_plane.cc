@@ -214,16 +214,18 @@ bool SupportPlane::ProjectsInsideHull(const Eigen::Vector3f& p,
                                       float margin) const {
   if (hull.size() < 3 || !p.allFinite()) return false;
   const Eigen::Vector2f q = ToPlane(p);
+  const float margin2 = margin * margin;
   for (size_t i = 0; i < hull.size(); ++i) {
     const Eigen::Vector2f& a = hull[i];
     const Eigen::Vector2f edge = hull[(i + 1) % hull.size()] - a;
-    const float length = edge.norm();
-    if (!(length > 0.0f)) continue;
-    // Signed distance of q from the edge's line, positive inside (the hull
-    // is counter-clockwise).
-    const float inside =
-        (edge.x() * (q.y() - a.y()) - edge.y() * (q.x() - a.x())) / length;
-    if (!(inside >= margin)) return false;  // NaN is outside too
+    // cross = |edge| times the signed distance of q from the edge's line,
+    // positive inside (the hull is counter-clockwise). Inside by `margin`:
+    // cross >= margin |edge|, compared squared to avoid a square root.
+    const float cross = edge.x() * (q.y() - a.y()) - edge.y() * (q.x() - a.x());
+    if (!(cross >= 0.0f)) return false;  // NaN is outside too
+    if (margin > 0.0f && cross * cross < margin2 * edge.squaredNorm()) {
+      return false;
+    }
   }
   return true;
 }

@@ -8,6 +8,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "core/pipeline/channels.h"
+#include "core/pyramid/fusion.h"
 #include "core/saliency/saliency_map.h"
 
 namespace fovea {
@@ -16,6 +18,10 @@ namespace {
 // Debian 12's abseil has its own string_view (ABSL_OPTION_USE_STD_STRING_VIEW
 // is 0), which StrCat and StrSplit need.
 absl::string_view Abs(std::string_view s) { return {s.data(), s.size()}; }
+
+// Deepest pyramid level SYM3D may be asked to run on (a 640x480 frame has
+// 8 levels, 0..7).
+constexpr int kMaxSym3dLevel = 7;
 
 struct NamedOp {
   SaliencyOp op;
@@ -34,9 +40,13 @@ constexpr NamedOp kOps[] = {
     {SaliencyOp::kLocationPrior, "location-prior"},
 };
 
+// Every operator of the wire contract is built; kept so that a new one can
+// be added to the enum before its implementation.
 bool IsImplemented(SaliencyOp op) {
-  return op == SaliencyOp::kPh || op == SaliencyOp::kSh ||
-         op == SaliencyOp::kRso;
+  for (const NamedOp& n : kOps) {
+    if (n.op == op) return true;
+  }
+  return false;
 }
 
 // Wall-clock stage timer that appends to the result's timings.
@@ -61,41 +71,17 @@ absl::Status Check(const InterruptCheck& interrupt) {
   return interrupt ? interrupt() : absl::OkStatus();
 }
 
-absl::StatusOr<cv::Mat> ComputeChannel(SaliencyOp op,
-                                       const OrganizedCloud& cloud,
-                                       const SupportPlane& plane,
-                                       const TableScene& scene,
-                                       const DetectOptions& options) {
-  switch (op) {
-    case SaliencyOp::kPh:
-      return ComputePhSaliency(scene, options.ph);
-    case SaliencyOp::kSh:
-      return ComputeShSaliency(cloud, plane, scene, options.sh);
-    case SaliencyOp::kRso:
-      return ComputeRsoSaliency(cloud, plane, scene, options.rso);
-    default:
-      return absl::UnimplementedError(absl::StrCat(
-          "saliency '", Abs(SaliencyOpName(op)), "' is not implemented yet"));
+absl::StatusOr<std::vector<AttentionPoint>> ExtractPoints(
+    const cv::Mat& master, const DetectOptions& options) {
+  switch (options.extraction) {
+    case ExtractionKind::kWta:
+      return ExtractWtaPoints(master, options.max_points, options.wta);
+    case ExtractionKind::kTj:
+      return ExtractTjPoints(master, options.max_points, options.tj);
+    case ExtractionKind::kMsr:
+      break;
   }
-}
-
-// Weighted sum (eq. 2.42-2.43) or maximum (eq. 2.44) of the channels.
-cv::Mat Fuse(const std::vector<NamedMap>& maps,
-             const std::vector<WeightedChannel>& channels, FusionKind fusion) {
-  cv::Mat master = cv::Mat::zeros(maps[0].map.size(), CV_32FC1);
-  double total = 0.0;
-  for (const WeightedChannel& c : channels) total += c.weight;
-  for (size_t i = 0; i < maps.size(); ++i) {
-    if (fusion == FusionKind::kMax) {
-      cv::max(master, maps[i].map, master);
-    } else {
-      const double w =
-          total > 0.0 ? channels[i].weight / total : 1.0 / channels.size();
-      cv::scaleAdd(maps[i].map, w, master, master);
-    }
-  }
-  NormalizeLinear(master);
-  return master;
+  return ExtractMsrPoints(master, options.max_points, options.msr);
 }
 
 void FillPoints(const OrganizedCloud& cloud,
@@ -188,18 +174,10 @@ absl::Status Validate(const DetectOptions& options) {
         absl::StrCat("options.max_points must be in [1, ", kMaxAttentionPoints,
                      "], got ", options.max_points));
   }
-  if (options.pyramid != PyramidKind::kNone) {
-    return absl::UnimplementedError(
-        "options.pyramid: SIMPLE and ITTI pyramids are not implemented yet");
-  }
-  if (options.normalization != NormalizationKind::kLin) {
-    return absl::UnimplementedError(
-        "options.normalization: NMS and NLM are not implemented yet");
-  }
-  if (options.extraction != ExtractionKind::kMsr) {
-    return absl::UnimplementedError(absl::StrCat(
-        "options.extraction: '", Abs(ExtractionName(options.extraction)),
-        "' is not implemented yet"));
+  if (options.sym3d_level < 0 || options.sym3d_level > kMaxSym3dLevel) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("options.sym3d_level must be in [0, ", kMaxSym3dLevel,
+                     "], got ", options.sym3d_level));
   }
   if (absl::Status s = Validate(options.hole_filling); !s.ok()) return s;
   if (absl::Status s = Validate(options.normals); !s.ok()) return s;
@@ -208,6 +186,20 @@ absl::Status Validate(const DetectOptions& options) {
   if (absl::Status s = Validate(options.ph); !s.ok()) return s;
   if (absl::Status s = Validate(options.sh); !s.ok()) return s;
   if (absl::Status s = Validate(options.rso); !s.ok()) return s;
+  if (absl::Status s = Validate(options.sym3d); !s.ok()) return s;
+  if (absl::Status s = Validate(options.itti); !s.ok()) return s;
+  if (absl::Status s = Validate(options.harel); !s.ok()) return s;
+  if (absl::Status s = Validate(options.hou); !s.ok()) return s;
+  if (absl::Status s = Validate(options.kootstra); !s.ok()) return s;
+  if (absl::Status s = Validate(options.target_color); !s.ok()) return s;
+  if (absl::Status s = Validate(options.location_prior); !s.ok()) return s;
+  if (absl::Status s = Validate(options.wta); !s.ok()) return s;
+  if (absl::Status s = Validate(options.tj); !s.ok()) return s;
+  if (absl::Status s = Validate(options.cloud_pyramid); !s.ok()) return s;
+  if (absl::Status s = Validate(options.feature_pyramid); !s.ok()) return s;
+  if (absl::Status s = Validate(options.normalization_options); !s.ok()) {
+    return s;
+  }
   return Validate(options.msr);
 }
 
@@ -286,20 +278,32 @@ absl::StatusOr<DetectResult> RunDetectUnguarded(
   clock.Lap("support_plane");
   if (absl::Status s = Check(interrupt); !s.ok()) return s;
 
+  ChannelComputer channels(cloud, *plane, scene, options);
   std::vector<NamedMap> maps;
   for (const WeightedChannel& c : options.channels) {
-    absl::StatusOr<cv::Mat> map =
-        ComputeChannel(c.op, cloud, *plane, scene, options);
+    absl::StatusOr<cv::Mat> map = channels.Compute(c.op);
     if (!map.ok()) return map.status();
     maps.push_back({std::string(SaliencyOpName(c.op)), *std::move(map)});
     clock.Lap(absl::StrCat("saliency.", Abs(SaliencyOpName(c.op))));
     if (absl::Status s = Check(interrupt); !s.ok()) return s;
   }
-  result.master = Fuse(maps, options.channels, options.fusion);
+  std::vector<cv::Mat> channel_maps;
+  std::vector<float> weights;
+  for (size_t i = 0; i < maps.size(); ++i) {
+    channel_maps.push_back(maps[i].map);
+    weights.push_back(options.channels[i].weight);
+  }
+  absl::StatusOr<cv::Mat> master =
+      FuseChannels(channel_maps, weights,
+                   options.fusion == FusionKind::kMax ? ChannelFusion::kMax
+                                                      : ChannelFusion::kSum);
+  if (!master.ok()) return master.status();
+  result.master = *std::move(master);
+  NormalizeLinear(result.master);
   clock.Lap("fusion");
 
   absl::StatusOr<std::vector<AttentionPoint>> points =
-      ExtractMsrPoints(result.master, options.max_points, options.msr);
+      ExtractPoints(result.master, options);
   if (!points.ok()) return points.status();
   result.points = *std::move(points);
   FillPoints(cloud, result.points);

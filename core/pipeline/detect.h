@@ -10,14 +10,25 @@
 #include "absl/status/statusor.h"
 #include "core/attention/attention_point.h"
 #include "core/attention/msr.h"
+#include "core/attention/tj.h"
+#include "core/attention/wta.h"
 #include "core/frame/hole_filling.h"
 #include "core/frame/organized_cloud.h"
 #include "core/frame/rgbd_frame.h"
 #include "core/frame/support_plane.h"
 #include "core/frame/table_scene.h"
+#include "core/pyramid/cloud_pyramid.h"
+#include "core/pyramid/feature_pyramid.h"
+#include "core/pyramid/normalization.h"
+#include "core/saliency/harel.h"
+#include "core/saliency/hou.h"
+#include "core/saliency/itti.h"
+#include "core/saliency/kootstra.h"
 #include "core/saliency/ph.h"
 #include "core/saliency/rso.h"
 #include "core/saliency/sh.h"
+#include "core/saliency/sym3d.h"
+#include "core/saliency/top_down.h"
 
 namespace fovea {
 
@@ -60,15 +71,16 @@ struct DetectOptions {
   // most once. Default: RSO alone, the best single channel with MSR on the
   // 45 OSD learn scenes (HR 0.957; README, "Measuring it").
   std::vector<WeightedChannel> channels = {{SaliencyOp::kRso, 1.0f}};
-  // Multi-scale pyramid (section 2.4); only kNone is built so far.
+  // Multi-scale pyramid (section 2.4): kNone is one level; kSimple and
+  // kItti build each 3D channel's conspicuity map over the cloud pyramid.
   PyramidKind pyramid = PyramidKind::kNone;
   // Across-scale combination (eq. 2.40-2.41), used with a pyramid.
   LevelCombination level_combination = LevelCombination::kSum;
-  // Normalisation of each map (eq. 2.37-2.39); only kLin is built so far.
+  // Normalisation of each map (eq. 2.37-2.39).
   NormalizationKind normalization = NormalizationKind::kLin;
   // Fusion of the channels into the master map (eq. 2.42-2.44).
   FusionKind fusion = FusionKind::kSum;
-  // Attention-point extraction (section 2.5); only kMsr is built so far.
+  // Attention-point extraction (section 2.5).
   ExtractionKind extraction = ExtractionKind::kMsr;
   // Attention points to return at most, [1, kMaxAttentionPoints].
   int max_points = 10;
@@ -77,6 +89,9 @@ struct DetectOptions {
   // Fill small depth holes by colour-guided diffusion before anything else
   // (thesis section 2.2).
   bool fill_holes = false;
+  // Pyramid level SYM3D runs on without a pyramid: its k x k kernel must
+  // span an object (level 2 of a 640x480 frame is 160x120).
+  int sym3d_level = 2;
 
   // Options of each stage, documented with the stage.
   HoleFillingOptions hole_filling;
@@ -87,11 +102,24 @@ struct DetectOptions {
   ShOptions sh;
   RsoOptions rso;
   MsrOptions msr;
+  Sym3dOptions sym3d;
+  IttiOptions itti;
+  HarelOptions harel;
+  HouOptions hou;
+  KootstraOptions kootstra;
+  TargetColorOptions target_color;      // TARGET_COLOR: the requested colour
+  LocationPriorOptions location_prior;  // LOCATION_PRIOR: centre and spread
+  WtaOptions wta;
+  TjOptions tj;
+  CloudPyramidOptions cloud_pyramid;
+  // Levels and scales of the feature pyramids; its kind, combination and
+  // normalisation are taken from `pyramid`, `level_combination` and
+  // `normalization` above.
+  FeaturePyramidOptions feature_pyramid;
+  NormalizationOptions normalization_options;
 };
 
-// Validates every field. Combinations not built yet (a pyramid, SYM3D,
-// colour channels, WTA, TJ, non-linear normalisation) are UNIMPLEMENTED and
-// name the option and value, e.g. "saliency 'sym3d' is not implemented yet".
+// Validates every field; errors are INVALID_ARGUMENT and name the field.
 absl::Status Validate(const DetectOptions& options);
 
 struct StageTiming {

@@ -84,18 +84,42 @@ TEST(ToDetectOptionsTest, ValueOutsideTheEnumIsInvalidAndNamed) {
   EXPECT_THAT(status.message(), HasSubstr("options.pyramid"));
 }
 
-TEST(ToDetectOptionsTest, OptionNotBuiltYetIsUnimplementedAndNamed) {
-  v1::DetectOptions sym3d;
-  sym3d.add_saliency()->set_op(v1::SYM3D);
-  absl::Status status = ToDetectOptions(sym3d).status();
-  EXPECT_EQ(status.code(), absl::StatusCode::kUnimplemented);
-  EXPECT_THAT(status.message(), HasSubstr("sym3d"));
+TEST(ToDetectOptionsTest, TopDownCuesAreCopiedAndRequired) {
+  v1::DetectOptions in;
+  in.add_saliency()->set_op(v1::TARGET_COLOR);
+  absl::Status status = ToDetectOptions(in).status();
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(status.message(), HasSubstr("options.target_color_rgb"));
+  in.add_target_color_rgb(250);
+  in.add_target_color_rgb(200);
+  in.add_target_color_rgb(10);
+  absl::StatusOr<DetectOptions> out = ToDetectOptions(in);
+  ASSERT_TRUE(out.ok()) << out.status();
+  EXPECT_EQ(out->target_color.rgb[1], 200);
 
-  v1::DetectOptions wta;
-  wta.set_extraction(v1::WTA);
-  status = ToDetectOptions(wta).status();
-  EXPECT_EQ(status.code(), absl::StatusCode::kUnimplemented);
-  EXPECT_THAT(status.message(), HasSubstr("extraction"));
+  v1::DetectOptions prior;
+  prior.add_saliency()->set_op(v1::LOCATION_PRIOR);
+  status = ToDetectOptions(prior).status();
+  EXPECT_THAT(status.message(), HasSubstr("options.location_prior"));
+  prior.mutable_location_prior()->set_u(100);
+  prior.mutable_location_prior()->set_v(50);
+  prior.set_location_prior_sigma_px(20);
+  out = ToDetectOptions(prior);
+  ASSERT_TRUE(out.ok()) << out.status();
+  EXPECT_EQ(out->location_prior.u, 100.0f);
+  EXPECT_EQ(out->location_prior.sigma_px, 20.0f);
+}
+
+TEST(ToDetectOptionsTest, EveryStrategyOfTheThesisIsAccepted) {
+  v1::DetectOptions in;
+  in.add_saliency()->set_op(v1::SYM3D);
+  in.set_pyramid(v1::ITTI_PYRAMID);
+  in.set_normalization(v1::NLM);
+  in.set_extraction(v1::TJ);
+  absl::StatusOr<DetectOptions> out = ToDetectOptions(in);
+  ASSERT_TRUE(out.ok()) << out.status();
+  EXPECT_EQ(out->pyramid, PyramidKind::kItti);
+  EXPECT_EQ(out->extraction, ExtractionKind::kTj);
 }
 
 TEST(ToDetectOptionsTest, BadTopDownCuesAreInvalid) {
@@ -279,13 +303,17 @@ TEST(CapabilitiesTest, ListWhatCoreValidates) {
   std::vector<int> ops(capabilities.saliency_operators().begin(),
                        capabilities.saliency_operators().end());
   // The operators of this issue; each one listed passes core's Validate.
-  EXPECT_THAT(ops, ::testing::IsSupersetOf({v1::PH, v1::SH, v1::RSO}));
+  EXPECT_THAT(ops, ::testing::IsSupersetOf({v1::PH, v1::SH, v1::RSO, v1::SYM3D,
+                                            v1::ITTI, v1::HAREL, v1::HOU,
+                                            v1::KOOTSTRA}));
   for (int op : ops) {
     v1::DetectOptions options;
     options.add_saliency()->set_op(static_cast<v1::SaliencyOperator>(op));
+    // The top-down cues need their cue.
+    for (int c : {250, 200, 10}) options.add_target_color_rgb(c);
+    options.mutable_location_prior()->set_u(10);
     EXPECT_TRUE(ToDetectOptions(options).ok()) << op;
   }
-  EXPECT_THAT(ops, ::testing::Not(::testing::Contains(v1::SYM3D)));
   EXPECT_THAT(capabilities.pyramids(), ::testing::Contains(v1::NONE));
   EXPECT_THAT(capabilities.normalizations(), ::testing::Contains(v1::LIN));
   EXPECT_THAT(capabilities.extractions(), ::testing::Contains(v1::MSR));

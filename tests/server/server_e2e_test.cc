@@ -129,14 +129,14 @@ TEST_F(ServerTest, RawFrameOf1280x720FitsTheDefaultMessageLimit) {
   EXPECT_TRUE(status.ok()) << status.error_message();
 }
 
-TEST_F(ServerTest, OptionNotBuiltIsUnimplementedAndTooManyPointsInvalid) {
+TEST_F(ServerTest, CueWithoutItsValueAndTooManyPointsAreInvalid) {
   StartServer();
   v1::DetectRequest request = MakeSyntheticRequest(1, false).request;
-  request.mutable_options()->add_saliency()->set_op(v1::SYM3D);
+  request.mutable_options()->add_saliency()->set_op(v1::TARGET_COLOR);
   v1::DetectResponse response;
   grpc::Status status = Detect(request, &response);
-  EXPECT_EQ(status.error_code(), grpc::StatusCode::UNIMPLEMENTED);
-  EXPECT_THAT(status.error_message(), HasSubstr("sym3d"));
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("options.target_color_rgb"));
 
   request.mutable_options()->clear_saliency();
   request.mutable_options()->set_max_points(101);
@@ -264,6 +264,20 @@ TEST_F(ServerTest, FullQueueIsResourceExhausted) {
   EXPECT_EQ(Handled(Scrape(), "Detect", "ResourceExhausted"), 1);
 }
 
+TEST_F(ServerTest, Sym3dOnAnIttiPyramidWithTJunctionsFindsObjects) {
+  StartServer();
+  SyntheticRequest synthetic = MakeSyntheticRequest(2, false);
+  v1::DetectOptions* options = synthetic.request.mutable_options();
+  options->add_saliency()->set_op(v1::SYM3D);
+  options->set_pyramid(v1::ITTI_PYRAMID);
+  options->set_normalization(v1::NLM);
+  options->set_extraction(v1::TJ);
+  v1::DetectResponse response;
+  const grpc::Status status = Detect(synthetic.request, &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_GT(response.points_size(), 0);
+}
+
 TEST_F(ServerTest, SegmentMethodsAreUnimplemented) {
   StartServer();
   {
@@ -304,8 +318,14 @@ TEST_F(ServerTest, CapabilitiesReportWhatCoreImplements) {
                   .ok());
   EXPECT_EQ(capabilities.server_version(), ServerVersion());
   EXPECT_THAT(capabilities.saliency_operators(),
-              ::testing::UnorderedElementsAre(v1::PH, v1::SH, v1::RSO));
-  EXPECT_THAT(capabilities.extractions(), ::testing::ElementsAre(v1::MSR));
+              ::testing::UnorderedElementsAre(
+                  v1::PH, v1::SH, v1::RSO, v1::SYM3D, v1::ITTI, v1::HAREL,
+                  v1::HOU, v1::KOOTSTRA, v1::TARGET_COLOR, v1::LOCATION_PRIOR));
+  EXPECT_THAT(capabilities.extractions(),
+              ::testing::UnorderedElementsAre(v1::MSR, v1::WTA, v1::TJ));
+  EXPECT_THAT(
+      capabilities.pyramids(),
+      ::testing::UnorderedElementsAre(v1::NONE, v1::SIMPLE, v1::ITTI_PYRAMID));
   EXPECT_THAT(capabilities.color_encodings(),
               ::testing::ElementsAre("rgb8", "bgr8"));
   EXPECT_THAT(capabilities.depth_encodings(),

@@ -25,6 +25,14 @@ ABSL_FLAG(std::string, saliency, "rso",
           "the support plane, largest first (ignores --extract).");
 ABSL_FLAG(std::string, extract, "msr", "Attention-point extraction: msr.");
 ABSL_FLAG(int, points, 10, "Attention points per scene (HR uses the first K).");
+ABSL_FLAG(std::string, pyramid, "none", "Pyramid: none, simple or itti.");
+ABSL_FLAG(std::string, combine, "sum",
+          "Across-scale combination with a pyramid: sum or max.");
+ABSL_FLAG(std::string, norm, "lin", "Map normalisation: lin, nms or nlm.");
+ABSL_FLAG(std::string, fusion, "sum", "Channel fusion: sum or max.");
+ABSL_FLAG(int, sym3d_level, 2,
+          "Pyramid level SYM3D runs on without a pyramid.");
+ABSL_FLAG(int, sym3d_kernel, 7, "SYM3D kernel size, pixels of its level.");
 ABSL_FLAG(bool, msr_inhibit_slope, true,
           "MSR also inhibits the slope around each region (false = exactly "
           "the thesis's MSR).");
@@ -101,6 +109,30 @@ int RunDetectEval() {
   options.detect.max_points = absl::GetFlag(FLAGS_points);
   options.detect.msr.inhibit_slope = absl::GetFlag(FLAGS_msr_inhibit_slope);
   options.detect.fill_holes = absl::GetFlag(FLAGS_fill_holes);
+  options.detect.sym3d_level = absl::GetFlag(FLAGS_sym3d_level);
+  options.detect.sym3d.kernel_size = absl::GetFlag(FLAGS_sym3d_kernel);
+  const std::string pyramid = absl::GetFlag(FLAGS_pyramid);
+  const std::string combine = absl::GetFlag(FLAGS_combine);
+  const std::string norm = absl::GetFlag(FLAGS_norm);
+  const std::string fusion = absl::GetFlag(FLAGS_fusion);
+  if ((pyramid != "none" && pyramid != "simple" && pyramid != "itti") ||
+      (combine != "sum" && combine != "max") ||
+      (norm != "lin" && norm != "nms" && norm != "nlm") ||
+      (fusion != "sum" && fusion != "max")) {
+    std::fprintf(stderr,
+                 "fovea-eval: --pyramid none|simple|itti, --combine sum|max, "
+                 "--norm lin|nms|nlm, --fusion sum|max\n");
+    return kUsageError;
+  }
+  options.detect.pyramid = pyramid == "itti"     ? PyramidKind::kItti
+                           : pyramid == "simple" ? PyramidKind::kSimple
+                                                 : PyramidKind::kNone;
+  options.detect.level_combination =
+      combine == "max" ? LevelCombination::kMax : LevelCombination::kSum;
+  options.detect.normalization = norm == "nms"   ? NormalizationKind::kNms
+                                 : norm == "nlm" ? NormalizationKind::kNlm
+                                                 : NormalizationKind::kLin;
+  options.detect.fusion = fusion == "max" ? FusionKind::kMax : FusionKind::kSum;
   options.out_dir = absl::GetFlag(FLAGS_out);
   options.verbose = absl::GetFlag(FLAGS_verbose);
 

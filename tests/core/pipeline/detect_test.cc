@@ -45,17 +45,65 @@ TEST(DetectTest, PointsComeMostSalientFirstWithTimings) {
   EXPECT_TRUE(has_normals && has_plane);
 }
 
-TEST(DetectTest, UnbuiltOptionsAreUnimplementedAndNamed) {
+TEST(DetectTest, EveryOperatorRunsAlone) {
+  const synth::SynthScene scene = synth::GenerateScene(5);
+  for (SaliencyOp op :
+       {SaliencyOp::kPh, SaliencyOp::kSh, SaliencyOp::kRso, SaliencyOp::kSym3d,
+        SaliencyOp::kItti, SaliencyOp::kHarel, SaliencyOp::kHou,
+        SaliencyOp::kKootstra, SaliencyOp::kTargetColor,
+        SaliencyOp::kLocationPrior}) {
+    SCOPED_TRACE(SaliencyOpName(op));
+    DetectOptions options;
+    options.channels = {{op, 1}};
+    options.location_prior = {320.0f, 240.0f, 60.0f};
+    const Eigen::Vector3f albedo = scene.objects[0].primitive.rgb * 255.0f;
+    options.target_color.rgb = {static_cast<uint8_t>(albedo.x()),
+                                static_cast<uint8_t>(albedo.y()),
+                                static_cast<uint8_t>(albedo.z())};
+    absl::StatusOr<DetectResult> result = RunDetect(scene.frame.frame, options);
+    ASSERT_TRUE(result.ok()) << result.status();
+    EXPECT_FALSE(result->points.empty());
+  }
+}
+
+TEST(DetectTest, LocationPriorAloneAttendsToItsCentre) {
+  const synth::SynthScene scene = synth::GenerateScene(5);
   DetectOptions options;
-  options.channels = {{SaliencyOp::kSym3d, 1}};
-  absl::Status s = Validate(options);
-  EXPECT_EQ(s.code(), absl::StatusCode::kUnimplemented);
-  EXPECT_NE(s.message().find("sym3d"), std::string::npos);
-  options = {};
-  options.extraction = ExtractionKind::kTj;
-  s = Validate(options);
-  EXPECT_EQ(s.code(), absl::StatusCode::kUnimplemented);
-  EXPECT_NE(s.message().find("tj"), std::string::npos);
+  options.channels = {{SaliencyOp::kLocationPrior, 1}};
+  options.location_prior = {100.0f, 300.0f, 30.0f};
+  absl::StatusOr<DetectResult> result = RunDetect(scene.frame.frame, options);
+  ASSERT_TRUE(result.ok());
+  ASSERT_FALSE(result->points.empty());
+  EXPECT_NEAR(result->points[0].u, 100, 3);
+  EXPECT_NEAR(result->points[0].v, 300, 3);
+}
+
+TEST(DetectTest, EveryPyramidNormalisationAndExtractionRuns) {
+  const synth::SynthScene scene = synth::GenerateScene(4);
+  for (PyramidKind pyramid :
+       {PyramidKind::kNone, PyramidKind::kSimple, PyramidKind::kItti}) {
+    for (NormalizationKind norm :
+         {NormalizationKind::kLin, NormalizationKind::kNms,
+          NormalizationKind::kNlm}) {
+      for (ExtractionKind extract :
+           {ExtractionKind::kMsr, ExtractionKind::kWta, ExtractionKind::kTj}) {
+        DetectOptions options;
+        options.channels = {{SaliencyOp::kSym3d, 1}, {SaliencyOp::kRso, 1}};
+        options.pyramid = pyramid;
+        options.normalization = norm;
+        options.extraction = extract;
+        SCOPED_TRACE(::testing::Message()
+                     << "pyramid " << static_cast<int>(pyramid) << " norm "
+                     << static_cast<int>(norm) << " extract "
+                     << ExtractionName(extract));
+        absl::StatusOr<DetectResult> result =
+            RunDetect(scene.frame.frame, options);
+        ASSERT_TRUE(result.ok()) << result.status();
+        EXPECT_FALSE(result->points.empty());
+        EXPECT_EQ(result->master.size(), scene.frame.frame.depth.size());
+      }
+    }
+  }
 }
 
 TEST(DetectTest, BadOptionsNameTheField) {
@@ -118,7 +166,10 @@ TEST(DetectTest, StageNamesCoverEveryStageARunReports) {
     EXPECT_NE(std::find(names.begin(), names.end(), t.stage), names.end())
         << t.stage;
   }
-  EXPECT_EQ(std::find(names.begin(), names.end(), "saliency.sym3d"),
+  EXPECT_NE(std::find(names.begin(), names.end(), "saliency.sym3d"),
+            names.end());
+  EXPECT_NE(std::find(names.begin(), names.end(), "extract.tj"), names.end());
+  EXPECT_NE(std::find(names.begin(), names.end(), "saliency.itti"),
             names.end());
 }
 

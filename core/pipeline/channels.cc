@@ -1,0 +1,189 @@
+#include "core/pipeline/channels.h"
+
+#include <algorithm>
+
+#include "absl/strings/str_cat.h"
+#include "core/pyramid/feature_pyramid.h"
+#include "core/pyramid/normalization.h"
+#include "core/saliency/ph.h"
+#include "core/saliency/rso.h"
+#include "core/saliency/saliency_map.h"
+#include "core/saliency/sh.h"
+#include "core/saliency/sym3d.h"
+
+namespace fovea {
+namespace {
+
+absl::string_view Abs(std::string_view s) { return {s.data(), s.size()}; }
+
+MapNormalization ToMapNormalization(NormalizationKind kind) {
+  switch (kind) {
+    case NormalizationKind::kNms:
+      return MapNormalization::kNms;
+    case NormalizationKind::kNlm:
+      return MapNormalization::kNlm;
+    case NormalizationKind::kLin:
+      break;
+  }
+  return MapNormalization::kLin;
+}
+
+FeaturePyramidOptions ToFeaturePyramidOptions(const DetectOptions& options) {
+  FeaturePyramidOptions f = options.feature_pyramid;
+  f.kind = options.pyramid == PyramidKind::kItti ? FeaturePyramidKind::kItti
+                                                 : FeaturePyramidKind::kSimple;
+  f.combination = options.level_combination == LevelCombination::kMax
+                      ? ScaleCombination::kMax
+                      : ScaleCombination::kSum;
+  f.normalization = ToMapNormalization(options.normalization);
+  f.normalization_options = options.normalization_options;
+  return f;
+}
+
+bool IsColorOperator(SaliencyOp op) {
+  switch (op) {
+    case SaliencyOp::kItti:
+    case SaliencyOp::kHarel:
+    case SaliencyOp::kHou:
+    case SaliencyOp::kKootstra:
+    case SaliencyOp::kTargetColor:
+    case SaliencyOp::kLocationPrior:
+      return true;
+    default:
+      return false;
+  }
+}
+
+}  // namespace
+
+absl::StatusOr<cv::Mat> ChannelComputer::ColorOperator(SaliencyOp op) const {
+  const cv::Mat& color = cloud_.color;
+  switch (op) {
+    case SaliencyOp::kItti:
+      return ComputeIttiSaliency(color, options_.itti);
+    case SaliencyOp::kHarel:
+      return ComputeHarelSaliency(color, options_.harel);
+    case SaliencyOp::kHou:
+      return ComputeHouSaliency(color, options_.hou);
+    case SaliencyOp::kKootstra:
+      return ComputeKootstraSaliency(color, options_.kootstra);
+    case SaliencyOp::kTargetColor:
+      return ComputeTargetColorSaliency(color, options_.target_color);
+    case SaliencyOp::kLocationPrior:
+      return ComputeLocationPrior(color.cols, color.rows,
+                                  options_.location_prior);
+    default:
+      return absl::InternalError(absl::StrCat("'", Abs(SaliencyOpName(op)),
+                                              "' is not a colour operator"));
+  }
+}
+
+ChannelComputer::ChannelComputer(const OrganizedCloud& cloud,
+                                 const SupportPlane& plane,
+                                 const TableScene& table,
+                                 const DetectOptions& options)
+    : cloud_(cloud), plane_(plane), table_(table), options_(options) {}
+
+absl::StatusOr<const CloudPyramid*> ChannelComputer::Pyramid() {
+  if (!pyramid_.has_value()) {
+    // Without a feature pyramid only SYM3D's level is needed.
+    CloudPyramidOptions levels = options_.cloud_pyramid;
+    if (options_.pyramid == PyramidKind::kNone) {
+      levels.max_levels = std::min(levels.max_levels, options_.sym3d_level + 1);
+    }
+    absl::StatusOr<CloudPyramid> built = BuildCloudPyramid(cloud_, levels);
+    if (!built.ok()) return built.status();
+    pyramid_ = *std::move(built);
+    tables_.assign(pyramid_->size(), std::nullopt);
+  }
+  return &*pyramid_;
+}
+
+absl::StatusOr<const TableScene*> ChannelComputer::TableAt(int level) {
+  if (level == 0) return &table_;
+  absl::StatusOr<const CloudPyramid*> pyramid = Pyramid();
+  if (!pyramid.ok()) return pyramid.status();
+  if (level >= (*pyramid)->size()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("pyramid level ", level, " does not exist"));
+  }
+  if (!tables_[level].has_value()) {
+    tables_[level] = PrepareTableScene((*pyramid)->levels[level], plane_,
+                                       options_.table_scene);
+  }
+  return &*tables_[level];
+}
+
+absl::StatusOr<cv::Mat> ChannelComputer::OperatorAt(SaliencyOp op, int level) {
+  const OrganizedCloud* cloud = &cloud_;
+  if (level > 0) {
+    absl::StatusOr<const CloudPyramid*> pyramid = Pyramid();
+    if (!pyramid.ok()) return pyramid.status();
+    cloud = &(*pyramid)->levels[level];
+  }
+  absl::StatusOr<const TableScene*> table = TableAt(level);
+  if (!table.ok()) return table.status();
+  switch (op) {
+    case SaliencyOp::kPh:
+      return ComputePhSaliency(**table, options_.ph);
+    case SaliencyOp::kSh:
+      return ComputeShSaliency(*cloud, plane_, **table, options_.sh);
+    case SaliencyOp::kRso:
+      return ComputeRsoSaliency(*cloud, plane_, **table, options_.rso);
+    case SaliencyOp::kSym3d:
+      return ComputeSym3dSaliency(*cloud, **table, options_.sym3d);
+    default:
+      return absl::UnimplementedError(absl::StrCat(
+          "saliency '", Abs(SaliencyOpName(op)), "' is not implemented yet"));
+  }
+}
+
+absl::StatusOr<cv::Mat> ChannelComputer::Compute(SaliencyOp op) {
+  if (IsColorOperator(op)) {
+    absl::StatusOr<cv::Mat> map = ColorOperator(op);
+    if (!map.ok()) return map.status();
+    return NormalizeMap(*map, ToMapNormalization(options_.normalization),
+                        options_.normalization_options);
+  }
+  if (options_.pyramid != PyramidKind::kNone) {
+    absl::StatusOr<const CloudPyramid*> pyramid = Pyramid();
+    if (!pyramid.ok()) return pyramid.status();
+    const LevelFeature feature =
+        [this, op](int level,
+                   const OrganizedCloud& /*cloud*/) -> absl::StatusOr<cv::Mat> {
+      return OperatorAt(op, level);
+    };
+    absl::StatusOr<Conspicuity> conspicuity = BuildConspicuityMap(
+        **pyramid, feature, ToFeaturePyramidOptions(options_));
+    if (!conspicuity.ok()) return conspicuity.status();
+    return OnCandidates(std::move(conspicuity->map));
+  }
+  // Single level: SYM3D needs a kernel the size of an object, so it runs on
+  // a coarser level and is resampled to level 0.
+  int level = 0;
+  if (op == SaliencyOp::kSym3d) {
+    absl::StatusOr<const CloudPyramid*> pyramid = Pyramid();
+    if (!pyramid.ok()) return pyramid.status();
+    level = std::min(options_.sym3d_level, (*pyramid)->size() - 1);
+  }
+  absl::StatusOr<cv::Mat> map = OperatorAt(op, level);
+  if (!map.ok()) return map.status();
+  if (level > 0) {
+    absl::StatusOr<cv::Mat> up =
+        ResampleBetweenLevels(*map, level, 0, **Pyramid());
+    if (!up.ok()) return up.status();
+    map = *std::move(up);
+  }
+  return NormalizeMap(OnCandidates(*std::move(map)),
+                      ToMapNormalization(options_.normalization),
+                      options_.normalization_options);
+}
+
+cv::Mat ChannelComputer::OnCandidates(cv::Mat map) const {
+  cv::Mat masked(map.size(), CV_32FC1, cv::Scalar(0));
+  map.copyTo(masked, table_.candidate);
+  NormalizeLinear(masked);
+  return masked;
+}
+
+}  // namespace fovea
