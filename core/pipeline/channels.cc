@@ -174,7 +174,9 @@ absl::StatusOr<cv::Mat> ChannelComputer::Compute(SaliencyOp op) {
     if (!up.ok()) return up.status();
     map = *std::move(up);
   }
-  return NormalizeMap(OnCandidates(*std::move(map)),
+  // Level-0 operators give zero off the candidates already; a resampled map
+  // is smeared and masked again.
+  return NormalizeMap(level > 0 ? OnCandidates(*std::move(map)) : *map,
                       ToMapNormalization(options_.normalization),
                       options_.normalization_options);
 }

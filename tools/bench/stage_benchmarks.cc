@@ -171,6 +171,52 @@ void RegisterDetectCases(const SceneList* scenes, const std::string& set,
   }
 }
 
+// The attention strategies of chapter 2 whose time the issue asks for:
+// SYM3D with T-junctions on one level and on both pyramids, and each colour
+// operator with MSR.
+struct AttentionCase {
+  std::string_view name;
+  SaliencyOp op;
+  PyramidKind pyramid;
+  ExtractionKind extraction;
+};
+constexpr AttentionCase kAttentionCases[] = {
+    {"sym3d/none/msr", SaliencyOp::kSym3d, PyramidKind::kNone,
+     ExtractionKind::kMsr},
+    {"sym3d/none/tj", SaliencyOp::kSym3d, PyramidKind::kNone,
+     ExtractionKind::kTj},
+    {"sym3d/itti/tj", SaliencyOp::kSym3d, PyramidKind::kItti,
+     ExtractionKind::kTj},
+    {"sym3d/simple/tj", SaliencyOp::kSym3d, PyramidKind::kSimple,
+     ExtractionKind::kTj},
+    {"itti/none/msr", SaliencyOp::kItti, PyramidKind::kNone,
+     ExtractionKind::kMsr},
+    {"harel/none/msr", SaliencyOp::kHarel, PyramidKind::kNone,
+     ExtractionKind::kMsr},
+    {"hou/none/msr", SaliencyOp::kHou, PyramidKind::kNone,
+     ExtractionKind::kMsr},
+    {"kootstra/none/msr", SaliencyOp::kKootstra, PyramidKind::kNone,
+     ExtractionKind::kMsr},
+};
+
+void RegisterAttentionCases(const SceneList* scenes, const std::string& set,
+                            const std::string& suffix,
+                            const SweepOptions& sweep) {
+  for (const AttentionCase& c : kAttentionCases) {
+    DetectOptions options;
+    options.channels = {{c.op, 1.0f}};
+    options.pyramid = c.pyramid;
+    options.extraction = c.extraction;
+    Register(absl::StrCat("BM_DetectAttention/", Abs(c.name), suffix), scenes,
+             set, sweep, kDetectMs, [options](const BenchScene& scene) {
+               absl::StatusOr<DetectResult> result =
+                   RunDetect(scene.frame, options);
+               benchmark::DoNotOptimize(result);
+               return result.status();
+             });
+  }
+}
+
 }  // namespace
 
 int64_t SweepIterations(const SweepOptions& sweep, int scene_count,
@@ -207,6 +253,7 @@ void RegisterStageBenchmarks(const SceneList* scenes,
   RegisterFrameCases(scenes, set_name, suffix, sweep);
   RegisterSaliencyCases(scenes, set_name, suffix, sweep);
   RegisterDetectCases(scenes, set_name, suffix, sweep);
+  RegisterAttentionCases(scenes, set_name, suffix, sweep);
 }
 
 }  // namespace fovea::bench
