@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/saliency/saliency_map.h"
 
 namespace fovea {
 namespace {
@@ -23,28 +24,6 @@ constexpr std::array<double, 4> kOrientationsDeg = {0.0, 45.0, 90.0, 135.0};
 // A final map whose range is below this fraction of its largest value is
 // flat and becomes all zero (ours).
 constexpr double kRelativeFlatTolerance = 1e-4;
-
-absl::Status CheckColor(const cv::Mat& color) {
-  if (color.empty()) return absl::InvalidArgumentError("color: empty");
-  if (color.type() != CV_8UC3) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "color: must be CV_8UC3 (RGB), got OpenCV type ", color.type()));
-  }
-  return absl::OkStatus();
-}
-
-void StretchToUnit(cv::Mat& map) {
-  double lo = 0.0, hi = 0.0;
-  cv::minMaxLoc(map, &lo, &hi);
-  const double scale = std::max(std::abs(lo), std::abs(hi));
-  if (scale == 0.0 || hi - lo <= kRelativeFlatTolerance * scale) {
-    map.setTo(0);
-    return;
-  }
-  map.convertTo(map, CV_32F, 1.0 / (hi - lo), -lo / (hi - lo));
-  // Round-off of the affine map can leave -1e-18 or 1 + 1e-7.
-  cv::min(cv::max(map, 0.0), 1.0, map);
-}
 
 cv::Size GridSize(cv::Size image, int long_side) {
   const int image_long = std::max(image.width, image.height);
@@ -359,7 +338,7 @@ absl::Status Validate(const HarelOptions& options) {
 
 absl::StatusOr<cv::Mat> ComputeHarelSaliency(const cv::Mat& color,
                                              const HarelOptions& options) {
-  if (absl::Status s = CheckColor(color); !s.ok()) return s;
+  if (absl::Status s = CheckColorImage(color); !s.ok()) return s;
   if (absl::Status s = Validate(options); !s.ok()) return s;
   try {
     const cv::Mat grid_map = ComputeGridMap(color, options);
@@ -371,7 +350,7 @@ absl::StatusOr<cv::Mat> ComputeHarelSaliency(const cv::Mat& color,
       cv::GaussianBlur(map, map, cv::Size(0, 0), sigma, sigma,
                        cv::BORDER_REPLICATE);
     }
-    StretchToUnit(map);
+    StretchToUnit(map, kRelativeFlatTolerance);
     return map;
   } catch (const cv::Exception& e) {
     return absl::InternalError(absl::StrCat("harel: OpenCV: ", e.what()));

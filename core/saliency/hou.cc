@@ -6,6 +6,7 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "core/saliency/saliency_map.h"
 
 namespace fovea {
 namespace {
@@ -13,29 +14,6 @@ namespace {
 // A map whose range is below this fraction of its largest magnitude is
 // round-off of a structureless input and becomes all zero (ours).
 constexpr double kRelativeFlatTolerance = 1e-4;
-
-absl::Status CheckColor(const cv::Mat& color) {
-  if (color.empty()) return absl::InvalidArgumentError("color: empty");
-  if (color.type() != CV_8UC3) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "color: must be CV_8UC3 (RGB), got OpenCV type ", color.type()));
-  }
-  return absl::OkStatus();
-}
-
-// Linear stretch to [0, 1]; a flat map becomes all zero. In place.
-void StretchToUnit(cv::Mat& map) {
-  double lo = 0.0, hi = 0.0;
-  cv::minMaxLoc(map, &lo, &hi);
-  const double scale = std::max(std::abs(lo), std::abs(hi));
-  if (hi - lo <= kRelativeFlatTolerance * scale || scale == 0.0) {
-    map.setTo(0);
-    return;
-  }
-  map.convertTo(map, CV_32F, 1.0 / (hi - lo), -lo / (hi - lo));
-  // Round-off of the affine map can leave -1e-18 or 1 + 1e-7.
-  cv::min(cv::max(map, 0.0), 1.0, map);
-}
 
 // Grey image (luma in [0, 1]) at the working width.
 cv::Mat WorkingGrey(const cv::Mat& color, int working_width) {
@@ -103,7 +81,7 @@ absl::Status Validate(const HouOptions& options) {
 
 absl::StatusOr<cv::Mat> ComputeHouSaliency(const cv::Mat& color,
                                            const HouOptions& options) {
-  if (absl::Status s = CheckColor(color); !s.ok()) return s;
+  if (absl::Status s = CheckColorImage(color); !s.ok()) return s;
   if (absl::Status s = Validate(options); !s.ok()) return s;
   try {
     const cv::Mat grey = WorkingGrey(color, options.working_width);
@@ -118,7 +96,7 @@ absl::StatusOr<cv::Mat> ComputeHouSaliency(const cv::Mat& color,
     cv::Mat map;
     cv::resize(energy(cv::Rect(0, 0, grey.cols, grey.rows)), map, color.size(),
                0, 0, cv::INTER_LINEAR);
-    StretchToUnit(map);
+    StretchToUnit(map, kRelativeFlatTolerance);
     return map;
   } catch (const cv::Exception& e) {
     return absl::InternalError(absl::StrCat("hou: OpenCV: ", e.what()));

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/saliency/saliency_map.h"
 
 namespace fovea {
 namespace {
@@ -19,17 +20,8 @@ constexpr std::array<double, 4> kOrientationsDeg = {0.0, 45.0, 90.0, 135.0};
 
 using Pyramid = std::vector<cv::Mat>;
 
-absl::Status CheckColor(const cv::Mat& color) {
-  if (color.empty()) return absl::InvalidArgumentError("color: empty");
-  if (color.type() != CV_8UC3) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "color: must be CV_8UC3 (RGB), got OpenCV type ", color.type()));
-  }
-  return absl::OkStatus();
-}
-
 // Linear stretch to [0, 1]; a flat map becomes all zero.
-cv::Mat StretchToUnit(const cv::Mat& map) {
+cv::Mat StretchToUnitAbsolute(const cv::Mat& map) {
   double lo = 0.0, hi = 0.0;
   cv::minMaxLoc(map, &lo, &hi);
   if (hi - lo <= kFlatTolerance) return cv::Mat::zeros(map.size(), CV_32F);
@@ -77,7 +69,7 @@ bool IsLocalMax(const cv::Mat& map, int x, int y) {
 
 // Itti's N(.): [0, 1], times (1 - mean of the other local maxima)^2.
 cv::Mat NormalizeItti(const cv::Mat& map, float local_max_threshold) {
-  cv::Mat out = StretchToUnit(map);
+  cv::Mat out = StretchToUnitAbsolute(map);
   cv::Point global;
   double global_value = 0.0;
   cv::minMaxLoc(out, nullptr, &global_value, nullptr, &global);
@@ -294,13 +286,13 @@ absl::Status Validate(const IttiOptions& options) {
 
 absl::StatusOr<cv::Mat> ComputeIttiSaliency(const cv::Mat& color,
                                             const IttiOptions& options) {
-  if (absl::Status s = CheckColor(color); !s.ok()) return s;
+  if (absl::Status s = CheckColorImage(color); !s.ok()) return s;
   if (absl::Status s = Validate(options); !s.ok()) return s;
   try {
     const cv::Mat master = ComputeMasterMap(color, options);
     cv::Mat map;
     cv::resize(master, map, color.size(), 0, 0, cv::INTER_LINEAR);
-    return StretchToUnit(map);
+    return StretchToUnitAbsolute(map);
   } catch (const cv::Exception& e) {
     return absl::InternalError(absl::StrCat("itti: OpenCV: ", e.what()));
   }

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/saliency/saliency_map.h"
 
 namespace fovea {
 namespace {
@@ -20,28 +21,6 @@ constexpr int kMaxRadius = 64;
 // A final map whose range is below this fraction of its largest value is
 // flat and becomes all zero (ours).
 constexpr double kRelativeFlatTolerance = 1e-6;
-
-absl::Status CheckColor(const cv::Mat& color) {
-  if (color.empty()) return absl::InvalidArgumentError("color: empty");
-  if (color.type() != CV_8UC3) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "color: must be CV_8UC3 (RGB), got OpenCV type ", color.type()));
-  }
-  return absl::OkStatus();
-}
-
-void StretchToUnit(cv::Mat& map) {
-  double lo = 0.0, hi = 0.0;
-  cv::minMaxLoc(map, &lo, &hi);
-  const double scale = std::max(std::abs(lo), std::abs(hi));
-  if (scale == 0.0 || hi - lo <= kRelativeFlatTolerance * scale) {
-    map.setTo(0);
-    return;
-  }
-  map.convertTo(map, CV_32F, 1.0 / (hi - lo), -lo / (hi - lo));
-  // Round-off of the affine map can leave -1e-18 or 1 + 1e-7.
-  cv::min(cv::max(map, 0.0), 1.0, map);
-}
 
 // A voting pixel: position, unit gradient, log(1 + |g|).
 struct Edgel {
@@ -185,7 +164,7 @@ absl::Status Validate(const KootstraOptions& options) {
 
 absl::StatusOr<cv::Mat> ComputeKootstraSaliency(
     const cv::Mat& color, const KootstraOptions& options) {
-  if (absl::Status s = CheckColor(color); !s.ok()) return s;
+  if (absl::Status s = CheckColorImage(color); !s.ok()) return s;
   if (absl::Status s = Validate(options); !s.ok()) return s;
   try {
     cv::Mat grey8, level;
@@ -212,7 +191,7 @@ absl::StatusOr<cv::Mat> ComputeKootstraSaliency(
                  cv::INTER_LINEAR);
       map += resized;
     }
-    StretchToUnit(map);
+    StretchToUnit(map, kRelativeFlatTolerance);
     return map;
   } catch (const cv::Exception& e) {
     return absl::InternalError(absl::StrCat("kootstra: OpenCV: ", e.what()));

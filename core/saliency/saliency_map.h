@@ -3,6 +3,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "absl/status/status.h"
+
 namespace fovea {
 
 // A saliency map is a CV_32FC1 cv::Mat the size of the frame with values in
@@ -12,6 +14,15 @@ namespace fovea {
 // spans [0, 1] (the minimum of a saliency map is 0 by construction: the
 // table). A map that is all zero stays zero. In place.
 void NormalizeLinear(cv::Mat& map);
+
+// The colour operators' input check: INVALID_ARGUMENT "color: empty" or
+// "color: must be CV_8UC3 (RGB) ..." unless `color` is a non-empty CV_8UC3.
+absl::Status CheckColorImage(const cv::Mat& color);
+
+// Stretches `map` linearly to [0, 1] in place (minimum to 0, maximum to 1,
+// CV_32F). A map whose range is at most `relative_flat_tolerance` times its
+// largest magnitude is flat and becomes all zero.
+void StretchToUnit(cv::Mat& map, double relative_flat_tolerance);
 
 }  // namespace fovea
 
