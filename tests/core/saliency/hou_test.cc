@@ -6,28 +6,15 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "tests/core/saliency/color_test_images.h"
+
 namespace fovea {
 namespace {
 
-const cv::Vec3b kGrey(128, 128, 128);
-const cv::Vec3b kRed(255, 0, 0);
-
-// A red disc of radius 12 px on a grey 256 x 192 background, off centre so
-// that a map peaking at the image centre fails.
-cv::Mat RedDiscOnGrey(cv::Point center) {
-  cv::Mat image(192, 256, CV_8UC3, cv::Scalar(kGrey));
-  cv::circle(image, center, 12, cv::Scalar(kRed), cv::FILLED);
-  return image;
-}
-
-void ExpectIsSaliencyMap(const cv::Mat& map, cv::Size size) {
-  ASSERT_EQ(map.type(), CV_32FC1);
-  ASSERT_EQ(map.size(), size);
-  double lo = 0.0, hi = 0.0;
-  cv::minMaxLoc(map, &lo, &hi);
-  EXPECT_GE(lo, 0.0);
-  EXPECT_LE(hi, 1.0);
-}
+using testing::ExpectIsSaliencyMap;
+using testing::kGrey;
+using testing::kRed;
+using testing::RedDiscOnGrey;
 
 TEST(HouSaliencyTest, RedDiscOnGreyIsTheMostSalientSpot) {
   const cv::Point center(184, 64);

@@ -6,20 +6,15 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "tests/core/saliency/color_test_images.h"
+
 namespace fovea {
 namespace {
 
+using testing::ExpectIsSaliencyMap;
+
 const cv::Scalar kGrey(128, 128, 128);
 const cv::Scalar kDark(30, 60, 90);
-
-void ExpectIsSaliencyMap(const cv::Mat& map, cv::Size size) {
-  ASSERT_EQ(map.type(), CV_32FC1);
-  ASSERT_EQ(map.size(), size);
-  double lo = 0.0, hi = 0.0;
-  cv::minMaxLoc(map, &lo, &hi);
-  EXPECT_GE(lo, 0.0);
-  EXPECT_LE(hi, 1.0);
-}
 
 cv::Point Peak(const cv::Mat& map) {
   cv::Point peak;
