@@ -319,6 +319,11 @@ int MiddleOfLongestPath(const std::vector<int>& skeleton, const Grid& grid,
 }  // namespace
 
 absl::Status Validate(const TjOptions& options) {
+  if (!(options.support_fraction >= 0.0f && options.support_fraction < 1.0f)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("tj.support_fraction must be in [0, 1), got ",
+                     options.support_fraction));
+  }
   if (!(options.min_mean_fraction >= 0.0f &&
         options.min_mean_fraction <= 1.0f)) {
     return absl::InvalidArgumentError(
@@ -357,6 +362,16 @@ absl::StatusOr<std::vector<AttentionPoint>> ExtractTjPoints(
       return absl::InvalidArgumentError("tj: map has an infinite value");
     }
     return points;
+  }
+  if (options.support_fraction > 0.0f) {
+    const float support = options.support_fraction * global_max;
+    for (int v = 0; v < map.rows; ++v) {
+      const float* row = map.ptr<float>(v);
+      const int p0 = grid.Index(0, v);
+      for (int u = 0; u < map.cols; ++u) {
+        if (row[u] < support) grid.on[p0 + u] = 0;
+      }
+    }
   }
   std::vector<Component> components = LabelComponents(grid);
   const double theta =

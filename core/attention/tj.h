@@ -14,6 +14,11 @@ struct TjOptions {
   // map's global maximum are dropped (thesis sections 2.5.3 and 3.2.1:
   // 10 %); range [0, 1].
   float min_mean_fraction = 0.1f;
+  // Components are taken of the pixels at or above this fraction of the
+  // map's global maximum, [0, 1). 0 is the thesis's "map above zero"; a
+  // smoothed map is above zero between touching objects too, which joins
+  // them into one component and one point.
+  float support_fraction = 0.0f;
 };
 
 absl::Status Validate(const TjOptions& options);

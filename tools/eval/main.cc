@@ -33,6 +33,9 @@ ABSL_FLAG(std::string, fusion, "sum", "Channel fusion: sum or max.");
 ABSL_FLAG(int, sym3d_level, 2,
           "Pyramid level SYM3D runs on without a pyramid.");
 ABSL_FLAG(int, sym3d_kernel, 7, "SYM3D kernel size, pixels of its level.");
+ABSL_FLAG(double, tj_support, 0.0,
+          "TJ: components of the pixels at or above this fraction of the "
+          "maximum (0: above zero, as the thesis).");
 ABSL_FLAG(bool, msr_inhibit_slope, true,
           "MSR also inhibits the slope around each region (false = exactly "
           "the thesis's MSR).");
@@ -111,6 +114,8 @@ int RunDetectEval() {
   options.detect.fill_holes = absl::GetFlag(FLAGS_fill_holes);
   options.detect.sym3d_level = absl::GetFlag(FLAGS_sym3d_level);
   options.detect.sym3d.kernel_size = absl::GetFlag(FLAGS_sym3d_kernel);
+  options.detect.tj.support_fraction =
+      static_cast<float>(absl::GetFlag(FLAGS_tj_support));
   const std::string pyramid = absl::GetFlag(FLAGS_pyramid);
   const std::string combine = absl::GetFlag(FLAGS_combine);
   const std::string norm = absl::GetFlag(FLAGS_norm);

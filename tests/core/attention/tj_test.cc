@@ -380,3 +380,33 @@ TEST(TjTest, TimingOnA640x480Map) {
 
 }  // namespace
 }  // namespace fovea
+
+namespace fovea {
+namespace {
+
+// Two bright plateaus joined by a dim bridge: above zero they are one
+// component (one point); above 30 % of the maximum they are two.
+TEST(TjSupportTest, ASupportThresholdSeparatesObjectsJoinedByADimBridge) {
+  cv::Mat map(40, 80, CV_32FC1, cv::Scalar(0));
+  map(cv::Rect(5, 10, 20, 20)).setTo(1.0f);
+  map(cv::Rect(55, 10, 20, 20)).setTo(0.9f);
+  map(cv::Rect(25, 18, 30, 4)).setTo(0.05f);
+  absl::StatusOr<std::vector<AttentionPoint>> joined =
+      ExtractTjPoints(map, 5, TjOptions{});
+  ASSERT_TRUE(joined.ok());
+  EXPECT_EQ(joined->size(), 1u);
+  TjOptions options;
+  options.support_fraction = 0.3f;
+  absl::StatusOr<std::vector<AttentionPoint>> apart =
+      ExtractTjPoints(map, 5, options);
+  ASSERT_TRUE(apart.ok());
+  ASSERT_EQ(apart->size(), 2u);
+  EXPECT_LT((*apart)[0].u, 25);  // the brighter plateau first
+  EXPECT_GT((*apart)[1].u, 55);
+  options.support_fraction = 1.0f;
+  EXPECT_NE(Validate(options).message().find("tj.support_fraction"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace fovea
