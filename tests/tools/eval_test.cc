@@ -10,6 +10,7 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "core/synth/synth_scene.h"
@@ -93,6 +94,33 @@ TEST(FoveaEvalTest, DetectPrintsATableAndAJsonLastLine) {
   // Synthetic objects on a clean table: most are found.
   const size_t hr = last.find("\"hit_ratio\": ") + 13;
   EXPECT_GE(std::stod(last.substr(hr)), 0.6) << last;
+}
+
+TEST(FoveaEvalTest, SweepWritesTheGridAsMarkdownAndCsv) {
+  const std::filesystem::path dir = SyntheticDataDir();
+  const std::filesystem::path out =
+      std::filesystem::path(::testing::TempDir()) / "fovea_eval_sweep";
+  const EvalRun run = RunEval("sweep --data " + dir.string() + " --out " +
+                              out.string() + " --filter rso/none/-/lin/");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  std::ifstream md(out / "sweep.md");
+  std::string header, rule, row1, row2, extra;
+  std::getline(md, header);
+  std::getline(md, rule);
+  std::getline(md, row1);
+  std::getline(md, row2);
+  EXPECT_THAT(header, HasSubstr("| HR | DC | DC (thesis) |"));
+  // rso with WTA and MSR (TJ is a SYM3D row), then the two ph+sh+rso rows
+  // the substring filter also matches.
+  EXPECT_THAT(row1, HasSubstr("| rso | none | - | lin | wta |"));
+  EXPECT_THAT(row2, HasSubstr("| rso | none | - | lin | msr |"));
+  ASSERT_TRUE(std::getline(md, extra));
+  EXPECT_THAT(extra, HasSubstr("| ph+sh+rso | none | - | lin | wta |"));
+  std::ifstream csv(out / "sweep.csv");
+  std::string line;
+  int lines = 0;
+  while (std::getline(csv, line)) ++lines;
+  EXPECT_EQ(lines, 5);  // header and four rows
 }
 
 TEST(FoveaEvalTest, UnknownSaliencyIsAUsageErrorNamingIt) {

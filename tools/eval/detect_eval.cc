@@ -131,52 +131,74 @@ DetectEvalSummary Summarize(const std::vector<SceneResult>& scenes,
   return s;
 }
 
-absl::StatusOr<DetectEvalSummary> EvaluateDetect(
-    const DetectEvalOptions& options) {
-  if (absl::Status s = Validate(options.detect); !s.ok()) return s;
+absl::StatusOr<std::vector<LabelledFrame>> LoadScenes(
+    const std::string& data_dir) {
   absl::StatusOr<std::vector<std::string>> files =
-      ListPcdFiles(ResolveDataDir(options.data_dir));
+      ListPcdFiles(ResolveDataDir(data_dir));
   if (!files.ok()) return files.status();
   if (files->empty()) {
-    return absl::NotFoundError("no .pcd files in " + options.data_dir);
+    return absl::NotFoundError("no .pcd files in " + data_dir);
   }
+  std::vector<LabelledFrame> scenes;
+  scenes.reserve(files->size());
+  for (const std::string& path : *files) {
+    absl::StatusOr<LabelledFrame> scene = LoadOsdPcd(path);
+    if (!scene.ok()) return scene.status();
+    scenes.push_back(*std::move(scene));
+  }
+  return scenes;
+}
+
+absl::StatusOr<DetectEvalSummary> EvaluateDetectOn(
+    const std::vector<LabelledFrame>& scenes,
+    const DetectEvalOptions& options) {
+  if (absl::Status s = Validate(options.detect); !s.ok()) return s;
   if (!options.out_dir.empty()) {
     std::filesystem::create_directories(options.out_dir);
   }
   std::vector<SceneResult> results;
-  for (const std::string& path : *files) {
-    absl::StatusOr<LabelledFrame> scene = LoadOsdPcd(path);
-    if (!scene.ok()) return scene.status();
+  for (const LabelledFrame& scene : scenes) {
     const auto start = std::chrono::steady_clock::now();
     absl::StatusOr<DetectResult> result =
-        options.pcl_clusters ? RunPclClusters(scene->frame, options)
-                             : RunDetect(scene->frame, options.detect);
+        options.pcl_clusters ? RunPclClusters(scene.frame, options)
+                             : RunDetect(scene.frame, options.detect);
     const double ms = std::chrono::duration<double, std::milli>(
                           std::chrono::steady_clock::now() - start)
                           .count();
     if (!result.ok()) {
       return absl::Status(
           result.status().code(),
-          scene->name + ": " + std::string(result.status().message()));
+          scene.name + ": " + std::string(result.status().message()));
     }
-    const OrganizedCloud cloud = BackProject(scene->frame);
+    const OrganizedCloud cloud = BackProject(scene.frame);
     SceneResult r;
-    r.name = scene->name;
-    r.kind = SceneKind(scene->name);
-    r.score = ScoreAttentionPoints(result->points, scene->labels, cloud.xyz);
+    r.name = scene.name;
+    r.kind = SceneKind(scene.name);
+    r.score = ScoreAttentionPoints(result->points, scene.labels, cloud.xyz);
     r.points = static_cast<int>(result->points.size());
     r.detect_ms = ms;
     if (options.verbose) {
-      std::fprintf(
-          stderr, "%-10s %-10s objects %2d hits %2d HR %.2f DC %.2f %6.1f ms\n",
-          r.name.c_str(), r.kind.c_str(), r.score.objects, r.score.hits,
-          r.score.hit_ratio, r.score.distance_to_center, ms);
+      std::fprintf(stderr,
+                   "%-10s %-10s objects %2d hits %2d HR %.2f DC %.2f "
+                   "DC(thesis) %.2f %6.1f ms\n",
+                   r.name.c_str(), r.kind.c_str(), r.score.objects,
+                   r.score.hits, r.score.hit_ratio, r.score.distance_to_center,
+                   r.score.distance_to_center_thesis, ms);
     }
     if (!options.out_dir.empty())
-      WriteScenePng(options.out_dir, *scene, *result);
+      WriteScenePng(options.out_dir, scene, *result);
     if (r.score.objects > 0) results.push_back(std::move(r));
   }
   return Summarize(results, "");
+}
+
+absl::StatusOr<DetectEvalSummary> EvaluateDetect(
+    const DetectEvalOptions& options) {
+  if (absl::Status s = Validate(options.detect); !s.ok()) return s;
+  absl::StatusOr<std::vector<LabelledFrame>> scenes =
+      LoadScenes(options.data_dir);
+  if (!scenes.ok()) return scenes.status();
+  return EvaluateDetectOn(*scenes, options);
 }
 
 }  // namespace fovea::eval

@@ -8,6 +8,7 @@
 #include "absl/status/statusor.h"
 #include "core/baseline/pcl_clusters.h"
 #include "core/eval/detection_metrics.h"
+#include "core/frame/osd_pcd.h"
 #include "core/pipeline/detect.h"
 
 namespace fovea::eval {
@@ -44,6 +45,14 @@ struct DetectEvalOptions {
 // (thesis section 2.6.1; objects are label / 10).
 absl::StatusOr<DetectEvalSummary> EvaluateDetect(
     const DetectEvalOptions& options);
+
+// The PCDs of an OSD folder (or its learn/ subfolder), loaded once.
+absl::StatusOr<std::vector<LabelledFrame>> LoadScenes(
+    const std::string& data_dir);
+
+// EvaluateDetect on scenes already loaded (options.data_dir is ignored).
+absl::StatusOr<DetectEvalSummary> EvaluateDetectOn(
+    const std::vector<LabelledFrame>& scenes, const DetectEvalOptions& options);
 
 // Mean of the per-scene figures over the scenes of one kind ("" = all).
 DetectEvalSummary Summarize(const std::vector<SceneResult>& scenes,

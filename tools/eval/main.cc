@@ -15,6 +15,7 @@
 #include "absl/strings/str_join.h"
 #include "core/pipeline/detect.h"
 #include "tools/eval/detect_eval.h"
+#include "tools/eval/sweep.h"
 
 ABSL_FLAG(std::string, data, "",
           "OSD-format folder: *.pcd files, or a folder with learn/ inside. "
@@ -49,6 +50,9 @@ ABSL_FLAG(std::string, out, "",
           "Write <scene>.png (colour with object outlines | saliency map, "
           "points numbered) into this folder.");
 ABSL_FLAG(bool, verbose, false, "One line per scene on stderr.");
+ABSL_FLAG(std::string, filter, "",
+          "sweep: only the rows whose label saliency/pyramid/combine/norm/"
+          "extract contains this.");
 
 namespace fovea::eval {
 namespace {
@@ -158,11 +162,50 @@ int RunDetectEval() {
 }  // namespace
 }  // namespace fovea::eval
 
+namespace fovea::eval {
+namespace {
+
+int RunSweepCommand() {
+  std::string data = absl::GetFlag(FLAGS_data);
+  if (data.empty()) {
+    const char* env = std::getenv("FOVEA_OSD_DIR");
+    if (env != nullptr) data = env;
+  }
+  const std::string out = absl::GetFlag(FLAGS_out);
+  if (data.empty() || out.empty()) {
+    std::fprintf(stderr,
+                 "fovea-eval sweep: --data (or FOVEA_OSD_DIR) and --out are "
+                 "required\n");
+    return kUsageError;
+  }
+  const std::vector<SweepRow> rows = ThesisGrid(absl::GetFlag(FLAGS_filter));
+  absl::StatusOr<std::vector<LabelledFrame>> scenes = LoadScenes(data);
+  if (!scenes.ok()) {
+    std::fprintf(stderr, "fovea-eval: %s\n",
+                 scenes.status().ToString().c_str());
+    return kRunError;
+  }
+  std::fprintf(stderr, "sweep: %zu rows on %zu scenes\n", rows.size(),
+               scenes->size());
+  if (absl::Status s = RunSweep(*scenes, rows, out); !s.ok()) {
+    std::fprintf(stderr, "fovea-eval: %s\n", s.ToString().c_str());
+    return kRunError;
+  }
+  std::printf("wrote %s/sweep.md and %s/sweep.csv\n", out.c_str(), out.c_str());
+  return 0;
+}
+
+}  // namespace
+}  // namespace fovea::eval
+
 int main(int argc, char** argv) {
   absl::SetProgramUsageMessage(
       "Detection quality on labelled OSD scenes.\n"
-      "  fovea-eval detect --data DIR [--saliency ph|sh|rso|ph+sh+rso] "
-      "[--extract msr] [--json] [--out DIR]");
+      "  fovea-eval detect --data DIR [--saliency ph|sh|rso|sym3d|ph+sh+rso|"
+      "pcl-clusters|...] [--pyramid none|simple|itti] [--combine sum|max] "
+      "[--norm lin|nms|nlm] [--extract wta|msr|tj] [--json] [--out DIR]\n"
+      "  fovea-eval sweep --data DIR --out DIR [--filter TEXT]   (the grid "
+      "of Tables 2.4/2.5 as Markdown and CSV)");
   std::vector<char*> args = absl::ParseCommandLine(argc, argv);
   if (args.size() < 2) {
     std::fprintf(stderr, "%s\n", absl::ProgramUsageMessage());
@@ -170,6 +213,7 @@ int main(int argc, char** argv) {
   }
   const std::string command = args[1];
   if (command == "detect") return fovea::eval::RunDetectEval();
+  if (command == "sweep") return fovea::eval::RunSweepCommand();
   std::fprintf(stderr, "fovea-eval: unknown command '%s'\n%s\n",
                command.c_str(), absl::ProgramUsageMessage());
   return fovea::eval::kUsageError;
