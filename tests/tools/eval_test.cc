@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
-#include <sys/wait.h>
 
 #include <algorithm>
 #include <array>
@@ -14,6 +13,7 @@
 #include <string>
 
 #include "core/synth/synth_scene.h"
+#include "tests/testing/run_command.h"
 #include "tools/eval/scene_kind.h"
 
 namespace fovea {
@@ -21,24 +21,12 @@ namespace {
 
 using ::testing::HasSubstr;
 
-struct EvalRun {
-  int exit_code = -1;
-  std::string out;
-};
-
-EvalRun RunEval(const std::string& args) {
-  const std::string command =
-      std::string(FOVEA_EVAL_BIN) + " " + args + " 2>&1";
-  EvalRun run;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return run;
-  std::array<char, 4096> buffer;
-  size_t n;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) {
-    run.out.append(buffer.data(), n);
-  }
-  const int status = pclose(pipe);
-  if (WIFEXITED(status)) run.exit_code = WEXITSTATUS(status);
+// Runs fovea-eval with `args`; stderr is appended to stdout, since the
+// tests look for messages in either.
+::fovea::testing::CommandRun RunEval(const std::string& args) {
+  ::fovea::testing::CommandRun run =
+      ::fovea::testing::RunCommand(std::string(FOVEA_EVAL_BIN) + " " + args);
+  run.out += run.err;
   return run;
 }
 
@@ -77,7 +65,8 @@ std::filesystem::path SyntheticDataDir() {
 
 TEST(FoveaEvalTest, DetectPrintsATableAndAJsonLastLine) {
   const std::filesystem::path dir = SyntheticDataDir();
-  const EvalRun run = RunEval("detect --data " + dir.string() + " --json");
+  const ::fovea::testing::CommandRun run =
+      RunEval("detect --data " + dir.string() + " --json");
   ASSERT_EQ(run.exit_code, 0) << run.out;
   EXPECT_THAT(run.out, HasSubstr("boxes"));  // learn0-2 are box scenes
   const std::string last =
@@ -100,8 +89,9 @@ TEST(FoveaEvalTest, SweepWritesTheGridAsMarkdownAndCsv) {
   const std::filesystem::path dir = SyntheticDataDir();
   const std::filesystem::path out =
       std::filesystem::path(::testing::TempDir()) / "fovea_eval_sweep";
-  const EvalRun run = RunEval("sweep --data " + dir.string() + " --out " +
-                              out.string() + " --filter rso/none/-/lin/");
+  const ::fovea::testing::CommandRun run =
+      RunEval("sweep --data " + dir.string() + " --out " + out.string() +
+              " --filter rso/none/-/lin/");
   ASSERT_EQ(run.exit_code, 0) << run.out;
   std::ifstream md(out / "sweep.md");
   std::string header, rule, row1, row2, extra;
@@ -124,13 +114,15 @@ TEST(FoveaEvalTest, SweepWritesTheGridAsMarkdownAndCsv) {
 }
 
 TEST(FoveaEvalTest, UnknownSaliencyIsAUsageErrorNamingIt) {
-  const EvalRun run = RunEval("detect --data /nonexistent --saliency ph+bogus");
+  const ::fovea::testing::CommandRun run =
+      RunEval("detect --data /nonexistent --saliency ph+bogus");
   EXPECT_EQ(run.exit_code, 64);
   EXPECT_THAT(run.out, HasSubstr("bogus"));
 }
 
 TEST(FoveaEvalTest, MissingDataIsAnErrorNotACrash) {
-  const EvalRun run = RunEval("detect --data /nonexistent/osd");
+  const ::fovea::testing::CommandRun run =
+      RunEval("detect --data /nonexistent/osd");
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_THAT(run.out, HasSubstr("/nonexistent/osd"));
 }
