@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/attention/tj.h"
 #include "core/frame/organized_cloud.h"
 #include "core/frame/osd_pcd.h"
 #include "core/frame/support_plane.h"
@@ -41,11 +42,25 @@ double Median(std::vector<double> values) {
 // Saliency map in false colour with the points numbered on it, next to the
 // colour image with the ground-truth object outlines.
 void WriteScenePng(const std::string& out_dir, const LabelledFrame& scene,
-                   const DetectResult& result) {
+                   const DetectResult& result, const DetectOptions& options) {
   cv::Mat map8;
   result.master.convertTo(map8, CV_8UC1, 255.0);
   cv::Mat heat;
   cv::applyColorMap(map8, heat, cv::COLORMAP_JET);
+  if (options.extraction == ExtractionKind::kTj) {
+    // The skeletons TJ found its points on, drawn in white (the support is
+    // TJ's: pixels above support_fraction of the maximum).
+    double max_value = 0.0;
+    cv::minMaxLoc(result.master, nullptr, &max_value);
+    const cv::Mat support =
+        result.master > std::max(options.tj.support_fraction * max_value, 0.0);
+    absl::StatusOr<cv::Mat> skeleton = ThinToSkeleton(support);
+    if (skeleton.ok()) {
+      cv::Mat visible;  // 3 px wide, so it shows at full size
+      cv::dilate(*skeleton, visible, cv::Mat());
+      heat.setTo(cv::Scalar(255, 255, 255), visible);
+    }
+  }
   cv::Mat bgr;
   cv::cvtColor(scene.frame.color, bgr, cv::COLOR_RGB2BGR);
   // One outline per ground-truth object (all of its labelled parts).
@@ -186,7 +201,7 @@ absl::StatusOr<DetectEvalSummary> EvaluateDetectOn(
                    r.score.distance_to_center_thesis, ms);
     }
     if (!options.out_dir.empty())
-      WriteScenePng(options.out_dir, scene, *result);
+      WriteScenePng(options.out_dir, scene, *result, options.detect);
     if (r.score.objects > 0) results.push_back(std::move(r));
   }
   return Summarize(results, "");
