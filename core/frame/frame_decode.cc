@@ -20,6 +20,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
 #include "core/base/check.h"
+#include "core/base/strings.h"
 
 namespace fovea {
 namespace {
@@ -39,11 +40,6 @@ constexpr size_t kPngHeaderBytes = 26;
 constexpr int kPngColorTypeGrey = 0;
 
 enum class Slot { kColor, kDepth };
-
-// Debian's abseil keeps its own string_view; the header speaks std.
-absl::string_view View(std::string_view text) {
-  return absl::string_view(text.data(), text.size());
-}
 
 // How an image's pixels are carried.
 enum class Format { kRgb8, kBgr8, kDepth16, kDepth32F, kPng, kJpeg };
@@ -218,11 +214,11 @@ absl::Status CheckAgreesWithFile(const RawImage& image, const FileHeader& file,
   uint32_t bytes_per_pixel = slot == Slot::kColor ? 3 : 2;
   if (!image.encoding.empty()) {
     absl::StatusOr<const Encoding*> encoding =
-        FindEncoding(View(image.encoding), slot, field);
+        FindEncoding(AbslView(image.encoding), slot, field);
     if (!encoding.ok()) return encoding.status();
     if (slot == Slot::kDepth && (*encoding)->format != Format::kDepth16) {
       return absl::InvalidArgumentError(
-          absl::StrCat(field, ".encoding: ", Quoted(View(image.encoding)),
+          absl::StrCat(field, ".encoding: ", Quoted(AbslView(image.encoding)),
                        " does not match the 16-bit ", kind, " (16UC1)"));
     }
     bytes_per_pixel = (*encoding)->bytes_per_pixel;
@@ -240,7 +236,7 @@ absl::Status CheckAgreesWithFile(const RawImage& image, const FileHeader& file,
 absl::StatusOr<Layout> InspectCompressed(const RawImage& image, Slot slot,
                                          absl::string_view field,
                                          const FrameLimits& limits) {
-  const absl::string_view file = View(image.compressed);
+  const absl::string_view file = AbslView(image.compressed);
   Layout layout;
   FileHeader header;
   absl::string_view kind;
@@ -299,7 +295,7 @@ absl::StatusOr<Layout> InspectRaw(const RawImage& image, Slot slot,
                      " data takes ", SlotEncodings(slot)));
   }
   absl::StatusOr<const Encoding*> encoding =
-      FindEncoding(View(image.encoding), slot, field);
+      FindEncoding(AbslView(image.encoding), slot, field);
   if (!encoding.ok()) return encoding.status();
   absl::Status status =
       CheckDimensions(image.width, image.height, field, "", limits);
@@ -428,7 +424,7 @@ absl::StatusOr<cv::Mat> DecodeColor(const RawImage& image, const Layout& layout,
     return ColorFromRaw(image, layout);
   }
   const absl::string_view kind = layout.format == Format::kPng ? "PNG" : "JPEG";
-  cv::Mat bgr = DecodeFile(View(image.compressed), cv::IMREAD_COLOR);
+  cv::Mat bgr = DecodeFile(AbslView(image.compressed), cv::IMREAD_COLOR);
   if (bgr.type() != CV_8UC3 || bgr.cols != static_cast<int>(layout.width) ||
       bgr.rows != static_cast<int>(layout.height)) {
     return absl::InvalidArgumentError(
@@ -443,7 +439,8 @@ absl::StatusOr<cv::Mat> DecodeColor(const RawImage& image, const Layout& layout,
 absl::StatusOr<cv::Mat> DecodeDepth(const RawImage& image, const Layout& layout,
                                     double scale, absl::string_view field) {
   if (layout.format != Format::kPng) return DepthFromRaw(image, layout, scale);
-  const cv::Mat units = DecodeFile(View(image.compressed), cv::IMREAD_ANYDEPTH);
+  const cv::Mat units =
+      DecodeFile(AbslView(image.compressed), cv::IMREAD_ANYDEPTH);
   if (units.type() != CV_16UC1 ||
       units.cols != static_cast<int>(layout.width) ||
       units.rows != static_cast<int>(layout.height)) {
@@ -535,7 +532,7 @@ absl::Status Validate(const FrameLimits& limits) {
 
 absl::Status ValidateIntrinsics(const Intrinsics& intrinsics,
                                 std::string_view field_name) {
-  const absl::string_view field = View(field_name);
+  const absl::string_view field = AbslView(field_name);
   const struct {
     absl::string_view name;
     double value;

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/strings.h"
 #include "core/pyramid/feature_pyramid.h"
 #include "core/pyramid/normalization.h"
 #include "core/saliency/ph.h"
@@ -13,8 +14,6 @@
 
 namespace fovea {
 namespace {
-
-absl::string_view Abs(std::string_view s) { return {s.data(), s.size()}; }
 
 MapNormalization ToMapNormalization(NormalizationKind kind) {
   switch (kind) {
@@ -73,7 +72,7 @@ absl::StatusOr<cv::Mat> ChannelComputer::ColorOperator(SaliencyOp op) const {
       return ComputeLocationPrior(color.cols, color.rows,
                                   options_.location_prior);
     default:
-      return absl::InternalError(absl::StrCat("'", Abs(SaliencyOpName(op)),
+      return absl::InternalError(absl::StrCat("'", AbslView(SaliencyOpName(op)),
                                               "' is not a colour operator"));
   }
 }
@@ -133,8 +132,9 @@ absl::StatusOr<cv::Mat> ChannelComputer::OperatorAt(SaliencyOp op, int level) {
     case SaliencyOp::kSym3d:
       return ComputeSym3dSaliency(*cloud, **table, options_.sym3d);
     default:
-      return absl::UnimplementedError(absl::StrCat(
-          "saliency '", Abs(SaliencyOpName(op)), "' is not implemented yet"));
+      return absl::UnimplementedError(absl::StrCat("saliency '",
+                                                   AbslView(SaliencyOpName(op)),
+                                                   "' is not implemented yet"));
   }
 }
 

@@ -8,16 +8,13 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "core/base/strings.h"
 #include "core/pipeline/channels.h"
 #include "core/pyramid/fusion.h"
 #include "core/saliency/saliency_map.h"
 
 namespace fovea {
 namespace {
-
-// Debian 12's abseil has its own string_view (ABSL_OPTION_USE_STD_STRING_VIEW
-// is 0), which StrCat and StrSplit need.
-absl::string_view Abs(std::string_view s) { return {s.data(), s.size()}; }
 
 // Deepest pyramid level SYM3D may be asked to run on (a 640x480 frame has
 // 8 levels, 0..7).
@@ -116,10 +113,10 @@ std::string_view ExtractionName(ExtractionKind kind) {
 absl::StatusOr<std::vector<SaliencyOp>> ParseSaliencyOps(
     std::string_view text) {
   std::vector<SaliencyOp> ops;
-  for (absl::string_view part : absl::StrSplit(Abs(text), '+')) {
+  for (absl::string_view part : absl::StrSplit(AbslView(text), '+')) {
     bool found = false;
     for (const NamedOp& n : kOps) {
-      if (Abs(n.name) == part) {
+      if (AbslView(n.name) == part) {
         ops.push_back(n.op);
         found = true;
         break;
@@ -140,7 +137,7 @@ absl::StatusOr<ExtractionKind> ParseExtraction(std::string_view text) {
   if (text == "wta") return ExtractionKind::kWta;
   if (text == "tj") return ExtractionKind::kTj;
   return absl::InvalidArgumentError(absl::StrCat(
-      "extract: unknown strategy '", Abs(text), "' (known: msr wta tj)"));
+      "extract: unknown strategy '", AbslView(text), "' (known: msr wta tj)"));
 }
 
 absl::Status Validate(const DetectOptions& options) {
@@ -151,7 +148,8 @@ absl::Status Validate(const DetectOptions& options) {
     for (size_t j = 0; j < i; ++j) {
       if (options.channels[j].op == options.channels[i].op) {
         return absl::InvalidArgumentError(absl::StrCat(
-            "options.saliency: '", Abs(SaliencyOpName(options.channels[i].op)),
+            "options.saliency: '",
+            AbslView(SaliencyOpName(options.channels[i].op)),
             "' is given more than once; give each operator once with its "
             "weight"));
       }
@@ -160,13 +158,13 @@ absl::Status Validate(const DetectOptions& options) {
   for (const WeightedChannel& c : options.channels) {
     if (!(c.weight >= 0.0f) || !std::isfinite(c.weight)) {
       return absl::InvalidArgumentError(absl::StrCat(
-          "options.saliency: weight of '", Abs(SaliencyOpName(c.op)),
+          "options.saliency: weight of '", AbslView(SaliencyOpName(c.op)),
           "' must be finite and >= 0, got ", c.weight));
     }
     if (!IsImplemented(c.op)) {
-      return absl::UnimplementedError(absl::StrCat("options.saliency: '",
-                                                   Abs(SaliencyOpName(c.op)),
-                                                   "' is not implemented yet"));
+      return absl::UnimplementedError(
+          absl::StrCat("options.saliency: '", AbslView(SaliencyOpName(c.op)),
+                       "' is not implemented yet"));
     }
   }
   if (options.max_points < 1 || options.max_points > kMaxAttentionPoints) {
@@ -214,7 +212,7 @@ std::vector<std::string> DetectStageNames() {
                                     "support_plane", "fusion"};
   for (const NamedOp& n : kOps) {
     if (IsImplemented(n.op)) {
-      names.push_back(absl::StrCat("saliency.", Abs(n.name)));
+      names.push_back(absl::StrCat("saliency.", AbslView(n.name)));
     }
   }
   for (ExtractionKind kind :
@@ -222,7 +220,7 @@ std::vector<std::string> DetectStageNames() {
     DetectOptions probe;
     probe.extraction = kind;
     if (Validate(probe).ok()) {
-      names.push_back(absl::StrCat("extract.", Abs(ExtractionName(kind))));
+      names.push_back(absl::StrCat("extract.", AbslView(ExtractionName(kind))));
     }
   }
   return names;
@@ -284,7 +282,7 @@ absl::StatusOr<DetectResult> RunDetectUnguarded(
     absl::StatusOr<cv::Mat> map = channels.Compute(c.op);
     if (!map.ok()) return map.status();
     maps.push_back({std::string(SaliencyOpName(c.op)), *std::move(map)});
-    clock.Lap(absl::StrCat("saliency.", Abs(SaliencyOpName(c.op))));
+    clock.Lap(absl::StrCat("saliency.", AbslView(SaliencyOpName(c.op))));
     if (absl::Status s = Check(interrupt); !s.ok()) return s;
   }
   std::vector<cv::Mat> channel_maps;
@@ -307,7 +305,8 @@ absl::StatusOr<DetectResult> RunDetectUnguarded(
   if (!points.ok()) return points.status();
   result.points = *std::move(points);
   FillPoints(cloud, result.points);
-  clock.Lap(absl::StrCat("extract.", Abs(ExtractionName(options.extraction))));
+  clock.Lap(
+      absl::StrCat("extract.", AbslView(ExtractionName(options.extraction))));
 
   if (options.keep_channel_maps) result.channel_maps = std::move(maps);
   result.plane = *std::move(plane);

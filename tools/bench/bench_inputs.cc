@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/strings.h"
 #include "core/frame/osd_pcd.h"
 #include "core/pipeline/detect.h"
 #include "core/saliency/rso.h"
@@ -20,8 +21,6 @@ namespace {
 
 // Largest depth a 16UC1 millimetre pixel holds.
 constexpr float kMaxWireDepthUnits = 65535.0f;
-
-absl::string_view Abs(std::string_view s) { return {s.data(), s.size()}; }
 
 std::string_view View(const std::string& s) { return {s.data(), s.size()}; }
 
@@ -83,7 +82,7 @@ RawImage RawWire(uint32_t width, uint32_t height, std::string_view encoding,
 absl::Status StageError(const BenchScene& scene, std::string_view stage,
                         const absl::Status& status) {
   return absl::FailedPreconditionError(
-      absl::StrCat(scene.name, ": ", Abs(stage), ": ", status.ToString()));
+      absl::StrCat(scene.name, ": ", AbslView(stage), ": ", status.ToString()));
 }
 
 void AddScene(std::string name, const RgbdFrame& frame, SceneList& scenes) {

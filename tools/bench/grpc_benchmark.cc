@@ -11,6 +11,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/time.h"
+#include "core/base/strings.h"
 #include "core/pipeline/detect.h"
 #include "fovea/v1/perception.grpc.pb.h"
 #include "server/convert.h"
@@ -19,8 +20,6 @@
 
 namespace fovea::bench {
 namespace {
-
-absl::string_view Abs(std::string_view s) { return {s.data(), s.size()}; }
 
 // Rough cost per call, milliseconds (sizes the passes, see SweepIterations).
 constexpr double kGrpcDetectMs = 40.0;
@@ -122,7 +121,7 @@ void RegisterGrpcBenchmarks(const SceneList* scenes,
   for (const std::string_view channels : kDetectChannelSets) {
     const std::vector<SaliencyOp> ops = ParseSaliencyOps(channels).value();
     benchmark::RegisterBenchmark(
-        absl::StrCat("BM_DetectGrpc/", Abs(channels), suffix).c_str(),
+        absl::StrCat("BM_DetectGrpc/", AbslView(channels), suffix).c_str(),
         [scenes, set_name, ops](benchmark::State& state) {
           BenchmarkGrpcDetect(state, *scenes, set_name, ops);
         })

@@ -6,6 +6,9 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/attention/msr.h"
+#include "core/attention/tj.h"
+#include "core/attention/wta.h"
+#include "core/base/strings.h"
 #include "core/frame/frame_decode.h"
 #include "core/frame/organized_cloud.h"
 #include "core/frame/support_plane.h"
@@ -17,8 +20,6 @@
 
 namespace fovea::bench {
 namespace {
-
-absl::string_view Abs(std::string_view s) { return {s.data(), s.size()}; }
 
 // Rough per-frame cost of each case on one core, milliseconds; only sizes
 // the number of passes per repetition (SweepIterations).
@@ -149,6 +150,22 @@ void RegisterSaliencyCases(const SceneList* scenes, const std::string& set,
              benchmark::DoNotOptimize(points);
              return points.status();
            });
+  Register("BM_Wta" + suffix, scenes, set, sweep, kMsrMs,
+           [defaults](const BenchScene& scene) {
+             absl::StatusOr<std::vector<AttentionPoint>> points =
+                 ExtractWtaPoints(scene.rso_map, defaults.max_points,
+                                  defaults.wta);
+             benchmark::DoNotOptimize(points);
+             return points.status();
+           });
+  Register("BM_Tj" + suffix, scenes, set, sweep, kMsrMs,
+           [defaults](const BenchScene& scene) {
+             absl::StatusOr<std::vector<AttentionPoint>> points =
+                 ExtractTjPoints(scene.rso_map, defaults.max_points,
+                                 defaults.tj);
+             benchmark::DoNotOptimize(points);
+             return points.status();
+           });
 }
 
 void RegisterDetectCases(const SceneList* scenes, const std::string& set,
@@ -161,8 +178,8 @@ void RegisterDetectCases(const SceneList* scenes, const std::string& set,
     for (const SaliencyOp op : ops.value()) {
       options.channels.push_back({op, 1.0f});
     }
-    Register(absl::StrCat("BM_Detect/", Abs(channels), suffix), scenes, set,
-             sweep, kDetectMs, [options](const BenchScene& scene) {
+    Register(absl::StrCat("BM_Detect/", AbslView(channels), suffix), scenes,
+             set, sweep, kDetectMs, [options](const BenchScene& scene) {
                absl::StatusOr<DetectResult> result =
                    RunDetect(scene.frame, options);
                benchmark::DoNotOptimize(result);
@@ -207,8 +224,8 @@ void RegisterAttentionCases(const SceneList* scenes, const std::string& set,
     options.channels = {{c.op, 1.0f}};
     options.pyramid = c.pyramid;
     options.extraction = c.extraction;
-    Register(absl::StrCat("BM_DetectAttention/", Abs(c.name), suffix), scenes,
-             set, sweep, kDetectMs, [options](const BenchScene& scene) {
+    Register(absl::StrCat("BM_DetectAttention/", AbslView(c.name), suffix),
+             scenes, set, sweep, kDetectMs, [options](const BenchScene& scene) {
                absl::StatusOr<DetectResult> result =
                    RunDetect(scene.frame, options);
                benchmark::DoNotOptimize(result);
@@ -242,7 +259,8 @@ void SweepScenes(benchmark::State& state, const SceneList& scenes,
     }
     if (++next == scenes.size()) next = 0;
   }
-  state.SetLabel(absl::StrCat(scenes.size(), " ", Abs(set_name), " frames"));
+  state.SetLabel(
+      absl::StrCat(scenes.size(), " ", AbslView(set_name), " frames"));
 }
 
 void RegisterStageBenchmarks(const SceneList* scenes,

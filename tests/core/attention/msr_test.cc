@@ -4,18 +4,12 @@
 
 #include <cmath>
 
+#include "tests/core/attention/test_maps.h"
+
 namespace fovea {
 namespace {
 
-void AddBlob(cv::Mat& map, float cu, float cv, float sigma, float peak) {
-  for (int v = 0; v < map.rows; ++v) {
-    for (int u = 0; u < map.cols; ++u) {
-      const float d2 = (u - cu) * (u - cu) + (v - cv) * (v - cv);
-      map.at<float>(v, u) = std::max(
-          map.at<float>(v, u), peak * std::exp(-d2 / (2 * sigma * sigma)));
-    }
-  }
-}
+using testing::AddBlob;
 
 TEST(MsrTest, FirstPointLiesOnTheMostSalientBlobNearItsCentre) {
   cv::Mat map(60, 80, CV_32FC1, cv::Scalar(0));
