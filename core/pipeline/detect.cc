@@ -68,19 +68,6 @@ absl::Status Check(const InterruptCheck& interrupt) {
   return interrupt ? interrupt() : absl::OkStatus();
 }
 
-absl::StatusOr<std::vector<AttentionPoint>> ExtractPoints(
-    const cv::Mat& master, const DetectOptions& options) {
-  switch (options.extraction) {
-    case ExtractionKind::kWta:
-      return ExtractWtaPoints(master, options.max_points, options.wta);
-    case ExtractionKind::kTj:
-      return ExtractTjPoints(master, options.max_points, options.tj);
-    case ExtractionKind::kMsr:
-      break;
-  }
-  return ExtractMsrPoints(master, options.max_points, options.msr);
-}
-
 void FillPoints(const OrganizedCloud& cloud,
                 std::vector<AttentionPoint>& points) {
   for (AttentionPoint& p : points) {
@@ -207,6 +194,19 @@ absl::StatusOr<DetectResult> RunDetectUnguarded(
     const InterruptCheck& interrupt);
 }  // namespace
 
+absl::StatusOr<std::vector<AttentionPoint>> ExtractAttentionPoints(
+    const cv::Mat& master, const DetectOptions& options) {
+  switch (options.extraction) {
+    case ExtractionKind::kWta:
+      return ExtractWtaPoints(master, options.max_points, options.wta);
+    case ExtractionKind::kTj:
+      return ExtractTjPoints(master, options.max_points, options.tj);
+    case ExtractionKind::kMsr:
+      break;
+  }
+  return ExtractMsrPoints(master, options.max_points, options.msr);
+}
+
 std::vector<std::string> DetectStageNames() {
   std::vector<std::string> names = {"fill_holes", "cloud", "normals",
                                     "support_plane", "fusion"};
@@ -301,7 +301,7 @@ absl::StatusOr<DetectResult> RunDetectUnguarded(
   clock.Lap("fusion");
 
   absl::StatusOr<std::vector<AttentionPoint>> points =
-      ExtractPoints(result.master, options);
+      ExtractAttentionPoints(result.master, options);
   if (!points.ok()) return points.status();
   result.points = *std::move(points);
   FillPoints(cloud, result.points);

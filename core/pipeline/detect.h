@@ -142,6 +142,12 @@ struct DetectResult {
   double total_seconds = 0.0;
 };
 
+// The attention points of a master map (CV_32FC1, [0, 1]) by
+// options.extraction (MSR, WTA or TJ with their options), at most
+// options.max_points, most salient first; the 3D points are not filled in.
+absl::StatusOr<std::vector<AttentionPoint>> ExtractAttentionPoints(
+    const cv::Mat& master, const DetectOptions& options);
+
 // Every stage name RunDetect can report with the options it accepts today
 // ("cloud", "normals", "support_plane", "saliency.<op>", "fusion",
 // "extract.<kind>"), for metrics that must exist before the first call.

@@ -1,13 +1,11 @@
 #include "tools/bench/stage_benchmarks.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "core/attention/msr.h"
-#include "core/attention/tj.h"
-#include "core/attention/wta.h"
 #include "core/base/strings.h"
 #include "core/frame/frame_decode.h"
 #include "core/frame/organized_cloud.h"
@@ -142,30 +140,20 @@ void RegisterSaliencyCases(const SceneList* scenes, const std::string& set,
              benchmark::DoNotOptimize(map);
              return map.status();
            });
-  Register("BM_Msr" + suffix, scenes, set, sweep, kMsrMs,
-           [defaults](const BenchScene& scene) {
-             absl::StatusOr<std::vector<AttentionPoint>> points =
-                 ExtractMsrPoints(scene.rso_map, defaults.max_points,
-                                  defaults.msr);
-             benchmark::DoNotOptimize(points);
-             return points.status();
-           });
-  Register("BM_Wta" + suffix, scenes, set, sweep, kMsrMs,
-           [defaults](const BenchScene& scene) {
-             absl::StatusOr<std::vector<AttentionPoint>> points =
-                 ExtractWtaPoints(scene.rso_map, defaults.max_points,
-                                  defaults.wta);
-             benchmark::DoNotOptimize(points);
-             return points.status();
-           });
-  Register("BM_Tj" + suffix, scenes, set, sweep, kMsrMs,
-           [defaults](const BenchScene& scene) {
-             absl::StatusOr<std::vector<AttentionPoint>> points =
-                 ExtractTjPoints(scene.rso_map, defaults.max_points,
-                                 defaults.tj);
-             benchmark::DoNotOptimize(points);
-             return points.status();
-           });
+  for (const ExtractionKind kind :
+       {ExtractionKind::kMsr, ExtractionKind::kWta, ExtractionKind::kTj}) {
+    DetectOptions options = defaults;
+    options.extraction = kind;
+    std::string name(ExtractionName(kind));
+    name[0] = static_cast<char>(std::toupper(name[0]));
+    Register(absl::StrCat("BM_", name, suffix), scenes, set, sweep, kMsrMs,
+             [options](const BenchScene& scene) {
+               absl::StatusOr<std::vector<AttentionPoint>> points =
+                   ExtractAttentionPoints(scene.rso_map, options);
+               benchmark::DoNotOptimize(points);
+               return points.status();
+             });
+  }
 }
 
 void RegisterDetectCases(const SceneList* scenes, const std::string& set,
