@@ -349,6 +349,9 @@ absl::StatusOr<DetectOptions> ToDetectOptions(
     out.max_points = static_cast<int>(options.max_points());
   }
   out.keep_channel_maps = options.return_channel_maps();
+  if (options.has_split_at_surface_edges()) {
+    out.split_at_surface_edges = options.split_at_surface_edges();
+  }
   if (absl::Status status = ApplyTopDownCues(options, out); !status.ok()) {
     return status;
   }
@@ -455,6 +458,7 @@ v1::DetectOptions ToProtoDetectOptions(const DetectOptions& options) {
   out.set_extraction(ToProtoEnum(options.extraction));
   out.set_max_points(static_cast<uint32_t>(options.max_points));
   out.set_return_channel_maps(options.keep_channel_maps);
+  out.set_split_at_surface_edges(options.split_at_surface_edges);
   return out;
 }
 

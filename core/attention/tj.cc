@@ -51,6 +51,7 @@ struct Component {
   std::vector<int> pixels;    // padded indices; pixels[0] first in row-major
   double sum = 0.0;           // sum of saliency
   double su = 0.0, sv = 0.0;  // saliency-weighted sums of u and v
+  double au = 0.0, av = 0.0;  // sums of u and v
   double Mean() const { return sum / static_cast<double>(pixels.size()); }
 };
 
@@ -87,6 +88,8 @@ std::vector<Component> LabelComponents(Grid& grid) {
           c.sum += s;
           c.su += s * grid.U(q);
           c.sv += s * grid.V(q);
+          c.au += grid.U(q);
+          c.av += grid.V(q);
         }
         for (int offset : grid.ring) {
           const int r = q + offset;
@@ -241,12 +244,14 @@ std::vector<int> FinishSkeleton(const Component& component, Grid& grid) {
   return skeleton;
 }
 
-// The most salient junction of `skeleton` (ties: nearest the component's
-// centroid, then row-major order), or -1 without one.
+// The junction of `skeleton` nearest the component's centroid (`central`)
+// or the most salient one (ties: nearest the saliency-weighted centroid),
+// then the first in row-major order; -1 without a junction.
 int BestJunction(const std::vector<int>& skeleton, const Component& component,
-                 const Grid& grid) {
-  const double cu = component.su / component.sum;
-  const double cv = component.sv / component.sum;
+                 const Grid& grid, bool central) {
+  const double n = static_cast<double>(component.pixels.size());
+  const double cu = central ? component.au / n : component.su / component.sum;
+  const double cv = central ? component.av / n : component.sv / component.sum;
   int best = -1;
   float best_saliency = 0.0f;
   double best_d2 = 0.0;
@@ -255,6 +260,13 @@ int BestJunction(const std::vector<int>& skeleton, const Component& component,
     const float s = grid.Saliency(p);
     const double du = grid.U(p) - cu, dv = grid.V(p) - cv;
     const double d2 = du * du + dv * dv;
+    if (central) {
+      if (best < 0 || d2 < best_d2) {
+        best = p;
+        best_d2 = d2;
+      }
+      continue;
+    }
     if (best < 0 || s > best_saliency || (s == best_saliency && d2 < best_d2)) {
       best = p;
       best_saliency = s;
@@ -382,16 +394,30 @@ absl::StatusOr<std::vector<AttentionPoint>> ExtractTjPoints(
   }
   // Rank first, so that only the components that can yield a point are
   // thinned.
-  std::stable_sort(kept.begin(), kept.end(),
-                   [](const Component* a, const Component* b) {
-                     return a->Mean() > b->Mean();
-                   });
+  if (options.ranking == TjRanking::kTotalSaliency) {
+    std::stable_sort(
+        kept.begin(), kept.end(),
+        [](const Component* a, const Component* b) { return a->sum > b->sum; });
+  } else {
+    std::stable_sort(kept.begin(), kept.end(),
+                     [](const Component* a, const Component* b) {
+                       return a->Mean() > b->Mean();
+                     });
+  }
   if (static_cast<int>(kept.size()) > max_points) kept.resize(max_points);
+  // With kTotalSaliency a point's saliency is its component's total over
+  // the largest kept component's area: in [0, 1], non-increasing in rank,
+  // and the mean for the largest component.
+  size_t largest_area = 1;
+  for (const Component* c : kept) {
+    largest_area = std::max(largest_area, c->pixels.size());
+  }
   std::vector<int> border, doomed, local;
   for (const Component* c : kept) {
     ThinComponent(*c, grid, border, doomed);
     const std::vector<int> skeleton = FinishSkeleton(*c, grid);
-    int p = BestJunction(skeleton, *c, grid);
+    int p = BestJunction(skeleton, *c, grid,
+                         options.junction == TjJunction::kCentral);
     if (p < 0) {
       if (local.empty()) local.assign(grid.on.size(), -1);
       p = MiddleOfLongestPath(skeleton, grid, local);
@@ -399,7 +425,10 @@ absl::StatusOr<std::vector<AttentionPoint>> ExtractTjPoints(
     AttentionPoint point;
     point.u = grid.U(p);
     point.v = grid.V(p);
-    point.saliency = static_cast<float>(c->Mean());
+    point.saliency = static_cast<float>(
+        options.ranking == TjRanking::kTotalSaliency
+            ? c->sum / static_cast<double>(largest_area)
+            : c->Mean());
     points.push_back(point);
   }
   return points;

@@ -97,6 +97,27 @@ std::string_view ExtractionName(ExtractionKind kind) {
   return "unknown";
 }
 
+std::string_view PyramidName(PyramidKind kind) {
+  switch (kind) {
+    case PyramidKind::kNone:
+      return "none";
+    case PyramidKind::kSimple:
+      return "simple";
+    case PyramidKind::kItti:
+      return "itti";
+  }
+  return "unknown";
+}
+
+std::string ChannelsText(const std::vector<WeightedChannel>& channels) {
+  std::string text;
+  for (const WeightedChannel& c : channels) {
+    if (!text.empty()) text += '+';
+    text += SaliencyOpName(c.op);
+  }
+  return text;
+}
+
 absl::StatusOr<std::vector<SaliencyOp>> ParseSaliencyOps(
     std::string_view text) {
   std::vector<SaliencyOp> ops;
@@ -180,6 +201,7 @@ absl::Status Validate(const DetectOptions& options) {
   if (absl::Status s = Validate(options.location_prior); !s.ok()) return s;
   if (absl::Status s = Validate(options.wta); !s.ok()) return s;
   if (absl::Status s = Validate(options.tj); !s.ok()) return s;
+  if (absl::Status s = Validate(options.surface_edges); !s.ok()) return s;
   if (absl::Status s = Validate(options.cloud_pyramid); !s.ok()) return s;
   if (absl::Status s = Validate(options.feature_pyramid); !s.ok()) return s;
   if (absl::Status s = Validate(options.normalization_options); !s.ok()) {
@@ -297,6 +319,9 @@ absl::StatusOr<DetectResult> RunDetectUnguarded(
                                                       : ChannelFusion::kSum);
   if (!master.ok()) return master.status();
   result.master = *std::move(master);
+  if (options.split_at_surface_edges) {
+    result.master.setTo(0.0f, FindSurfaceEdges(cloud, options.surface_edges));
+  }
   NormalizeLinear(result.master);
   clock.Lap("fusion");
 

@@ -16,6 +16,7 @@
 #include "core/frame/organized_cloud.h"
 #include "core/frame/rgbd_frame.h"
 #include "core/frame/support_plane.h"
+#include "core/frame/surface_edges.h"
 #include "core/frame/table_scene.h"
 #include "core/pyramid/cloud_pyramid.h"
 #include "core/pyramid/feature_pyramid.h"
@@ -54,6 +55,7 @@ enum class ExtractionKind { kMsr, kWta, kTj };
 
 std::string_view SaliencyOpName(SaliencyOp op);        // "ph", "sym3d", ...
 std::string_view ExtractionName(ExtractionKind kind);  // "msr", "wta", "tj"
+std::string_view PyramidName(PyramidKind kind);  // "none", "simple", "itti"
 // Parses "ph", "ph+sh+rso", ... into equally weighted channels.
 absl::StatusOr<std::vector<SaliencyOp>> ParseSaliencyOps(std::string_view text);
 absl::StatusOr<ExtractionKind> ParseExtraction(std::string_view text);
@@ -66,14 +68,20 @@ struct WeightedChannel {
   float weight = 1.0f;  // >= 0; renormalised so the weights sum to 1
 };
 
+// "sym3d", "ph+sh+rso": the channels' names joined by '+', as
+// ParseSaliencyOps reads them (weights left out).
+std::string ChannelsText(const std::vector<WeightedChannel>& channels);
+
 struct DetectOptions {
   // Channels of the master map (thesis eq. 2.42-2.44), each operator at
-  // most once. Default: RSO alone, the best single channel with MSR on the
-  // 45 OSD learn scenes (HR 0.957; README, "Measuring it").
-  std::vector<WeightedChannel> channels = {{SaliencyOp::kRso, 1.0f}};
+  // most once. The defaults of this struct are the combination that
+  // measures best on the 45 OSD learn scenes (docs/attention-sweep.md):
+  // SYM3D on the ITTI pyramid, split at surface edges, with TJ points;
+  // HR 0.993, DC 0.184.
+  std::vector<WeightedChannel> channels = {{SaliencyOp::kSym3d, 1.0f}};
   // Multi-scale pyramid (section 2.4): kNone is one level; kSimple and
   // kItti build each 3D channel's conspicuity map over the cloud pyramid.
-  PyramidKind pyramid = PyramidKind::kNone;
+  PyramidKind pyramid = PyramidKind::kItti;
   // Across-scale combination (eq. 2.40-2.41), used with a pyramid.
   LevelCombination level_combination = LevelCombination::kSum;
   // Normalisation of each map (eq. 2.37-2.39).
@@ -81,7 +89,7 @@ struct DetectOptions {
   // Fusion of the channels into the master map (eq. 2.42-2.44).
   FusionKind fusion = FusionKind::kSum;
   // Attention-point extraction (section 2.5).
-  ExtractionKind extraction = ExtractionKind::kMsr;
+  ExtractionKind extraction = ExtractionKind::kTj;
   // Attention points to return at most, [1, kMaxAttentionPoints].
   int max_points = 10;
   // Return each channel's map in DetectResult::channel_maps.
@@ -92,12 +100,19 @@ struct DetectOptions {
   // Pyramid level SYM3D runs on without a pyramid: its k x k kernel must
   // span an object (level 2 of a 640x480 frame is 160x120).
   int sym3d_level = 2;
+  // Zero the master map on occluding edges and concave creases
+  // (FindSurfaceEdges) before extraction, so that touching objects fall
+  // into separate components and regions.
+  // Off, the master map is the thesis's; touching and stacked objects then
+  // share one TJ component (learn scenes: HR 0.62 instead of 0.99).
+  bool split_at_surface_edges = true;
 
   // Options of each stage, documented with the stage.
   HoleFillingOptions hole_filling;
   NormalOptions normals;
   SupportPlaneOptions support_plane;
   TableSceneOptions table_scene;
+  SurfaceEdgeOptions surface_edges;
   PhOptions ph;
   ShOptions sh;
   RsoOptions rso;

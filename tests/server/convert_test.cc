@@ -25,7 +25,18 @@ TEST(ToDetectOptionsTest, EmptyOptionsAreCoreDefaults) {
   EXPECT_EQ(options->max_points, 10);
   EXPECT_EQ(options->pyramid, defaults.pyramid);
   EXPECT_EQ(options->extraction, defaults.extraction);
+  EXPECT_EQ(options->split_at_surface_edges, defaults.split_at_surface_edges);
   EXPECT_FALSE(options->keep_channel_maps);
+}
+
+TEST(ToDetectOptionsTest, SurfaceEdgeSplitIsDefaultUnlessSet) {
+  for (const bool split : {false, true}) {
+    v1::DetectOptions in;
+    in.set_split_at_surface_edges(split);
+    absl::StatusOr<DetectOptions> options = ToDetectOptions(in);
+    ASSERT_TRUE(options.ok()) << options.status();
+    EXPECT_EQ(options->split_at_surface_edges, split);
+  }
 }
 
 TEST(ToDetectOptionsTest, ChannelsWithZeroWeightWeighOne) {
@@ -154,6 +165,7 @@ TEST(ToDetectOptionsTest, DefaultsSurviveTheWire) {
   EXPECT_EQ(back->fusion, defaults.fusion);
   EXPECT_EQ(back->extraction, defaults.extraction);
   EXPECT_EQ(back->max_points, defaults.max_points);
+  EXPECT_EQ(back->split_at_surface_edges, defaults.split_at_surface_edges);
 }
 
 TEST(ToRawFrameTest, ViewsPointIntoTheRequest) {

@@ -8,6 +8,9 @@
 #include <string>
 #include <thread>
 
+#include "absl/strings/str_cat.h"
+#include "core/base/strings.h"
+#include "core/pipeline/detect.h"
 #include "core/synth/synth_scene.h"
 #include "fovea/v1/perception.grpc.pb.h"
 #include "gmock/gmock.h"
@@ -20,6 +23,13 @@
 
 namespace fovea::server {
 namespace {
+
+// The label of the default channel's stage metric, {stage="saliency.sym3d"}.
+std::string DefaultSaliencyStageLabel() {
+  return absl::StrCat("stage=\"saliency.",
+                      AbslView(SaliencyOpName(DetectOptions().channels[0].op)),
+                      "\"");
+}
 
 using ::fovea::server::testing::HealthStatus;
 using ::fovea::server::testing::kCallTimeout;
@@ -234,9 +244,9 @@ TEST_F(ServerTest, DeadlinePassingMidPipelineStopsTheJobBeforeSaliency) {
   // the boundary after its saliency channel too.
   EXPECT_EQ(stage_gate_.entered(), kCoreFirstBoundary);
   EXPECT_EQ(MetricValue(after, "fovea_stage_duration_seconds_count",
-                        {"stage=\"saliency.rso\""}),
+                        {DefaultSaliencyStageLabel()}),
             MetricValue(before, "fovea_stage_duration_seconds_count",
-                        {"stage=\"saliency.rso\""}));
+                        {DefaultSaliencyStageLabel()}));
 }
 
 TEST_F(ServerTest, FullQueueIsResourceExhausted) {
@@ -414,10 +424,11 @@ TEST_F(ServerTest, MetricsScrapeShowsCountersWithGrpcLabels) {
             MetricValue(before, "grpc_server_handling_seconds_count", detect)
                     .value_or(-1) +
                 2);
-  EXPECT_GE(MetricValue(after, "fovea_stage_duration_seconds_count",
-                        {"stage=\"saliency.rso\""})
-                .value_or(-1),
-            1);
+  const std::string default_stage = DefaultSaliencyStageLabel();
+  EXPECT_GE(
+      MetricValue(after, "fovea_stage_duration_seconds_count", {default_stage})
+          .value_or(-1),
+      1);
   EXPECT_EQ(
       MetricValue(after, "fovea_queue_wait_seconds_count", {}),
       MetricValue(before, "fovea_queue_wait_seconds_count", {}).value_or(-1) +

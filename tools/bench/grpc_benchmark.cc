@@ -79,7 +79,11 @@ v1::DetectRequest MakeRequest(const BenchScene& scene,
     weighted.set_op(server::ToProtoEnum(op));
     weighted.set_weight(1.0);
   }
+  if (ops.empty()) return request;  // the server's defaults
+  // The foundation's configuration, as BM_Detect runs it.
+  options.set_pyramid(v1::NONE);
   options.set_extraction(v1::MSR);
+  options.set_split_at_surface_edges(false);
   options.set_max_points(DetectOptions{}.max_points);
   return request;
 }
@@ -118,10 +122,15 @@ void RegisterGrpcBenchmarks(const SceneList* scenes,
                             const std::string& suffix,
                             const SweepOptions& sweep) {
   if (scenes->empty()) return;
+  std::vector<std::pair<std::string, std::vector<SaliencyOp>>> cases = {
+      {"default", {}}};  // no options: the server's defaults
   for (const std::string_view channels : kDetectChannelSets) {
-    const std::vector<SaliencyOp> ops = ParseSaliencyOps(channels).value();
+    cases.emplace_back(std::string(channels),
+                       ParseSaliencyOps(channels).value());
+  }
+  for (const auto& [name, ops] : cases) {
     benchmark::RegisterBenchmark(
-        absl::StrCat("BM_DetectGrpc/", AbslView(channels), suffix).c_str(),
+        absl::StrCat("BM_DetectGrpc/", AbslView(name), suffix).c_str(),
         [scenes, set_name, ops](benchmark::State& state) {
           BenchmarkGrpcDetect(state, *scenes, set_name, ops);
         })

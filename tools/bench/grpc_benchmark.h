@@ -8,7 +8,10 @@
 
 namespace fovea::bench {
 
-// Registers "BM_DetectGrpc/<ops><suffix>" for each of kDetectChannelSets:
+// Registers "BM_DetectGrpc/default<suffix>" (a request without options: the
+// server's defaults) and "BM_DetectGrpc/<ops><suffix>" for each of
+// kDetectChannelSets (one level, MSR, no surface-edge split, as
+// BM_Detect/<ops>):
 // the scene's raw wire frame (rgb8 + 16UC1, the bytes BM_DecodeRaw
 // decodes) sent as a DetectRequest over an insecure loopback channel to a
 // fovea-server started in this process (server/server.h, concurrency 1,

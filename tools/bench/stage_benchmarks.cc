@@ -10,6 +10,7 @@
 #include "core/frame/frame_decode.h"
 #include "core/frame/organized_cloud.h"
 #include "core/frame/support_plane.h"
+#include "core/frame/surface_edges.h"
 #include "core/frame/table_scene.h"
 #include "core/pipeline/detect.h"
 #include "core/saliency/ph.h"
@@ -29,6 +30,7 @@ constexpr double kSupportPlaneMs = 5.0;
 constexpr double kFramePrepMs = 15.0;
 constexpr double kSaliencyMs = 3.0;
 constexpr double kMsrMs = 2.0;
+constexpr double kSurfaceEdgesMs = 3.0;
 constexpr double kDetectMs = 30.0;
 
 using SceneBody = std::function<absl::Status(const BenchScene&)>;
@@ -133,6 +135,12 @@ void RegisterSaliencyCases(const SceneList* scenes, const std::string& set,
              benchmark::DoNotOptimize(map);
              return map.status();
            });
+  Register("BM_SurfaceEdges" + suffix, scenes, set, sweep, kSurfaceEdgesMs,
+           [options = defaults.surface_edges](const BenchScene& scene) {
+             cv::Mat edges = FindSurfaceEdges(scene.cloud, options);
+             benchmark::DoNotOptimize(edges);
+             return absl::OkStatus();
+           });
   Register("BM_SaliencyRso" + suffix, scenes, set, sweep, kSaliencyMs,
            [options = defaults.rso](const BenchScene& scene) {
              absl::StatusOr<cv::Mat> map = ComputeRsoSaliency(
@@ -158,10 +166,23 @@ void RegisterSaliencyCases(const SceneList* scenes, const std::string& set,
 
 void RegisterDetectCases(const SceneList* scenes, const std::string& set,
                          const std::string& suffix, const SweepOptions& sweep) {
+  // What a request without options gets.
+  Register("BM_Detect/default" + suffix, scenes, set, sweep, kDetectMs,
+           [](const BenchScene& scene) {
+             absl::StatusOr<DetectResult> result =
+                 RunDetect(scene.frame, DetectOptions{});
+             benchmark::DoNotOptimize(result);
+             return result.status();
+           });
   for (const std::string_view channels : kDetectChannelSets) {
     const absl::StatusOr<std::vector<SaliencyOp>> ops =
         ParseSaliencyOps(channels);
+    // The foundation's configuration (one level, MSR, the thesis's master
+    // map), so that these rows stay comparable across changes of defaults.
     DetectOptions options;
+    options.pyramid = PyramidKind::kNone;
+    options.extraction = ExtractionKind::kMsr;
+    options.split_at_surface_edges = false;
     options.channels.clear();
     for (const SaliencyOp op : ops.value()) {
       options.channels.push_back({op, 1.0f});
@@ -185,6 +206,8 @@ struct AttentionCase {
   PyramidKind pyramid;
   ExtractionKind extraction;
 };
+// Each runs with the defaults of DetectOptions otherwise (surface edges
+// split the master map).
 constexpr AttentionCase kAttentionCases[] = {
     {"sym3d/none/msr", SaliencyOp::kSym3d, PyramidKind::kNone,
      ExtractionKind::kMsr},

@@ -20,23 +20,46 @@
 ABSL_FLAG(std::string, data, "",
           "OSD-format folder: *.pcd files, or a folder with learn/ inside. "
           "Defaults to $FOVEA_OSD_DIR.");
-ABSL_FLAG(std::string, saliency, "rso",
+ABSL_FLAG(std::string, saliency,
+          fovea::ChannelsText(fovea::DetectOptions().channels),
           "Saliency channels: ph, sh, rso, or a combination like ph+sh+rso "
           "(equal weights); or pcl-clusters, the peer: Euclidean clusters on "
           "the support plane, largest first (ignores --extract).");
-ABSL_FLAG(std::string, extract, "msr", "Attention-point extraction: msr.");
+ABSL_FLAG(std::string, extract,
+          std::string(fovea::ExtractionName(fovea::DetectOptions().extraction)),
+          "Attention-point extraction: msr, wta or tj.");
 ABSL_FLAG(int, points, 10, "Attention points per scene (HR uses the first K).");
-ABSL_FLAG(std::string, pyramid, "none", "Pyramid: none, simple or itti.");
+ABSL_FLAG(std::string, pyramid,
+          std::string(fovea::PyramidName(fovea::DetectOptions().pyramid)),
+          "Pyramid: none, simple or itti.");
 ABSL_FLAG(std::string, combine, "sum",
           "Across-scale combination with a pyramid: sum or max.");
 ABSL_FLAG(std::string, norm, "lin", "Map normalisation: lin, nms or nlm.");
 ABSL_FLAG(std::string, fusion, "sum", "Channel fusion: sum or max.");
-ABSL_FLAG(int, sym3d_level, 2,
+ABSL_FLAG(int, sym3d_level, fovea::DetectOptions().sym3d_level,
           "Pyramid level SYM3D runs on without a pyramid.");
-ABSL_FLAG(int, sym3d_kernel, 7, "SYM3D kernel size, pixels of its level.");
-ABSL_FLAG(double, tj_support, 0.0,
+ABSL_FLAG(int, sym3d_kernel, fovea::DetectOptions().sym3d.kernel_size,
+          "SYM3D kernel size, pixels of its level.");
+ABSL_FLAG(double, tj_support, fovea::DetectOptions().tj.support_fraction,
           "TJ: components of the pixels at or above this fraction of the "
           "maximum (0: above zero, as the thesis).");
+ABSL_FLAG(std::string, tj_junction, "central",
+          "TJ: of several skeleton junctions take the one nearest the "
+          "component's centroid (central) or the most salient (salient).");
+ABSL_FLAG(std::string, tj_rank, "total",
+          "TJ: rank components by total saliency (total) or by mean saliency "
+          "(mean, the thesis).");
+ABSL_FLAG(bool, split_edges, fovea::DetectOptions().split_at_surface_edges,
+          "Zero the master map on occluding edges and concave creases "
+          "before extraction (touching objects become separate components).");
+ABSL_FLAG(double, edge_jump,
+          fovea::DetectOptions().surface_edges.depth_jump_fraction,
+          "Surface edges: depth jump, fraction of depth (0: off).");
+ABSL_FLAG(double, edge_concave,
+          fovea::DetectOptions().surface_edges.concave_curvature,
+          "Surface edges: concave crease threshold (0: off).");
+ABSL_FLAG(int, edge_radius, fovea::DetectOptions().surface_edges.radius_px,
+          "Surface edges: neighbour distance, pixels at f = 525 px.");
 ABSL_FLAG(bool, msr_inhibit_slope, true,
           "MSR also inhibits the slope around each region (false = exactly "
           "the thesis's MSR).");
@@ -120,6 +143,26 @@ int RunDetectEval() {
   options.detect.sym3d.kernel_size = absl::GetFlag(FLAGS_sym3d_kernel);
   options.detect.tj.support_fraction =
       static_cast<float>(absl::GetFlag(FLAGS_tj_support));
+  const std::string tj_junction = absl::GetFlag(FLAGS_tj_junction);
+  const std::string tj_rank = absl::GetFlag(FLAGS_tj_rank);
+  if ((tj_junction != "central" && tj_junction != "salient") ||
+      (tj_rank != "total" && tj_rank != "mean")) {
+    std::fprintf(stderr,
+                 "fovea-eval: --tj_junction central|salient, "
+                 "--tj_rank total|mean\n");
+    return kUsageError;
+  }
+  options.detect.tj.junction = tj_junction == "central"
+                                   ? TjJunction::kCentral
+                                   : TjJunction::kMostSalient;
+  options.detect.tj.ranking =
+      tj_rank == "total" ? TjRanking::kTotalSaliency : TjRanking::kMeanSaliency;
+  options.detect.split_at_surface_edges = absl::GetFlag(FLAGS_split_edges);
+  options.detect.surface_edges.depth_jump_fraction =
+      static_cast<float>(absl::GetFlag(FLAGS_edge_jump));
+  options.detect.surface_edges.concave_curvature =
+      static_cast<float>(absl::GetFlag(FLAGS_edge_concave));
+  options.detect.surface_edges.radius_px = absl::GetFlag(FLAGS_edge_radius);
   const std::string pyramid = absl::GetFlag(FLAGS_pyramid);
   const std::string combine = absl::GetFlag(FLAGS_combine);
   const std::string norm = absl::GetFlag(FLAGS_norm);
@@ -208,13 +251,15 @@ int main(int argc, char** argv) {
       "of Tables 2.4/2.5 as Markdown and CSV)");
   std::vector<char*> args = absl::ParseCommandLine(argc, argv);
   if (args.size() < 2) {
-    std::fprintf(stderr, "%s\n", absl::ProgramUsageMessage());
+    std::fprintf(stderr, "%s\n",
+                 std::string(absl::ProgramUsageMessage()).c_str());
     return fovea::eval::kUsageError;
   }
   const std::string command = args[1];
   if (command == "detect") return fovea::eval::RunDetectEval();
   if (command == "sweep") return fovea::eval::RunSweepCommand();
   std::fprintf(stderr, "fovea-eval: unknown command '%s'\n%s\n",
-               command.c_str(), absl::ProgramUsageMessage());
+               command.c_str(),
+               std::string(absl::ProgramUsageMessage()).c_str());
   return fovea::eval::kUsageError;
 }

@@ -138,10 +138,31 @@ TEST(TjTest, OfSeveralJunctionsTheMostSalientWins) {
   map(cv::Rect(30, 5, 1, 31)).setTo(1.0f);
   map(cv::Rect(11, 20, 9, 1)).setTo(0.8f);
   map(cv::Rect(20, 20, 10, 1)).setTo(1.0f);
-  const std::vector<AttentionPoint> points = Extract(map);
+  TjOptions most_salient;
+  most_salient.junction = TjJunction::kMostSalient;
+  const std::vector<AttentionPoint> points = Extract(map, 10, most_salient);
   ASSERT_EQ(points.size(), 1u);
   // Guo-Hall moves the junction of a one-pixel T by a pixel into the stem.
   EXPECT_LE(Distance(points[0], 30, 20), 1.0);
+}
+
+TEST(TjTest, OfSeveralJunctionsTheCentralOneWinsByDefault) {
+  // A comb: a bar along row 20 crossed by three teeth at columns 10, 30
+  // and 50, so three crossings; the component's centroid is (30, 20). The
+  // right tooth is the brightest, so kMostSalient takes its crossing.
+  cv::Mat map = Zeros(61, 41);
+  map(cv::Rect(5, 20, 51, 1)).setTo(0.6f);
+  map(cv::Rect(10, 5, 1, 31)).setTo(0.6f);
+  map(cv::Rect(30, 5, 1, 31)).setTo(0.6f);
+  map(cv::Rect(50, 5, 1, 31)).setTo(1.0f);
+  std::vector<AttentionPoint> points = Extract(map);
+  ASSERT_EQ(points.size(), 1u);
+  EXPECT_LE(Distance(points[0], 30, 20), 1.0);
+  TjOptions most_salient;
+  most_salient.junction = TjJunction::kMostSalient;
+  points = Extract(map, 10, most_salient);
+  ASSERT_EQ(points.size(), 1u);
+  EXPECT_LE(Distance(points[0], 50, 20), 1.0);
 }
 
 TEST(TjTest, StraightBarYieldsItsMiddle) {
@@ -229,6 +250,28 @@ TEST(TjTest, PointsAreRankedByComponentMeanSaliency) {
   ASSERT_EQ(points.size(), 2u);
   EXPECT_TRUE(points[1].u >= 62);
   EXPECT_TRUE(Extract(map, 0).empty());
+}
+
+TEST(TjTest, ByDefaultALargeComponentComesBeforeASmallBrightOne) {
+  // A 30 x 30 object at 0.6 (total 540) and a 5 x 5 sliver at 1.0 (total
+  // 25), as an occluder leaves of the object behind it.
+  cv::Mat map = Zeros(80, 40);
+  map(cv::Rect(2, 2, 30, 30)).setTo(0.6f);
+  map(cv::Rect(60, 2, 5, 5)).setTo(1.0f);
+  std::vector<AttentionPoint> points = Extract(map);
+  ASSERT_EQ(points.size(), 2u);
+  EXPECT_LT(points[0].u, 32);
+  EXPECT_GE(points[1].u, 60);
+  // Total over the largest area: the big one's mean, then 25 / 900.
+  EXPECT_NEAR(points[0].saliency, 0.6f, 1e-5);
+  EXPECT_NEAR(points[1].saliency, 25.0f / 900.0f, 1e-5);
+  TjOptions by_mean;
+  by_mean.ranking = TjRanking::kMeanSaliency;
+  points = Extract(map, 10, by_mean);
+  ASSERT_EQ(points.size(), 2u);
+  EXPECT_GE(points[0].u, 60);
+  EXPECT_FLOAT_EQ(points[0].saliency, 1.0f);
+  EXPECT_NEAR(points[1].saliency, 0.6f, 1e-5);
 }
 
 TEST(TjTest, EmptyMapGivesNoPoints) {

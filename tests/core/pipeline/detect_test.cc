@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <set>
 
 #include "core/synth/synth_scene.h"
 
@@ -22,6 +23,38 @@ TEST(DetectTest, FirstPointLiesOnAnObjectInSyntheticScenes) {
     EXPECT_FALSE(std::isnan(p.point.z()));
   }
   EXPECT_GE(on_object, kScenes - 1);
+}
+
+TEST(DetectTest, DefaultsGiveAStackedBoxItsOwnPoint) {
+  // A small box on a large one: one region of the thesis's master map,
+  // two once it is split at the fold between them.
+  synth::SceneSpec spec;
+  spec.camera_pose = synth::LookAt({0.0f, -0.75f, 0.75f}, {0.0f, 0.0f, 0.0f});
+  synth::Primitive bottom;
+  bottom.half_extents = {0.1f, 0.06f, 0.06f};
+  bottom.pose.translation() = Eigen::Vector3f(0.0f, 0.05f, 0.06f);
+  synth::Primitive top = bottom;
+  top.half_extents = {0.05f, 0.04f, 0.04f};
+  top.pose.translation() = Eigen::Vector3f(0.0f, 0.05f, 0.16f);
+  spec.objects = {bottom, top};
+  const synth::SynthScene scene = synth::RenderScene(spec, {}, 7);
+  auto objects_hit_by_first_two = [&](const DetectOptions& options) {
+    absl::StatusOr<DetectResult> result =
+        RunDetect(scene.frame.frame, options);
+    EXPECT_TRUE(result.ok()) << result.status();
+    std::set<int> hit;
+    for (size_t i = 0; result.ok() && i < result->points.size() && i < 2;
+         ++i) {
+      const int label =
+          scene.frame.labels.at<int>(result->points[i].v, result->points[i].u);
+      if (label >= 20) hit.insert(label);
+    }
+    return hit.size();
+  };
+  EXPECT_EQ(objects_hit_by_first_two(DetectOptions{}), 2u);
+  DetectOptions thesis;
+  thesis.split_at_surface_edges = false;
+  EXPECT_LT(objects_hit_by_first_two(thesis), 2u);
 }
 
 TEST(DetectTest, PointsComeMostSalientFirstWithTimings) {
@@ -70,6 +103,9 @@ TEST(DetectTest, LocationPriorAloneAttendsToItsCentre) {
   const synth::SynthScene scene = synth::GenerateScene(5);
   DetectOptions options;
   options.channels = {{SaliencyOp::kLocationPrior, 1}};
+  // A Gaussian over the whole image has a mean far below 10 % of its peak,
+  // which TJ drops (theta_sal); MSR takes its peak.
+  options.extraction = ExtractionKind::kMsr;
   options.location_prior = {100.0f, 300.0f, 30.0f};
   absl::StatusOr<DetectResult> result = RunDetect(scene.frame.frame, options);
   ASSERT_TRUE(result.ok());
