@@ -91,7 +91,7 @@ TEST(FoveaEvalTest, SweepWritesTheGridAsMarkdownAndCsv) {
       std::filesystem::path(::testing::TempDir()) / "fovea_eval_sweep";
   const ::fovea::testing::CommandRun run =
       RunEval("sweep --data " + dir.string() + " --out " + out.string() +
-              " --filter rso/none/-/lin/");
+              " --filter rso/none/-/lin/wta/");
   ASSERT_EQ(run.exit_code, 0) << run.out;
   std::ifstream md(out / "sweep.md");
   std::string header, rule, row1, row2, extra;
@@ -99,13 +99,14 @@ TEST(FoveaEvalTest, SweepWritesTheGridAsMarkdownAndCsv) {
   std::getline(md, rule);
   std::getline(md, row1);
   std::getline(md, row2);
-  EXPECT_THAT(header, HasSubstr("| HR | DC | DC (thesis) |"));
-  // rso with WTA and MSR (TJ is a SYM3D row), then the two ph+sh+rso rows
-  // the substring filter also matches.
-  EXPECT_THAT(row1, HasSubstr("| rso | none | - | lin | wta |"));
-  EXPECT_THAT(row2, HasSubstr("| rso | none | - | lin | msr |"));
+  EXPECT_THAT(header, HasSubstr("| variant | HR | DC | DC (thesis) |"));
+  // rso with WTA as the thesis has it and with Fovea's defaults, then the
+  // two ph+sh+rso rows the substring filter also matches.
+  EXPECT_THAT(row1, HasSubstr("| rso | none | - | lin | wta | thesis |"));
+  EXPECT_THAT(row2, HasSubstr("| rso | none | - | lin | wta | fovea |"));
   ASSERT_TRUE(std::getline(md, extra));
-  EXPECT_THAT(extra, HasSubstr("| ph+sh+rso | none | - | lin | wta |"));
+  EXPECT_THAT(extra,
+              HasSubstr("| ph+sh+rso | none | - | lin | wta | thesis |"));
   std::ifstream csv(out / "sweep.csv");
   std::string line;
   int lines = 0;

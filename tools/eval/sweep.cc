@@ -18,7 +18,8 @@ constexpr const char* kKinds[] = {"boxes", "stacked", "occluded", "cylindric"};
 DetectEvalOptions Options(const std::string& saliency,
                           const std::string& pyramid,
                           const std::string& combine, const std::string& norm,
-                          const std::string& extract) {
+                          const std::string& extract,
+                          const std::string& variant) {
   DetectEvalOptions o;
   if (saliency == "pcl-clusters") {
     o.pcl_clusters = true;
@@ -41,12 +42,17 @@ DetectEvalOptions Options(const std::string& saliency,
   const absl::StatusOr<ExtractionKind> kind = ParseExtraction(extract);
   FOVEA_CHECK(kind.ok());
   o.detect.extraction = *kind;
+  if (variant == "thesis") {
+    o.detect.split_at_surface_edges = false;
+    o.detect.tj.junction = TjJunction::kMostSalient;
+    o.detect.tj.ranking = TjRanking::kMeanSaliency;
+  }
   return o;
 }
 
 std::string Label(const SweepRow& r) {
   return absl::StrCat(r.saliency, "/", r.pyramid, "/", r.combine, "/", r.norm,
-                      "/", r.extract);
+                      "/", r.extract, "/", r.variant);
 }
 
 }  // namespace
@@ -56,9 +62,13 @@ std::vector<SweepRow> ThesisGrid(const std::string& filter) {
   auto add = [&](const std::string& s, const std::string& p,
                  const std::string& c, const std::string& n,
                  const std::string& e) {
-    SweepRow row{s, p, c, n, e, Options(s, p, c, n, e)};
-    if (filter.empty() || Label(row).find(filter) != std::string::npos) {
-      rows.push_back(std::move(row));
+    const bool peer = s == "pcl-clusters";
+    for (const std::string v : {"thesis", "fovea"}) {
+      SweepRow row{s, p, c, n, e, peer ? "-" : v, Options(s, p, c, n, e, v)};
+      if (filter.empty() || Label(row).find(filter) != std::string::npos) {
+        rows.push_back(std::move(row));
+      }
+      if (peer) break;
     }
   };
   for (const std::string s : {"ph", "sh", "rso", "sym3d"}) {
@@ -92,11 +102,12 @@ absl::Status RunSweep(const std::vector<LabelledFrame>& scenes,
   if (!md || !csv) {
     return absl::InvalidArgumentError("sweep: cannot write to " + out_dir);
   }
-  md << "| saliency | pyramid | combine | norm | extract | HR | DC | DC "
-        "(thesis) | HR boxes | HR stacked | HR occluded | HR cylindric | "
+  md << "| saliency | pyramid | combine | norm | extract | variant | HR | DC "
+        "| DC (thesis) | HR boxes | HR stacked | HR occluded | HR cylindric | "
         "ms (median) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|"
-        "\n";
-  csv << "saliency,pyramid,combine,norm,extract,hit_ratio,distance_to_center,"
+        "---|\n";
+  csv << "saliency,pyramid,combine,norm,extract,variant,hit_ratio,"
+         "distance_to_center,"
          "distance_to_center_thesis,hr_boxes,hr_stacked,hr_occluded,"
          "hr_cylindric,detect_ms_median\n";
   for (size_t i = 0; i < rows.size(); ++i) {
@@ -119,14 +130,14 @@ absl::Status RunSweep(const std::vector<LabelledFrame>& scenes,
                         all->distance_to_center, all->distance_to_center_thesis,
                         absl::StrJoin(by_kind, "|"), all->detect_ms_median);
     md << "| " << row.saliency << " | " << row.pyramid << " | " << row.combine
-       << " | " << row.norm << " | " << row.extract << " | "
-       << absl::StrJoin(absl::StrSplit(numbers, '|'), " | ") << " |\n";
+       << " | " << row.norm << " | " << row.extract << " | " << row.variant
+       << " | " << absl::StrJoin(absl::StrSplit(numbers, '|'), " | ") << " |\n";
     csv << row.saliency << "," << row.pyramid << "," << row.combine << ","
-        << row.norm << "," << row.extract << ","
+        << row.norm << "," << row.extract << "," << row.variant << ","
         << absl::StrJoin(absl::StrSplit(numbers, '|'), ",") << "\n";
     md.flush();
     csv.flush();
-    std::fprintf(stderr, "[%zu/%zu] %-40s HR %.3f DC %.3f\n", i + 1,
+    std::fprintf(stderr, "[%zu/%zu] %-48s HR %.3f DC %.3f\n", i + 1,
                  rows.size(), Label(row).c_str(), all->hit_ratio,
                  all->distance_to_center);
   }

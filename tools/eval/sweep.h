@@ -17,14 +17,19 @@ struct SweepRow {
   std::string combine;   // "sum", "max" ("-" without a pyramid)
   std::string norm;      // "lin", "nms", "nlm"
   std::string extract;   // "wta", "msr", "tj"
+  // "thesis": the thesis's master map and TJ (no surface-edge split, the
+  // most salient junction, regions ranked by mean saliency); "fovea": the
+  // defaults of DetectOptions for those three.
+  std::string variant;
   DetectEvalOptions options;
 };
 
 // The grid: each 3D map (ph, sh, rso, sym3d) x {single level, SIMPLE, ITTI}
 // x {SUM, MAX} (pyramids only) x {LIN, NMS, NLM} x {WTA, MSR, and TJ for
 // SYM3D}; the colour maps with WTA and MSR; PH+SH+RSO with and without
-// HAREL; the pcl-clusters peer. `filter` keeps the rows whose label
-// ("saliency/pyramid/combine/norm/extract") contains it.
+// HAREL; each in the "thesis" and the "fovea" variant; the pcl-clusters
+// peer. `filter` keeps the rows whose label
+// ("saliency/pyramid/combine/norm/extract/variant") contains it.
 std::vector<SweepRow> ThesisGrid(const std::string& filter);
 
 // Evaluates every row on `scenes` and writes <out_dir>/sweep.md (a table
