@@ -85,6 +85,9 @@ ABSL_FLAG(std::string, norm, "", "map normalisation: lin | nms | nlm");
 ABSL_FLAG(std::string, combine, "", "pyramid level combination: sum | max");
 ABSL_FLAG(std::string, fusion, "", "channel fusion: sum | max");
 ABSL_FLAG(bool, maps, false, "ask for each channel's saliency map");
+ABSL_FLAG(std::optional<bool>, split_edges, std::nullopt,
+          "split the master map at surface edges before extraction "
+          "(unset: the server's default; false: the thesis's map)");
 ABSL_FLAG(int32_t, points, 0,
           "number of attention points, 0 = the server's default (10)");
 
@@ -211,6 +214,9 @@ absl::StatusOr<fovea::v1::DetectOptions> DetectOptionsFromFlags() {
   }
   options.set_max_points(static_cast<uint32_t>(points));
   options.set_return_channel_maps(absl::GetFlag(FLAGS_maps));
+  if (const std::optional<bool> split = absl::GetFlag(FLAGS_split_edges)) {
+    options.set_split_at_surface_edges(*split);
+  }
   options.set_return_saliency_map(!absl::GetFlag(FLAGS_out).empty());
   return options;
 }

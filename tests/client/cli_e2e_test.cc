@@ -89,6 +89,20 @@ TEST_F(FoveaClientCliE2eTest, DetectSyntheticJsonHasPoints) {
   EXPECT_LT(response.points(0).v(), 480u);
 }
 
+TEST_F(FoveaClientCliE2eTest, SplitEdgesFlagIsSentEitherWay) {
+  for (const char* value : {"true", "false"}) {
+    const CliRun run = RunCli(
+        absl::StrCat("--server ", address_,
+                     " detect --synthetic 3 --json --split_edges=", value));
+    ASSERT_EQ(run.exit_code, 0) << value << ": " << run.err;
+    EXPECT_THAT(run.out, HasSubstr("\"points\"")) << value;
+  }
+  const CliRun bad = RunCli(absl::StrCat(
+      "--server ", address_, " detect --synthetic 3 --split_edges=maybe"));
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_THAT(bad.err, HasSubstr("split_edges"));
+}
+
 TEST_F(FoveaClientCliE2eTest, FailedCallPrintsCodeAndExits2) {
   // A negative focal length is bad input the server must refuse.
   const CliRun run = RunCli(

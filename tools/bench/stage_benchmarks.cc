@@ -16,6 +16,7 @@
 #include "core/saliency/ph.h"
 #include "core/saliency/rso.h"
 #include "core/saliency/sh.h"
+#include "core/saliency/sym3d.h"
 
 namespace fovea::bench {
 namespace {
@@ -31,6 +32,7 @@ constexpr double kFramePrepMs = 15.0;
 constexpr double kSaliencyMs = 3.0;
 constexpr double kMsrMs = 2.0;
 constexpr double kSurfaceEdgesMs = 3.0;
+constexpr double kSym3dLevel0Ms = 40.0;
 constexpr double kDetectMs = 30.0;
 
 using SceneBody = std::function<absl::Status(const BenchScene&)>;
@@ -132,6 +134,15 @@ void RegisterSaliencyCases(const SceneList* scenes, const std::string& set,
            [options = defaults.sh](const BenchScene& scene) {
              absl::StatusOr<cv::Mat> map = ComputeShSaliency(
                  scene.cloud, scene.plane, scene.table, options);
+             benchmark::DoNotOptimize(map);
+             return map.status();
+           });
+  // SYM3D on the full-resolution level: the SIMPLE pyramid's most costly
+  // level (level l has 4^-l of its pixels).
+  Register("BM_SaliencySym3d/level0" + suffix, scenes, set, sweep,
+           kSym3dLevel0Ms, [options = defaults.sym3d](const BenchScene& scene) {
+             absl::StatusOr<cv::Mat> map =
+                 ComputeSym3dSaliency(scene.cloud, scene.table, options);
              benchmark::DoNotOptimize(map);
              return map.status();
            });
