@@ -89,6 +89,40 @@ TEST(Sym3dSaliencyTest, LyingCylinderPeaksOnItsAxisLine) {
   EXPECT_GT(on_axis, columns * 8 / 10) << on_axis << " of " << columns;
 }
 
+TEST(Sym3dSaliencyTest, StandingConePeaksOnItsAxis) {
+  // Fig. 2.4's cone: its axis projects to a vertical line through the
+  // middle of its silhouette, and each row's most symmetric pixel is there.
+  synth::Primitive cone;
+  cone.shape = synth::Shape::kCone;
+  cone.radius = 0.07f;
+  cone.half_extents = {0.0f, 0.0f, 0.09f};
+  cone.pose = Eigen::Isometry3f(Eigen::Translation3f(0.0f, 0.0f, 0.09f));
+  const Rendered r = Render(cone);
+  absl::StatusOr<cv::Mat> map =
+      ComputeSym3dSaliency(r.cloud, r.table, ObjectSizedKernel());
+  ASSERT_TRUE(map.ok()) << map.status();
+  int rows = 0, on_axis = 0;
+  for (int v = 0; v < map->rows; ++v) {
+    int left = -1, right = -1, best_col = -1;
+    float best = 0.0f;
+    for (int u = 0; u < map->cols; ++u) {
+      if (r.table.candidate.at<uint8_t>(v, u) == 0) continue;
+      if (left < 0) left = u;
+      right = u;
+      if (map->at<float>(v, u) > best) {
+        best = map->at<float>(v, u);
+        best_col = u;
+      }
+    }
+    if (left < 0 || right - left < 10 || best_col < 0) continue;
+    ++rows;
+    const float middle = 0.5f * (left + right);
+    on_axis += std::abs(best_col - middle) <= 0.15f * (right - left);
+  }
+  ASSERT_GT(rows, 10);
+  EXPECT_GT(on_axis, rows * 8 / 10) << on_axis << " of " << rows;
+}
+
 TEST(Sym3dSaliencyTest, SpherePeaksNearItsCentre) {
   synth::Primitive sphere;
   sphere.shape = synth::Shape::kSphere;
