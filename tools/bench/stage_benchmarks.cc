@@ -17,6 +17,7 @@
 #include "core/saliency/rso.h"
 #include "core/saliency/sh.h"
 #include "core/saliency/sym3d.h"
+#include "core/segmentation/planar_patches.h"
 
 namespace fovea::bench {
 namespace {
@@ -32,6 +33,7 @@ constexpr double kFramePrepMs = 15.0;
 constexpr double kSaliencyMs = 3.0;
 constexpr double kMsrMs = 2.0;
 constexpr double kSurfaceEdgesMs = 3.0;
+constexpr double kPlanarPatchesMs = 15.0;
 constexpr double kSym3dLevel0Ms = 40.0;
 constexpr double kDetectMs = 30.0;
 
@@ -145,6 +147,15 @@ void RegisterSaliencyCases(const SceneList* scenes, const std::string& set,
                  ComputeSym3dSaliency(scene.cloud, scene.table, options);
              benchmark::DoNotOptimize(map);
              return map.status();
+           });
+  // Planar patches (thesis section 3.2.2), the first step of every
+  // segmentation, on the whole cloud.
+  Register("BM_PlanarPatches" + suffix, scenes, set, sweep, kPlanarPatchesMs,
+           [](const BenchScene& scene) {
+             absl::StatusOr<PlanarPatches> patches =
+                 FindPlanarPatches(scene.cloud, {}, {});
+             benchmark::DoNotOptimize(patches);
+             return patches.status();
            });
   Register("BM_SurfaceEdges" + suffix, scenes, set, sweep, kSurfaceEdgesMs,
            [options = defaults.surface_edges](const BenchScene& scene) {

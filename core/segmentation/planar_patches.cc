@@ -1,0 +1,267 @@
+#include "core/segmentation/planar_patches.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+#include "absl/strings/str_cat.h"
+
+namespace fovea {
+namespace {
+
+constexpr float kDegToRad = static_cast<float>(M_PI / 180.0);
+// Curvature in [0, 1] is sorted into this many buckets (counting sort).
+constexpr int kCurvatureBuckets = 1024;
+// Label states while growing.
+constexpr int kUnvisited = -2;
+constexpr int kUnused = -3;  // no normal, or outside the mask
+constexpr int kNoise = -1;
+
+// Least-squares plane of the points summed in `sum` and `sum_outer`,
+// oriented towards the camera; false when degenerate.
+bool FitPlane(const Eigen::Vector3d& sum, const Eigen::Matrix3d& sum_outer,
+              int n, Eigen::Vector3f& normal, float& d) {
+  if (n < 3) return false;
+  const Eigen::Vector3d c = sum / n;
+  const Eigen::Matrix3d cov = sum_outer / n - c * c.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(cov);
+  Eigen::Vector3d nrm = eig.eigenvectors().col(0);
+  if (!nrm.allFinite() || nrm.norm() < 0.5) return false;
+  if (nrm.dot(c) > 0.0) nrm = -nrm;
+  normal = nrm.cast<float>().normalized();
+  d = static_cast<float>(-nrm.dot(c));
+  return true;
+}
+
+}  // namespace
+
+absl::Status Validate(const PlanarPatchOptions& options) {
+  if (!(options.max_plane_distance > 0.0f)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("planar_patches.max_plane_distance must be > 0, got ",
+                     options.max_plane_distance));
+  }
+  if (!(options.distance_per_m2 >= 0.0f)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("planar_patches.distance_per_m2 must be >= 0, got ",
+                     options.distance_per_m2));
+  }
+  if (!(options.max_normal_angle_deg > 0.0f &&
+        options.max_normal_angle_deg < 90.0f)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("planar_patches.max_normal_angle_deg must be in (0, 90), "
+                     "got ",
+                     options.max_normal_angle_deg));
+  }
+  if (!(options.max_depth_step_fraction > 0.0f)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("planar_patches.max_depth_step_fraction must be > 0, got ",
+                     options.max_depth_step_fraction));
+  }
+  if (!(options.refit_growth == 0.0f || options.refit_growth > 1.0f)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("planar_patches.refit_growth must be 0 or > 1, got ",
+                     options.refit_growth));
+  }
+  if (options.min_points < 1) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "planar_patches.min_points must be >= 1, got ", options.min_points));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<PlanarPatches> FindPlanarPatches(
+    const OrganizedCloud& cloud, const cv::Mat& mask,
+    const PlanarPatchOptions& options) {
+  if (absl::Status s = Validate(options); !s.ok()) return s;
+  const int w = cloud.width(), h = cloud.height();
+  if (!mask.empty() &&
+      (mask.type() != CV_8UC1 || mask.rows != h || mask.cols != w)) {
+    return absl::InvalidArgumentError(
+        "planar_patches: mask must be CV_8UC1 of the cloud's size");
+  }
+  if (!cloud.xyz.isContinuous() || !cloud.normals.isContinuous() ||
+      (!mask.empty() && !mask.isContinuous())) {
+    return absl::InvalidArgumentError(
+        "planar_patches: cloud and mask must be continuous matrices");
+  }
+  const int n = w * h;
+  const auto* xyz = reinterpret_cast<const cv::Vec3f*>(cloud.xyz.data);
+  const auto* nrm = reinterpret_cast<const cv::Vec3f*>(cloud.normals.data);
+  PlanarPatches result;
+  result.labels.create(h, w, CV_32SC1);
+  int* label = result.labels.ptr<int>();
+  for (int i = 0; i < n; ++i) {
+    const bool use = !std::isnan(nrm[i][2]) && !std::isnan(xyz[i][2]) &&
+                     (mask.empty() || mask.data[i] != 0);
+    label[i] = use ? kUnvisited : kUnused;
+  }
+
+  // Curvature, counting-sorted into seed order.
+  std::vector<uint16_t> bucket(n, 0);
+  std::vector<int> count(kCurvatureBuckets + 1, 0);
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const int i = v * w + u;
+      if (label[i] == kUnused) continue;
+      cv::Vec3f m(0, 0, 0);
+      for (int dv = -1; dv <= 1; ++dv) {
+        const int y = v + dv;
+        if (y < 0 || y >= h) continue;
+        for (int du = -1; du <= 1; ++du) {
+          const int x = u + du;
+          if (x < 0 || x >= w || label[y * w + x] == kUnused) continue;
+          m += nrm[y * w + x];
+        }
+      }
+      const float len = std::sqrt(m.dot(m));
+      const float curvature =
+          len > 0.0f
+              ? std::clamp(1.0f - std::abs(nrm[i].dot(m)) / len, 0.0f, 1.0f)
+              : 1.0f;
+      bucket[i] = static_cast<uint16_t>(
+          std::min(kCurvatureBuckets - 1,
+                   static_cast<int>(curvature * kCurvatureBuckets)));
+      ++count[bucket[i] + 1];
+    }
+  }
+  for (int b = 0; b < kCurvatureBuckets; ++b) count[b + 1] += count[b];
+  std::vector<int> order(count[kCurvatureBuckets]);
+  for (int i = 0; i < n; ++i) {
+    if (label[i] != kUnused) order[count[bucket[i]]++] = i;
+  }
+
+  const float min_cos = std::cos(options.max_normal_angle_deg * kDegToRad);
+  std::vector<int> members;
+  members.reserve(n);
+  for (const int seed : order) {
+    if (label[seed] != kUnvisited) continue;
+    const int id = static_cast<int>(result.patches.size());
+    Eigen::Vector3f normal(nrm[seed][0], nrm[seed][1], nrm[seed][2]);
+    const Eigen::Vector3f p0(xyz[seed][0], xyz[seed][1], xyz[seed][2]);
+    float d = -normal.dot(p0);
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d sum_outer = Eigen::Matrix3d::Zero();
+    int next_fit = 3;
+    members.clear();
+    members.push_back(seed);
+    label[seed] = id;
+    for (size_t head = 0; head < members.size(); ++head) {
+      const int i = members[head];
+      const Eigen::Vector3d p(xyz[i][0], xyz[i][1], xyz[i][2]);
+      sum += p;
+      sum_outer += p * p.transpose();
+      const int size = static_cast<int>(head) + 1;
+      if (options.refit_growth > 0.0f && size >= next_fit) {
+        FitPlane(sum, sum_outer, size, normal, d);
+        next_fit = static_cast<int>(std::ceil(size * options.refit_growth));
+      }
+      const int u = i % w, v = i / w;
+      const int neighbours[4] = {u > 0 ? i - 1 : -1, u + 1 < w ? i + 1 : -1,
+                                 v > 0 ? i - w : -1, v + 1 < h ? i + w : -1};
+      for (const int q : neighbours) {
+        if (q < 0 || label[q] != kUnvisited) continue;
+        const float zq = xyz[q][2];
+        if (std::abs(zq - xyz[i][2]) >
+            options.max_depth_step_fraction * std::min(zq, xyz[i][2])) {
+          continue;
+        }
+        const Eigen::Vector3f pq(xyz[q][0], xyz[q][1], zq);
+        const float tolerance =
+            options.max_plane_distance + options.distance_per_m2 * zq * zq;
+        if (std::abs(normal.dot(pq) + d) > tolerance) continue;
+        const Eigen::Vector3f nq(nrm[q][0], nrm[q][1], nrm[q][2]);
+        if (normal.dot(nq) < min_cos) continue;
+        label[q] = id;
+        members.push_back(q);
+      }
+    }
+    if (static_cast<int>(members.size()) < options.min_points) {
+      for (int i : members) label[i] = kNoise;
+      continue;
+    }
+    PlanarPatch patch;
+    FitPlane(sum, sum_outer, static_cast<int>(members.size()), normal, d);
+    patch.normal = normal;
+    patch.d = d;
+    patch.centroid = (sum / static_cast<double>(members.size())).cast<float>();
+    result.patches.push_back(patch);
+  }
+  // Points near a fold have normals smoothed across it, which no patch
+  // accepts; they join a neighbouring patch whose plane they lie on
+  // (distance test only), growing out from the patches breadth first.
+  std::vector<int> frontier;
+  for (int i = 0; i < n; ++i) {
+    if (label[i] >= 0) frontier.push_back(i);
+  }
+  for (size_t head = 0; head < frontier.size(); ++head) {
+    const int i = frontier[head];
+    const PlanarPatch& patch = result.patches[label[i]];
+    const int u = i % w, v = i / w;
+    const int neighbours[4] = {u > 0 ? i - 1 : -1, u + 1 < w ? i + 1 : -1,
+                               v > 0 ? i - w : -1, v + 1 < h ? i + w : -1};
+    for (const int q : neighbours) {
+      if (q < 0 || (label[q] != kNoise && label[q] != kUnvisited)) continue;
+      const float zq = xyz[q][2];
+      if (std::abs(zq - xyz[i][2]) >
+          options.max_depth_step_fraction * std::min(zq, xyz[i][2])) {
+        continue;
+      }
+      const Eigen::Vector3f pq(xyz[q][0], xyz[q][1], zq);
+      const float tolerance =
+          options.max_plane_distance + options.distance_per_m2 * zq * zq;
+      if (std::abs(patch.normal.dot(pq) + patch.d) > tolerance) continue;
+      label[q] = label[i];
+      frontier.push_back(q);
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    if (label[i] < 0) label[i] = kNoise;
+  }
+  // Sizes and boxes with the joined points.
+  for (PlanarPatch& patch : result.patches) {
+    patch.points = 0;
+    patch.box = cv::Rect();
+  }
+  std::vector<cv::Vec4i> extent(result.patches.size(), cv::Vec4i(w, h, -1, -1));
+  for (int i = 0; i < n; ++i) {
+    if (label[i] < 0) continue;
+    ++result.patches[label[i]].points;
+    cv::Vec4i& e = extent[label[i]];
+    e[0] = std::min(e[0], i % w);
+    e[1] = std::min(e[1], i / w);
+    e[2] = std::max(e[2], i % w);
+    e[3] = std::max(e[3], i / w);
+  }
+  for (size_t k = 0; k < extent.size(); ++k) {
+    const cv::Vec4i& e = extent[k];
+    result.patches[k].box =
+        cv::Rect(e[0], e[1], e[2] - e[0] + 1, e[3] - e[1] + 1);
+  }
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const int a = label[v * w + u];
+      if (a < 0) continue;
+      if (u + 1 < w) {
+        const int b = label[v * w + u + 1];
+        if (b >= 0 && b != a) {
+          result.adjacency.emplace_back(std::min(a, b), std::max(a, b));
+        }
+      }
+      if (v + 1 < h) {
+        const int b = label[(v + 1) * w + u];
+        if (b >= 0 && b != a) {
+          result.adjacency.emplace_back(std::min(a, b), std::max(a, b));
+        }
+      }
+    }
+  }
+  std::sort(result.adjacency.begin(), result.adjacency.end());
+  result.adjacency.erase(
+      std::unique(result.adjacency.begin(), result.adjacency.end()),
+      result.adjacency.end());
+  return result;
+}
+
+}  // namespace fovea
