@@ -425,10 +425,10 @@ absl::StatusOr<std::vector<AttentionPoint>> ExtractTjPoints(
     AttentionPoint point;
     point.u = grid.U(p);
     point.v = grid.V(p);
-    point.saliency = static_cast<float>(
-        options.ranking == TjRanking::kTotalSaliency
-            ? c->sum / static_cast<double>(largest_area)
-            : c->Mean());
+    point.saliency =
+        static_cast<float>(options.ranking == TjRanking::kTotalSaliency
+                               ? c->sum / static_cast<double>(largest_area)
+                               : c->Mean());
     points.push_back(point);
   }
   return points;

@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
@@ -32,6 +33,27 @@ bool FitPlane(const Eigen::Vector3d& sum, const Eigen::Matrix3d& sum_outer,
   normal = nrm.cast<float>().normalized();
   d = static_cast<float>(-nrm.dot(c));
   return true;
+}
+
+// The 4-neighbours of pixel index i of a w x h image; -1 outside it.
+std::array<int, 4> Neighbours4(int i, int w, int h) {
+  const int u = i % w, v = i / w;
+  return {u > 0 ? i - 1 : -1, u + 1 < w ? i + 1 : -1, v > 0 ? i - w : -1,
+          v + 1 < h ? i + w : -1};
+}
+
+// Point q continues the surface of its neighbour i (no depth step) and
+// lies on the plane n . p + d = 0 within the depth-dependent tolerance.
+bool ContinuesOntoPlane(const cv::Vec3f& q, const cv::Vec3f& i,
+                        const Eigen::Vector3f& n, float d,
+                        const PlanarPatchOptions& options) {
+  if (std::abs(q[2] - i[2]) >
+      options.max_depth_step_fraction * std::min(q[2], i[2])) {
+    return false;
+  }
+  const float tolerance =
+      options.max_plane_distance + options.distance_per_m2 * q[2] * q[2];
+  return std::abs(n.x() * q[0] + n.y() * q[1] + n.z() * q[2] + d) <= tolerance;
 }
 
 }  // namespace
@@ -157,20 +179,9 @@ absl::StatusOr<PlanarPatches> FindPlanarPatches(
         FitPlane(sum, sum_outer, size, normal, d);
         next_fit = static_cast<int>(std::ceil(size * options.refit_growth));
       }
-      const int u = i % w, v = i / w;
-      const int neighbours[4] = {u > 0 ? i - 1 : -1, u + 1 < w ? i + 1 : -1,
-                                 v > 0 ? i - w : -1, v + 1 < h ? i + w : -1};
-      for (const int q : neighbours) {
+      for (const int q : Neighbours4(i, w, h)) {
         if (q < 0 || label[q] != kUnvisited) continue;
-        const float zq = xyz[q][2];
-        if (std::abs(zq - xyz[i][2]) >
-            options.max_depth_step_fraction * std::min(zq, xyz[i][2])) {
-          continue;
-        }
-        const Eigen::Vector3f pq(xyz[q][0], xyz[q][1], zq);
-        const float tolerance =
-            options.max_plane_distance + options.distance_per_m2 * zq * zq;
-        if (std::abs(normal.dot(pq) + d) > tolerance) continue;
+        if (!ContinuesOntoPlane(xyz[q], xyz[i], normal, d, options)) continue;
         const Eigen::Vector3f nq(nrm[q][0], nrm[q][1], nrm[q][2]);
         if (normal.dot(nq) < min_cos) continue;
         label[q] = id;
@@ -198,20 +209,11 @@ absl::StatusOr<PlanarPatches> FindPlanarPatches(
   for (size_t head = 0; head < frontier.size(); ++head) {
     const int i = frontier[head];
     const PlanarPatch& patch = result.patches[label[i]];
-    const int u = i % w, v = i / w;
-    const int neighbours[4] = {u > 0 ? i - 1 : -1, u + 1 < w ? i + 1 : -1,
-                               v > 0 ? i - w : -1, v + 1 < h ? i + w : -1};
-    for (const int q : neighbours) {
+    for (const int q : Neighbours4(i, w, h)) {
       if (q < 0 || (label[q] != kNoise && label[q] != kUnvisited)) continue;
-      const float zq = xyz[q][2];
-      if (std::abs(zq - xyz[i][2]) >
-          options.max_depth_step_fraction * std::min(zq, xyz[i][2])) {
+      if (!ContinuesOntoPlane(xyz[q], xyz[i], patch.normal, patch.d, options)) {
         continue;
       }
-      const Eigen::Vector3f pq(xyz[q][0], xyz[q][1], zq);
-      const float tolerance =
-          options.max_plane_distance + options.distance_per_m2 * zq * zq;
-      if (std::abs(patch.normal.dot(pq) + patch.d) > tolerance) continue;
       label[q] = label[i];
       frontier.push_back(q);
     }

@@ -39,12 +39,10 @@ TEST(DetectTest, DefaultsGiveAStackedBoxItsOwnPoint) {
   spec.objects = {bottom, top};
   const synth::SynthScene scene = synth::RenderScene(spec, {}, 7);
   auto objects_hit_by_first_two = [&](const DetectOptions& options) {
-    absl::StatusOr<DetectResult> result =
-        RunDetect(scene.frame.frame, options);
+    absl::StatusOr<DetectResult> result = RunDetect(scene.frame.frame, options);
     EXPECT_TRUE(result.ok()) << result.status();
     std::set<int> hit;
-    for (size_t i = 0; result.ok() && i < result->points.size() && i < 2;
-         ++i) {
+    for (size_t i = 0; result.ok() && i < result->points.size() && i < 2; ++i) {
       const int label =
           scene.frame.labels.at<int>(result->points[i].v, result->points[i].u);
       if (label >= 20) hit.insert(label);
