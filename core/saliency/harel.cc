@@ -309,31 +309,12 @@ absl::Status Validate(const HarelOptions& options) {
         absl::StrCat("harel.gabor_wavelength_px must be >= 2, got ",
                      options.gabor_wavelength_px));
   }
-  if (options.gabor_kernel_size < 3 || options.gabor_kernel_size % 2 == 0 ||
-      options.gabor_kernel_size > 63) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("harel.gabor_kernel_size must be odd in [3, 63], got ",
-                     options.gabor_kernel_size));
+  if (absl::Status s = CheckGaborKernelSize("harel", options.gabor_kernel_size);
+      !s.ok()) {
+    return s;
   }
-  const std::pair<const char*, float> weights[] = {
-      {"intensity_weight", options.intensity_weight},
-      {"color_weight", options.color_weight},
-      {"orientation_weight", options.orientation_weight},
-  };
-  for (const auto& [field, value] : weights) {
-    if (!(value >= 0.0f && std::isfinite(value))) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("harel.", field, " must be >= 0, got ", value));
-    }
-  }
-  if (!(options.intensity_weight + options.color_weight +
-            options.orientation_weight >
-        0.0f)) {
-    return absl::InvalidArgumentError(
-        "harel.intensity_weight + color_weight + orientation_weight must be "
-        "> 0");
-  }
-  return absl::OkStatus();
+  return CheckFeatureWeights("harel", options.intensity_weight,
+                             options.color_weight, options.orientation_weight);
 }
 
 absl::StatusOr<cv::Mat> ComputeHarelSaliency(const cv::Mat& color,

@@ -250,11 +250,9 @@ absl::Status Validate(const IttiOptions& options) {
     return absl::InvalidArgumentError(absl::StrCat(
         "itti.gabor_sigma_px must be > 0, got ", options.gabor_sigma_px));
   }
-  if (options.gabor_kernel_size < 3 || options.gabor_kernel_size % 2 == 0 ||
-      options.gabor_kernel_size > 63) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("itti.gabor_kernel_size must be odd in [3, 63], got ",
-                     options.gabor_kernel_size));
+  if (absl::Status s = CheckGaborKernelSize("itti", options.gabor_kernel_size);
+      !s.ok()) {
+    return s;
   }
   if (absl::Status s = CheckFraction("color_intensity_threshold",
                                      options.color_intensity_threshold);
@@ -266,22 +264,8 @@ absl::Status Validate(const IttiOptions& options) {
       !s.ok()) {
     return s;
   }
-  const float weights[3] = {options.intensity_weight, options.color_weight,
-                            options.orientation_weight};
-  const char* names[3] = {"intensity_weight", "color_weight",
-                          "orientation_weight"};
-  for (int k = 0; k < 3; ++k) {
-    if (!(weights[k] >= 0.0f && std::isfinite(weights[k]))) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("itti.", names[k], " must be >= 0, got ", weights[k]));
-    }
-  }
-  if (!(weights[0] + weights[1] + weights[2] > 0.0f)) {
-    return absl::InvalidArgumentError(
-        "itti.intensity_weight + color_weight + orientation_weight must be "
-        "> 0");
-  }
-  return absl::OkStatus();
+  return CheckFeatureWeights("itti", options.intensity_weight,
+                             options.color_weight, options.orientation_weight);
 }
 
 absl::StatusOr<cv::Mat> ComputeIttiSaliency(const cv::Mat& color,

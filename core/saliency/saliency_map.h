@@ -19,6 +19,14 @@ void NormalizeLinear(cv::Mat& map);
 // "color: must be CV_8UC3 (RGB) ..." unless `color` is a non-empty CV_8UC3.
 absl::Status CheckColorImage(const cv::Mat& color);
 
+// The colour operators' shared options check: the three feature weights
+// (intensity, colour, orientation) are finite, >= 0 and not all 0, and the
+// Gabor kernel size is odd in [3, 63]. Messages name the field as
+// "<op>.intensity_weight", "<op>.gabor_kernel_size", ...
+absl::Status CheckFeatureWeights(const char* op, float intensity_weight,
+                                 float color_weight, float orientation_weight);
+absl::Status CheckGaborKernelSize(const char* op, int gabor_kernel_size);
+
 // Stretches `map` linearly to [0, 1] in place (minimum to 0, maximum to 1,
 // CV_32F). A map whose range is at most `relative_flat_tolerance` times its
 // largest magnitude is flat and becomes all zero.
