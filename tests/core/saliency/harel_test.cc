@@ -12,10 +12,8 @@ namespace fovea {
 namespace {
 
 using testing::ExpectIsSaliencyMap;
-using testing::kGrey;
 using testing::kOddBarX;
 using testing::kOddBarY;
-using testing::kRed;
 using testing::OddBarOut;
 using testing::RedDiscOnGrey;
 
@@ -51,44 +49,6 @@ TEST(HarelSaliencyTest, OrientationChannelFindsTheOddBar) {
   cv::Point peak;
   cv::minMaxLoc(*map, nullptr, nullptr, nullptr, &peak);
   EXPECT_LT(cv::norm(peak - cv::Point(kOddBarX, kOddBarY)), 30.0) << peak;
-}
-
-TEST(HarelSaliencyTest, UniformImageGivesAnAllZeroMap) {
-  const cv::Mat image(96, 128, CV_8UC3, cv::Scalar(40, 160, 90));
-  absl::StatusOr<cv::Mat> map = ComputeHarelSaliency(image, HarelOptions{});
-  ASSERT_TRUE(map.ok()) << map.status();
-  ExpectIsSaliencyMap(*map, image.size());
-  EXPECT_EQ(cv::countNonZero(*map), 0);
-}
-
-TEST(HarelSaliencyTest, OddSizedNoiseGivesAMapInUnitRangeAtInputSize) {
-  cv::Mat image(77, 101, CV_8UC3);
-  cv::randu(image, cv::Scalar::all(0), cv::Scalar::all(256));
-  absl::StatusOr<cv::Mat> map = ComputeHarelSaliency(image, HarelOptions{});
-  ASSERT_TRUE(map.ok()) << map.status();
-  ExpectIsSaliencyMap(*map, image.size());
-  double hi = 0.0;
-  cv::minMaxLoc(*map, nullptr, &hi);
-  EXPECT_FLOAT_EQ(hi, 1.0f);
-}
-
-TEST(HarelSaliencyTest, TinyImageStillGivesAMap) {
-  cv::Mat image(3, 2, CV_8UC3, cv::Scalar(kGrey));
-  image.at<cv::Vec3b>(1, 1) = kRed;
-  absl::StatusOr<cv::Mat> map = ComputeHarelSaliency(image, HarelOptions{});
-  ASSERT_TRUE(map.ok()) << map.status();
-  ExpectIsSaliencyMap(*map, image.size());
-}
-
-TEST(HarelSaliencyTest, EmptyOrWrongTypeColorIsInvalidArgumentNamingColor) {
-  absl::Status s = ComputeHarelSaliency(cv::Mat(), HarelOptions{}).status();
-  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_EQ(s.message(), "color: empty");
-  s = ComputeHarelSaliency(cv::Mat(4, 4, CV_8UC1, cv::Scalar(0)),
-                           HarelOptions{})
-          .status();
-  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_NE(std::string(s.message()).find("color:"), std::string::npos);
 }
 
 TEST(HarelSaliencyTest, WarmStartGivesTheEquilibriumOfPowerIteration) {
