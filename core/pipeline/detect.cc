@@ -148,6 +148,38 @@ absl::StatusOr<ExtractionKind> ParseExtraction(std::string_view text) {
       "extract: unknown strategy '", AbslView(text), "' (known: msr wta tj)"));
 }
 
+absl::StatusOr<PyramidKind> ParsePyramid(std::string_view text) {
+  if (text == "none") return PyramidKind::kNone;
+  if (text == "simple") return PyramidKind::kSimple;
+  if (text == "itti") return PyramidKind::kItti;
+  return absl::InvalidArgumentError(
+      absl::StrCat("pyramid: unknown kind '", AbslView(text),
+                   "' (known: none simple itti)"));
+}
+
+absl::StatusOr<LevelCombination> ParseLevelCombination(std::string_view text) {
+  if (text == "sum") return LevelCombination::kSum;
+  if (text == "max") return LevelCombination::kMax;
+  return absl::InvalidArgumentError(absl::StrCat(
+      "combine: unknown combination '", AbslView(text), "' (known: sum max)"));
+}
+
+absl::StatusOr<NormalizationKind> ParseNormalization(std::string_view text) {
+  if (text == "lin") return NormalizationKind::kLin;
+  if (text == "nms") return NormalizationKind::kNms;
+  if (text == "nlm") return NormalizationKind::kNlm;
+  return absl::InvalidArgumentError(
+      absl::StrCat("norm: unknown normalisation '", AbslView(text),
+                   "' (known: lin nms nlm)"));
+}
+
+absl::StatusOr<FusionKind> ParseFusion(std::string_view text) {
+  if (text == "sum") return FusionKind::kSum;
+  if (text == "max") return FusionKind::kMax;
+  return absl::InvalidArgumentError(absl::StrCat(
+      "fusion: unknown fusion '", AbslView(text), "' (known: sum max)"));
+}
+
 absl::Status Validate(const DetectOptions& options) {
   if (options.channels.empty()) {
     return absl::InvalidArgumentError("options.saliency: no channel given");

@@ -59,6 +59,12 @@ std::string_view PyramidName(PyramidKind kind);  // "none", "simple", "itti"
 // Parses "ph", "ph+sh+rso", ... into equally weighted channels.
 absl::StatusOr<std::vector<SaliencyOp>> ParseSaliencyOps(std::string_view text);
 absl::StatusOr<ExtractionKind> ParseExtraction(std::string_view text);
+// "none" "simple" "itti"; "sum" "max"; "lin" "nms" "nlm"; "sum" "max". An
+// unknown name is INVALID_ARGUMENT listing the known ones.
+absl::StatusOr<PyramidKind> ParsePyramid(std::string_view text);
+absl::StatusOr<LevelCombination> ParseLevelCombination(std::string_view text);
+absl::StatusOr<NormalizationKind> ParseNormalization(std::string_view text);
+absl::StatusOr<FusionKind> ParseFusion(std::string_view text);
 
 // Most attention points one request may ask for.
 inline constexpr int kMaxAttentionPoints = 100;

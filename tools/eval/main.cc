@@ -163,28 +163,24 @@ int RunDetectEval() {
   options.detect.surface_edges.concave_curvature =
       static_cast<float>(absl::GetFlag(FLAGS_edge_concave));
   options.detect.surface_edges.radius_px = absl::GetFlag(FLAGS_edge_radius);
-  const std::string pyramid = absl::GetFlag(FLAGS_pyramid);
-  const std::string combine = absl::GetFlag(FLAGS_combine);
-  const std::string norm = absl::GetFlag(FLAGS_norm);
-  const std::string fusion = absl::GetFlag(FLAGS_fusion);
-  if ((pyramid != "none" && pyramid != "simple" && pyramid != "itti") ||
-      (combine != "sum" && combine != "max") ||
-      (norm != "lin" && norm != "nms" && norm != "nlm") ||
-      (fusion != "sum" && fusion != "max")) {
+  const absl::StatusOr<PyramidKind> pyramid =
+      ParsePyramid(absl::GetFlag(FLAGS_pyramid));
+  const absl::StatusOr<LevelCombination> combine =
+      ParseLevelCombination(absl::GetFlag(FLAGS_combine));
+  const absl::StatusOr<NormalizationKind> norm =
+      ParseNormalization(absl::GetFlag(FLAGS_norm));
+  const absl::StatusOr<FusionKind> fusion =
+      ParseFusion(absl::GetFlag(FLAGS_fusion));
+  if (!pyramid.ok() || !combine.ok() || !norm.ok() || !fusion.ok()) {
     std::fprintf(stderr,
                  "fovea-eval: --pyramid none|simple|itti, --combine sum|max, "
                  "--norm lin|nms|nlm, --fusion sum|max\n");
     return kUsageError;
   }
-  options.detect.pyramid = pyramid == "itti"     ? PyramidKind::kItti
-                           : pyramid == "simple" ? PyramidKind::kSimple
-                                                 : PyramidKind::kNone;
-  options.detect.level_combination =
-      combine == "max" ? LevelCombination::kMax : LevelCombination::kSum;
-  options.detect.normalization = norm == "nms"   ? NormalizationKind::kNms
-                                 : norm == "nlm" ? NormalizationKind::kNlm
-                                                 : NormalizationKind::kLin;
-  options.detect.fusion = fusion == "max" ? FusionKind::kMax : FusionKind::kSum;
+  options.detect.pyramid = *pyramid;
+  options.detect.level_combination = *combine;
+  options.detect.normalization = *norm;
+  options.detect.fusion = *fusion;
   options.out_dir = absl::GetFlag(FLAGS_out);
   options.verbose = absl::GetFlag(FLAGS_verbose);
 

@@ -31,14 +31,14 @@ DetectEvalOptions Options(const std::string& saliency,
       ParseSaliencyOps(saliency);
   FOVEA_CHECK(ops.ok());
   for (SaliencyOp op : *ops) o.detect.channels.push_back({op, 1.0f});
-  o.detect.pyramid = pyramid == "itti"     ? PyramidKind::kItti
-                     : pyramid == "simple" ? PyramidKind::kSimple
-                                           : PyramidKind::kNone;
+  // Without a pyramid the grid's combine column is "-": the default.
+  const absl::StatusOr<PyramidKind> p = ParsePyramid(pyramid);
+  const absl::StatusOr<NormalizationKind> n = ParseNormalization(norm);
+  FOVEA_CHECK(p.ok() && n.ok());
+  o.detect.pyramid = *p;
   o.detect.level_combination =
-      combine == "max" ? LevelCombination::kMax : LevelCombination::kSum;
-  o.detect.normalization = norm == "nms"   ? NormalizationKind::kNms
-                           : norm == "nlm" ? NormalizationKind::kNlm
-                                           : NormalizationKind::kLin;
+      ParseLevelCombination(combine).value_or(LevelCombination::kSum);
+  o.detect.normalization = *n;
   const absl::StatusOr<ExtractionKind> kind = ParseExtraction(extract);
   FOVEA_CHECK(kind.ok());
   o.detect.extraction = *kind;

@@ -173,6 +173,21 @@ TEST(DetectTest, ParsesSaliencyNamesAndCombinations) {
   EXPECT_FALSE(ParseExtraction("xyz").ok());
 }
 
+TEST(DetectTest, PyramidNamesRoundTripAndOtherNamesAreNamed) {
+  for (PyramidKind kind :
+       {PyramidKind::kNone, PyramidKind::kSimple, PyramidKind::kItti}) {
+    EXPECT_EQ(*ParsePyramid(PyramidName(kind)), kind);
+  }
+  EXPECT_EQ(*ParseLevelCombination("max"), LevelCombination::kMax);
+  EXPECT_EQ(*ParseNormalization("nlm"), NormalizationKind::kNlm);
+  EXPECT_EQ(*ParseFusion("sum"), FusionKind::kSum);
+  EXPECT_NE(ParsePyramid("gauss").status().message().find("gauss"),
+            std::string::npos);
+  EXPECT_FALSE(ParseLevelCombination("-").ok());
+  EXPECT_FALSE(ParseNormalization("l2").ok());
+  EXPECT_FALSE(ParseFusion("mean").ok());
+}
+
 }  // namespace
 }  // namespace fovea
 
