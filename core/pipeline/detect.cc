@@ -243,9 +243,26 @@ absl::Status Validate(const DetectOptions& options) {
 }
 
 namespace {
-absl::StatusOr<DetectResult> RunDetectUnguarded(
+absl::StatusOr<PreparedScene> PrepareSceneUnguarded(
     const RgbdFrame& frame, const DetectOptions& options,
     const InterruptCheck& interrupt);
+absl::StatusOr<DetectResult> DetectOnSceneUnguarded(
+    const PreparedScene& scene, const DetectOptions& options,
+    const InterruptCheck& interrupt);
+
+// Runs `body`, turning what a library underneath throws into a status
+// (nothing throws out of core/).
+template <typename Body>
+auto Guarded(std::string_view what, Body body) -> decltype(body()) {
+  try {
+    return body();
+  } catch (const std::bad_alloc&) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat(AbslView(what), ": out of memory"));
+  } catch (const std::exception& e) {
+    return absl::InternalError(absl::StrCat(AbslView(what), ": ", e.what()));
+  }
+}
 }  // namespace
 
 absl::StatusOr<std::vector<AttentionPoint>> ExtractAttentionPoints(
@@ -280,29 +297,48 @@ std::vector<std::string> DetectStageNames() {
   return names;
 }
 
+absl::StatusOr<PreparedScene> PrepareScene(const RgbdFrame& frame,
+                                           const DetectOptions& options,
+                                           const InterruptCheck& interrupt) {
+  return Guarded("detect", [&] {
+    return PrepareSceneUnguarded(frame, options, interrupt);
+  });
+}
+
+absl::StatusOr<DetectResult> DetectOnScene(const PreparedScene& scene,
+                                           const DetectOptions& options,
+                                           const InterruptCheck& interrupt) {
+  return Guarded("detect", [&] {
+    return DetectOnSceneUnguarded(scene, options, interrupt);
+  });
+}
+
 absl::StatusOr<DetectResult> RunDetect(const RgbdFrame& frame,
                                        const DetectOptions& options,
                                        const InterruptCheck& interrupt) {
-  // Nothing throws out of core/: OpenCV and the standard library can.
-  try {
-    return RunDetectUnguarded(frame, options, interrupt);
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError("detect: out of memory");
-  } catch (const std::exception& e) {
-    return absl::InternalError(absl::StrCat("detect: ", e.what()));
-  }
+  const auto start = std::chrono::steady_clock::now();
+  absl::StatusOr<PreparedScene> scene = PrepareScene(frame, options, interrupt);
+  if (!scene.ok()) return scene.status();
+  absl::StatusOr<DetectResult> result =
+      DetectOnScene(*scene, options, interrupt);
+  if (!result.ok()) return result.status();
+  result->timings.insert(result->timings.begin(), scene->timings.begin(),
+                         scene->timings.end());
+  result->total_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
+  return result;
 }
 
 namespace {
 
-// RunDetect without the exception guard.
-absl::StatusOr<DetectResult> RunDetectUnguarded(
+// PrepareScene without the exception guard.
+absl::StatusOr<PreparedScene> PrepareSceneUnguarded(
     const RgbdFrame& frame, const DetectOptions& options,
     const InterruptCheck& interrupt) {
   if (absl::Status s = Validate(options); !s.ok()) return s;
-  const auto start = std::chrono::steady_clock::now();
-  DetectResult result;
-  StageClock clock(result.timings);
+  PreparedScene scene;
+  StageClock clock(scene.timings);
 
   RgbdFrame filled_frame;
   const RgbdFrame* input = &frame;
@@ -316,21 +352,34 @@ absl::StatusOr<DetectResult> RunDetectUnguarded(
     input = &filled_frame;
     clock.Lap("fill_holes");
   }
-  OrganizedCloud cloud = BackProject(*input);
+  scene.cloud = BackProject(*input);
   clock.Lap("cloud");
-  EstimateNormals(options.normals, cloud);
+  EstimateNormals(options.normals, scene.cloud);
   clock.Lap("normals");
   if (absl::Status s = Check(interrupt); !s.ok()) return s;
 
   absl::StatusOr<SupportPlane> plane =
-      FindSupportPlane(cloud, options.support_plane);
+      FindSupportPlane(scene.cloud, options.support_plane);
   if (!plane.ok()) return plane.status();
-  const TableScene scene =
-      PrepareTableScene(cloud, *plane, options.table_scene);
+  scene.plane = *std::move(plane);
+  scene.table =
+      PrepareTableScene(scene.cloud, scene.plane, options.table_scene);
   clock.Lap("support_plane");
   if (absl::Status s = Check(interrupt); !s.ok()) return s;
+  return scene;
+}
 
-  ChannelComputer channels(cloud, *plane, scene, options);
+// DetectOnScene without the exception guard.
+absl::StatusOr<DetectResult> DetectOnSceneUnguarded(
+    const PreparedScene& scene, const DetectOptions& options,
+    const InterruptCheck& interrupt) {
+  if (absl::Status s = Validate(options); !s.ok()) return s;
+  const auto start = std::chrono::steady_clock::now();
+  DetectResult result;
+  StageClock clock(result.timings);
+  const OrganizedCloud& cloud = scene.cloud;
+
+  ChannelComputer channels(cloud, scene.plane, scene.table, options);
   std::vector<NamedMap> maps;
   for (const WeightedChannel& c : options.channels) {
     absl::StatusOr<cv::Mat> map = channels.Compute(c.op);
@@ -366,7 +415,7 @@ absl::StatusOr<DetectResult> RunDetectUnguarded(
       absl::StrCat("extract.", AbslView(ExtractionName(options.extraction))));
 
   if (options.keep_channel_maps) result.channel_maps = std::move(maps);
-  result.plane = *std::move(plane);
+  result.plane = scene.plane;
   result.total_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();

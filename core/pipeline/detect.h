@@ -169,6 +169,17 @@ struct DetectResult {
 absl::StatusOr<std::vector<AttentionPoint>> ExtractAttentionPoints(
     const cv::Mat& master, const DetectOptions& options);
 
+// What every pipeline computes first from a frame: the organized cloud with
+// normals (hole-filled first when options.fill_holes), the support plane
+// and the table scene, with the stages' timings ("fill_holes", "cloud",
+// "normals", "support_plane").
+struct PreparedScene {
+  OrganizedCloud cloud;
+  SupportPlane plane;
+  TableScene table;
+  std::vector<StageTiming> timings;
+};
+
 // Every stage name RunDetect can report with the options it accepts today
 // ("cloud", "normals", "support_plane", "saliency.<op>", "fusion",
 // "extract.<kind>"), for metrics that must exist before the first call.
@@ -188,6 +199,18 @@ using InterruptCheck = std::function<absl::Status()>;
 absl::StatusOr<DetectResult> RunDetect(const RgbdFrame& frame,
                                        const DetectOptions& options,
                                        const InterruptCheck& interrupt = {});
+
+// RunDetect's two halves, for pipelines that need the scene too
+// (segmentation): PrepareScene validates `options` and builds the scene
+// (errors as RunDetect's); DetectOnScene computes the saliency maps and
+// attention points on it (its timings start at the first channel;
+// `scene.timings` are not copied).
+absl::StatusOr<PreparedScene> PrepareScene(
+    const RgbdFrame& frame, const DetectOptions& options,
+    const InterruptCheck& interrupt = {});
+absl::StatusOr<DetectResult> DetectOnScene(
+    const PreparedScene& scene, const DetectOptions& options,
+    const InterruptCheck& interrupt = {});
 
 }  // namespace fovea
 
