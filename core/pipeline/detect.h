@@ -12,6 +12,7 @@
 #include "core/attention/msr.h"
 #include "core/attention/tj.h"
 #include "core/attention/wta.h"
+#include "core/base/interrupt.h"
 #include "core/frame/hole_filling.h"
 #include "core/frame/organized_cloud.h"
 #include "core/frame/rgbd_frame.h"
@@ -184,10 +185,6 @@ struct PreparedScene {
 // ("cloud", "normals", "support_plane", "saliency.<op>", "fusion",
 // "extract.<kind>"), for metrics that must exist before the first call.
 std::vector<std::string> DetectStageNames();
-
-// Called between stages; a non-OK status (e.g. DEADLINE_EXCEEDED,
-// CANCELLED) stops the pipeline and is returned as is.
-using InterruptCheck = std::function<absl::Status()>;
 
 // The whole Detect path on a decoded frame: optional hole filling,
 // organized cloud and normals,

@@ -13,6 +13,7 @@
 #include "core/frame/support_plane.h"
 #include "core/frame/table_scene.h"
 #include "tools/eval/scene_kind.h"
+#include "tools/eval/stats.h"
 
 namespace fovea::eval {
 namespace {
@@ -27,17 +28,6 @@ std::string ResolveDataDir(const std::string& dir) {
 constexpr int kPointRadiusPx = 6;
 const cv::Point kLabelOffset(7, -7);
 constexpr double kLabelScale = 0.5;
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  double m = values[mid];
-  if (values.size() % 2 == 0) {
-    m = (m + *std::max_element(values.begin(), values.begin() + mid)) / 2.0;
-  }
-  return m;
-}
 
 // Saliency map in false colour with the points numbered on it, next to the
 // colour image with the ground-truth object outlines.

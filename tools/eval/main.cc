@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #include "absl/strings/str_join.h"
 #include "core/pipeline/detect.h"
 #include "tools/eval/detect_eval.h"
+#include "tools/eval/segment_eval.h"
 #include "tools/eval/sweep.h"
 
 ABSL_FLAG(std::string, data, "",
@@ -73,6 +75,17 @@ ABSL_FLAG(std::string, out, "",
           "Write <scene>.png (colour with object outlines | saliency map, "
           "points numbered) into this folder.");
 ABSL_FLAG(bool, verbose, false, "One line per scene on stderr.");
+ABSL_FLAG(std::string, method, "cos", "segment: cos or ebs.");
+ABSL_FLAG(std::string, seeds, "",
+          "segment: where the seeds come from, tj, wta or msr (Detect's "
+          "extraction; overrides --extract).");
+ABSL_FLAG(int, folds, 5,
+          "segment: cross-validation folds; scene i is scored with models "
+          "trained on the scenes of the other folds.");
+ABSL_FLAG(double, svm_c, fovea::LinearSvmTrainingOptions().c,
+          "segment: the COS SVM's soft-margin penalty C.");
+ABSL_FLAG(double, cos_min_decision, fovea::CosOptions().min_decision,
+          "segment: COS joins a patch when the SVM's decision exceeds this.");
 ABSL_FLAG(std::string, filter, "",
           "sweep: only the rows whose label saliency/pyramid/combine/norm/"
           "extract contains this.");
@@ -107,6 +120,74 @@ std::string Json(const DetectEvalSummary& s) {
       "], \"detect_ms_median\": ", s.detect_ms_median, "}");
 }
 
+// The Detect options of the flags shared by detect and segment; nullopt
+// (after a message on stderr) when one does not parse.
+std::optional<DetectOptions> DetectOptionsFromFlags() {
+  DetectOptions detect;
+  const std::string saliency = absl::GetFlag(FLAGS_saliency);
+  absl::StatusOr<std::vector<SaliencyOp>> ops =
+      ParseSaliencyOps(saliency == "pcl-clusters" ? "rso" : saliency);
+  if (!ops.ok()) {
+    std::fprintf(stderr, "fovea-eval: --%s\n", ops.status().ToString().c_str());
+    return std::nullopt;
+  }
+  absl::StatusOr<ExtractionKind> extract =
+      ParseExtraction(absl::GetFlag(FLAGS_extract));
+  if (!extract.ok()) {
+    std::fprintf(stderr, "fovea-eval: --%s\n",
+                 extract.status().ToString().c_str());
+    return std::nullopt;
+  }
+  detect.channels.clear();
+  for (SaliencyOp op : *ops) detect.channels.push_back({op, 1.0f});
+  detect.extraction = *extract;
+  detect.max_points = absl::GetFlag(FLAGS_points);
+  detect.msr.inhibit_slope = absl::GetFlag(FLAGS_msr_inhibit_slope);
+  detect.fill_holes = absl::GetFlag(FLAGS_fill_holes);
+  detect.sym3d_level = absl::GetFlag(FLAGS_sym3d_level);
+  detect.sym3d.kernel_size = absl::GetFlag(FLAGS_sym3d_kernel);
+  detect.tj.support_fraction =
+      static_cast<float>(absl::GetFlag(FLAGS_tj_support));
+  const std::string tj_junction = absl::GetFlag(FLAGS_tj_junction);
+  const std::string tj_rank = absl::GetFlag(FLAGS_tj_rank);
+  if ((tj_junction != "central" && tj_junction != "salient") ||
+      (tj_rank != "total" && tj_rank != "mean")) {
+    std::fprintf(stderr,
+                 "fovea-eval: --tj_junction central|salient, "
+                 "--tj_rank total|mean\n");
+    return std::nullopt;
+  }
+  detect.tj.junction = tj_junction == "central" ? TjJunction::kCentral
+                                                : TjJunction::kMostSalient;
+  detect.tj.ranking =
+      tj_rank == "total" ? TjRanking::kTotalSaliency : TjRanking::kMeanSaliency;
+  detect.split_at_surface_edges = absl::GetFlag(FLAGS_split_edges);
+  detect.surface_edges.depth_jump_fraction =
+      static_cast<float>(absl::GetFlag(FLAGS_edge_jump));
+  detect.surface_edges.concave_curvature =
+      static_cast<float>(absl::GetFlag(FLAGS_edge_concave));
+  detect.surface_edges.radius_px = absl::GetFlag(FLAGS_edge_radius);
+  const absl::StatusOr<PyramidKind> pyramid =
+      ParsePyramid(absl::GetFlag(FLAGS_pyramid));
+  const absl::StatusOr<LevelCombination> combine =
+      ParseLevelCombination(absl::GetFlag(FLAGS_combine));
+  const absl::StatusOr<NormalizationKind> norm =
+      ParseNormalization(absl::GetFlag(FLAGS_norm));
+  const absl::StatusOr<FusionKind> fusion =
+      ParseFusion(absl::GetFlag(FLAGS_fusion));
+  if (!pyramid.ok() || !combine.ok() || !norm.ok() || !fusion.ok()) {
+    std::fprintf(stderr,
+                 "fovea-eval: --pyramid none|simple|itti, --combine sum|max, "
+                 "--norm lin|nms|nlm, --fusion sum|max\n");
+    return std::nullopt;
+  }
+  detect.pyramid = *pyramid;
+  detect.level_combination = *combine;
+  detect.normalization = *norm;
+  detect.fusion = *fusion;
+  return detect;
+}
+
 int RunDetectEval() {
   DetectEvalOptions options;
   options.data_dir = absl::GetFlag(FLAGS_data);
@@ -120,67 +201,9 @@ int RunDetectEval() {
   }
   const std::string saliency = absl::GetFlag(FLAGS_saliency);
   options.pcl_clusters = saliency == "pcl-clusters";
-  absl::StatusOr<std::vector<SaliencyOp>> ops =
-      ParseSaliencyOps(options.pcl_clusters ? "rso" : saliency);
-  if (!ops.ok()) {
-    std::fprintf(stderr, "fovea-eval: --%s\n", ops.status().ToString().c_str());
-    return kUsageError;
-  }
-  absl::StatusOr<ExtractionKind> extract =
-      ParseExtraction(absl::GetFlag(FLAGS_extract));
-  if (!extract.ok()) {
-    std::fprintf(stderr, "fovea-eval: --%s\n",
-                 extract.status().ToString().c_str());
-    return kUsageError;
-  }
-  options.detect.channels.clear();
-  for (SaliencyOp op : *ops) options.detect.channels.push_back({op, 1.0f});
-  options.detect.extraction = *extract;
-  options.detect.max_points = absl::GetFlag(FLAGS_points);
-  options.detect.msr.inhibit_slope = absl::GetFlag(FLAGS_msr_inhibit_slope);
-  options.detect.fill_holes = absl::GetFlag(FLAGS_fill_holes);
-  options.detect.sym3d_level = absl::GetFlag(FLAGS_sym3d_level);
-  options.detect.sym3d.kernel_size = absl::GetFlag(FLAGS_sym3d_kernel);
-  options.detect.tj.support_fraction =
-      static_cast<float>(absl::GetFlag(FLAGS_tj_support));
-  const std::string tj_junction = absl::GetFlag(FLAGS_tj_junction);
-  const std::string tj_rank = absl::GetFlag(FLAGS_tj_rank);
-  if ((tj_junction != "central" && tj_junction != "salient") ||
-      (tj_rank != "total" && tj_rank != "mean")) {
-    std::fprintf(stderr,
-                 "fovea-eval: --tj_junction central|salient, "
-                 "--tj_rank total|mean\n");
-    return kUsageError;
-  }
-  options.detect.tj.junction = tj_junction == "central"
-                                   ? TjJunction::kCentral
-                                   : TjJunction::kMostSalient;
-  options.detect.tj.ranking =
-      tj_rank == "total" ? TjRanking::kTotalSaliency : TjRanking::kMeanSaliency;
-  options.detect.split_at_surface_edges = absl::GetFlag(FLAGS_split_edges);
-  options.detect.surface_edges.depth_jump_fraction =
-      static_cast<float>(absl::GetFlag(FLAGS_edge_jump));
-  options.detect.surface_edges.concave_curvature =
-      static_cast<float>(absl::GetFlag(FLAGS_edge_concave));
-  options.detect.surface_edges.radius_px = absl::GetFlag(FLAGS_edge_radius);
-  const absl::StatusOr<PyramidKind> pyramid =
-      ParsePyramid(absl::GetFlag(FLAGS_pyramid));
-  const absl::StatusOr<LevelCombination> combine =
-      ParseLevelCombination(absl::GetFlag(FLAGS_combine));
-  const absl::StatusOr<NormalizationKind> norm =
-      ParseNormalization(absl::GetFlag(FLAGS_norm));
-  const absl::StatusOr<FusionKind> fusion =
-      ParseFusion(absl::GetFlag(FLAGS_fusion));
-  if (!pyramid.ok() || !combine.ok() || !norm.ok() || !fusion.ok()) {
-    std::fprintf(stderr,
-                 "fovea-eval: --pyramid none|simple|itti, --combine sum|max, "
-                 "--norm lin|nms|nlm, --fusion sum|max\n");
-    return kUsageError;
-  }
-  options.detect.pyramid = *pyramid;
-  options.detect.level_combination = *combine;
-  options.detect.normalization = *norm;
-  options.detect.fusion = *fusion;
+  std::optional<DetectOptions> detect = DetectOptionsFromFlags();
+  if (!detect) return kUsageError;
+  options.detect = *std::move(detect);
   options.out_dir = absl::GetFlag(FLAGS_out);
   options.verbose = absl::GetFlag(FLAGS_verbose);
 
@@ -203,6 +226,90 @@ int RunDetectEval() {
 
 namespace fovea::eval {
 namespace {
+
+void PrintSegmentTable(const std::vector<SceneSegmentResult>& scenes) {
+  std::printf("%-12s %7s %7s %7s %7s %8s %8s %10s %10s\n", "kind", "scenes",
+              "F(all)", "F(best)", "F(first)", "recall", "false", "first(ms)",
+              "all(ms)");
+  for (const char* kind :
+       {"boxes", "stacked", "occluded", "cylindric", "other", ""}) {
+    const SegmentEvalSummary s = SummarizeSegment(scenes, kind);
+    if (s.scenes.empty()) continue;
+    std::printf("%-12s %7zu %7.3f %7.3f %7.3f %8.3f %8.3f %10.1f %10.1f\n",
+                kind[0] ? kind : "all", s.scenes.size(), s.f_all, s.f_best,
+                s.f_first, s.object_recall, s.false_masks,
+                s.first_mask_ms_median, s.all_masks_ms_median);
+  }
+}
+
+int RunSegmentEval() {
+  std::string data = absl::GetFlag(FLAGS_data);
+  if (data.empty()) {
+    const char* env = std::getenv("FOVEA_OSD_DIR");
+    if (env != nullptr) data = env;
+  }
+  if (data.empty()) {
+    std::fprintf(stderr, "fovea-eval: --data (or FOVEA_OSD_DIR) is required\n");
+    return kUsageError;
+  }
+  SegmentEvalOptions options;
+  std::optional<DetectOptions> detect = DetectOptionsFromFlags();
+  if (!detect) return kUsageError;
+  options.segment.detect = *std::move(detect);
+  const std::string seeds = absl::GetFlag(FLAGS_seeds);
+  if (!seeds.empty()) {
+    absl::StatusOr<ExtractionKind> kind = ParseExtraction(seeds);
+    if (!kind.ok()) {
+      std::fprintf(stderr, "fovea-eval: --seeds: %s\n",
+                   kind.status().ToString().c_str());
+      return kUsageError;
+    }
+    options.segment.detect.extraction = *kind;
+  }
+  absl::StatusOr<SegmentMethod> method =
+      ParseSegmentMethod(absl::GetFlag(FLAGS_method));
+  if (!method.ok()) {
+    std::fprintf(stderr, "fovea-eval: --method: %s\n",
+                 method.status().ToString().c_str());
+    return kUsageError;
+  }
+  options.segment.method = *method;
+  options.folds = absl::GetFlag(FLAGS_folds);
+  options.svm.c = absl::GetFlag(FLAGS_svm_c);
+  options.segment.cos.min_decision = absl::GetFlag(FLAGS_cos_min_decision);
+  options.out_dir = absl::GetFlag(FLAGS_out);
+  options.verbose = absl::GetFlag(FLAGS_verbose);
+  absl::StatusOr<std::vector<LabelledFrame>> scenes = LoadScenes(data);
+  if (!scenes.ok()) {
+    std::fprintf(stderr, "fovea-eval: %s\n",
+                 scenes.status().ToString().c_str());
+    return kRunError;
+  }
+  absl::StatusOr<SegmentEvalSummary> summary =
+      EvaluateSegment(*scenes, options);
+  if (!summary.ok()) {
+    std::fprintf(stderr, "fovea-eval: %s\n",
+                 summary.status().ToString().c_str());
+    return kRunError;
+  }
+  std::printf(
+      "segment %s, seeds %s, %zu scenes, %d-fold cross-validated\n",
+      absl::GetFlag(FLAGS_method).c_str(),
+      std::string(ExtractionName(options.segment.detect.extraction)).c_str(),
+      summary->scenes.size(), options.folds);
+  PrintSegmentTable(summary->scenes);
+  if (absl::GetFlag(FLAGS_json)) {
+    std::printf(
+        "{\"scenes\": %zu, \"f_all\": %.4f, \"f_best\": %.4f, "
+        "\"f_first\": %.4f, \"object_recall\": %.4f, \"false_masks\": "
+        "%.4f, \"first_mask_ms_median\": %.1f, \"all_masks_ms_median\": "
+        "%.1f}\n",
+        summary->scenes.size(), summary->f_all, summary->f_best,
+        summary->f_first, summary->object_recall, summary->false_masks,
+        summary->first_mask_ms_median, summary->all_masks_ms_median);
+  }
+  return 0;
+}
 
 int RunSweepCommand() {
   std::string data = absl::GetFlag(FLAGS_data);
@@ -244,7 +351,9 @@ int main(int argc, char** argv) {
       "pcl-clusters|...] [--pyramid none|simple|itti] [--combine sum|max] "
       "[--norm lin|nms|nlm] [--extract wta|msr|tj] [--json] [--out DIR]\n"
       "  fovea-eval sweep --data DIR --out DIR [--filter TEXT]   (the grid "
-      "of Tables 2.4/2.5 as Markdown and CSV)");
+      "of Tables 2.4/2.5 as Markdown and CSV)\n"
+      "  fovea-eval segment --method cos|ebs --data DIR [--seeds tj|wta|msr] "
+      "[--folds 5] [--json] [--out DIR]   (Table 3.1, cross-validated)");
   std::vector<char*> args = absl::ParseCommandLine(argc, argv);
   if (args.size() < 2) {
     std::fprintf(stderr, "%s\n",
@@ -254,6 +363,7 @@ int main(int argc, char** argv) {
   const std::string command = args[1];
   if (command == "detect") return fovea::eval::RunDetectEval();
   if (command == "sweep") return fovea::eval::RunSweepCommand();
+  if (command == "segment") return fovea::eval::RunSegmentEval();
   std::fprintf(stderr, "fovea-eval: unknown command '%s'\n%s\n",
                command.c_str(),
                std::string(absl::ProgramUsageMessage()).c_str());

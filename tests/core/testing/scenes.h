@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "core/frame/rgbd_frame.h"
 #include "core/synth/synth_scene.h"
@@ -49,6 +50,42 @@ inline synth::SynthScene BoxOnTable(const Eigen::Vector3f& half_extents,
   synth::NoiseOptions noise;
   noise.enabled = false;
   return synth::RenderScene(spec, noise, 1);
+}
+
+// Two boxes touching side by side on the table: a red one 8 x 6 x 10 cm on
+// the left (label 20) and a blue one 8 x 6 x 6 cm on the right (label 30),
+// set back 2 cm so that their fronts are not one plane (planar patches
+// would merge coplanar faces: they see geometry only).
+// Camera as in BoxOnTable; no noise. The blue top lies below the red top, so
+// the two together are not convex.
+inline synth::SynthScene TwoBoxesOnTable() {
+  synth::SceneSpec spec;
+  spec.camera_pose = synth::LookAt({0.0f, -0.75f, 0.75f}, {0.0f, 0.0f, 0.0f});
+  for (const float side : {-1.0f, 1.0f}) {
+    synth::Primitive box;
+    box.shape = synth::Shape::kBox;
+    box.half_extents = {0.04f, 0.04f, side < 0.0f ? 0.05f : 0.03f};
+    box.pose.translation() = Eigen::Vector3f(
+        side * 0.04f, side < 0.0f ? 0.0f : 0.02f, box.half_extents.z());
+    box.rgb = side < 0.0f ? Eigen::Vector3f(0.9f, 0.2f, 0.1f)
+                          : Eigen::Vector3f(0.1f, 0.3f, 0.9f);
+    spec.objects.push_back(box);
+  }
+  synth::NoiseOptions noise;
+  noise.enabled = false;
+  return synth::RenderScene(spec, noise, 1);
+}
+
+// The pixel of `label` farthest from every other label (its visible
+// centre); (-1, -1) when the label is absent.
+inline cv::Point CentreOfLabel(const cv::Mat& labels, int label) {
+  cv::Mat inside = labels == label;
+  if (cv::countNonZero(inside) == 0) return {-1, -1};
+  cv::Mat distance;
+  cv::distanceTransform(inside, distance, cv::DIST_L2, 3);
+  cv::Point best;
+  cv::minMaxLoc(distance, nullptr, nullptr, nullptr, &best);
+  return best;
 }
 
 // Height of each pixel above the scene's table (NaN without depth).

@@ -1,0 +1,222 @@
+#include "core/pipeline/segment.h"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <new>
+#include <opencv2/imgproc.hpp>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "core/base/strings.h"
+
+namespace fovea {
+namespace {
+
+using SteadyClock = std::chrono::steady_clock;
+
+double SecondsSince(SteadyClock::time_point start) {
+  return std::chrono::duration<double>(SteadyClock::now() - start).count();
+}
+
+// The object's box, area, centroid and extent from its mask.
+void Describe(const OrganizedCloud& cloud, SegmentedObject& object) {
+  object.area = cv::countNonZero(object.mask);
+  object.box = object.area > 0 ? cv::boundingRect(object.mask) : cv::Rect();
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Vector3f lo =
+      Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity());
+  Eigen::Vector3f hi = -lo;
+  int n = 0;
+  for (int v = object.box.y; v < object.box.y + object.box.height; ++v) {
+    const unsigned char* in = object.mask.ptr<unsigned char>(v);
+    const cv::Vec3f* xyz = cloud.xyz.ptr<cv::Vec3f>(v);
+    for (int u = object.box.x; u < object.box.x + object.box.width; ++u) {
+      if (in[u] == 0 || std::isnan(xyz[u][2])) continue;
+      const Eigen::Vector3f p(xyz[u][0], xyz[u][1], xyz[u][2]);
+      sum += p.cast<double>();
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+      ++n;
+    }
+  }
+  if (n > 0) {
+    object.centroid = (sum / n).cast<float>();
+    object.extent = hi - lo;
+  }
+}
+
+// Pixels standing on the table: what scene_coverage is a fraction of.
+cv::Mat ObjectRegion(const TableScene& table, float min_height) {
+  cv::Mat region = table.height > min_height;  // NaN compares false
+  return region;
+}
+
+absl::StatusOr<std::vector<AttentionPoint>> TakeSeeds(
+    const PreparedScene& scene, const SegmentOptions& options,
+    const InterruptCheck& interrupt, std::vector<StageTiming>& timings) {
+  std::vector<AttentionPoint> seeds;
+  if (!options.seeds.empty()) {
+    for (const cv::Point& p : options.seeds) {
+      AttentionPoint a;
+      a.u = p.x;
+      a.v = p.y;
+      const cv::Vec3f& q = scene.cloud.xyz.at<cv::Vec3f>(p.y, p.x);
+      a.point = {q[0], q[1], q[2]};
+      seeds.push_back(a);
+    }
+    return seeds;
+  }
+  absl::StatusOr<DetectResult> detect =
+      DetectOnScene(scene, options.detect, interrupt);
+  if (!detect.ok()) return detect.status();
+  timings.insert(timings.end(), detect->timings.begin(), detect->timings.end());
+  return std::move(detect->points);
+}
+
+absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
+    const RgbdFrame& frame, const SegmentOptions& options,
+    const SegmentModels& models, const SegmentSinks& sinks,
+    const InterruptCheck& interrupt, SteadyClock::time_point start) {
+  if (absl::Status s = Validate(options); !s.ok()) return s;
+  for (const cv::Point& p : options.seeds) {
+    if (p.x < 0 || p.y < 0 || p.x >= frame.width() || p.y >= frame.height()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("seeds: (", p.x, ", ", p.y, ") lies outside the ",
+                       frame.width(), "x", frame.height(), " frame"));
+    }
+  }
+  if (options.method == SegmentMethod::kEbs) {
+    return absl::UnimplementedError("segment: EBS is not built yet");
+  }
+  if (models.cos == nullptr) {
+    return absl::FailedPreconditionError("segment: no COS model is loaded");
+  }
+  SegmentSummary summary;
+  absl::StatusOr<PreparedScene> scene =
+      PrepareScene(frame, options.detect, interrupt);
+  if (!scene.ok()) return scene.status();
+  summary.timings = scene->timings;
+
+  absl::StatusOr<std::vector<AttentionPoint>> seeds =
+      TakeSeeds(*scene, options, interrupt, summary.timings);
+  if (!seeds.ok()) return seeds.status();
+  if (sinks.points) {
+    if (absl::Status s = sinks.points(*seeds); !s.ok()) return s;
+  }
+  if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
+
+  SteadyClock::time_point lap = SteadyClock::now();
+  absl::StatusOr<CosScene> cos =
+      BuildCosScene(scene->cloud, scene->plane, options.cos);
+  if (!cos.ok()) return cos.status();
+  CosSegmenter segmenter(*cos, *models.cos, options.cos);
+  summary.timings.push_back({"segment.prepare", SecondsSince(lap)});
+
+  const cv::Mat region =
+      ObjectRegion(scene->table, options.detect.table_scene.min_object_height);
+  cv::Mat covered(region.size(), CV_8UC1, cv::Scalar(0));
+  for (const AttentionPoint& seed : *seeds) {
+    if (options.max_objects > 0 && summary.objects >= options.max_objects) {
+      summary.stop = SegmentStop::kMaxObjects;
+      break;
+    }
+    if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
+    lap = SteadyClock::now();
+    absl::StatusOr<std::optional<CosObject>> cut =
+        segmenter.Segment({seed.u, seed.v}, interrupt);
+    if (!cut.ok()) return cut.status();
+    summary.timings.push_back({"segment.object", SecondsSince(lap)});
+    if (!cut->has_value()) continue;
+    SegmentedObject object;
+    object.index = summary.objects++;
+    object.seed = seed;
+    object.mask = std::move((*cut)->mask);
+    object.score = (*cut)->score;
+    Describe(scene->cloud, object);
+    covered.setTo(255, object.mask);
+    object.seconds_since_start = SecondsSince(start);
+    if (sinks.object) {
+      if (absl::Status s = sinks.object(std::move(object)); !s.ok()) return s;
+    }
+  }
+  const int region_pixels = cv::countNonZero(region);
+  summary.scene_coverage =
+      region_pixels > 0
+          ? static_cast<double>(cv::countNonZero(covered & region)) /
+                region_pixels
+          : 0.0;
+  summary.total_seconds = SecondsSince(start);
+  return summary;
+}
+
+}  // namespace
+
+std::string_view SegmentMethodName(SegmentMethod method) {
+  return method == SegmentMethod::kEbs ? "ebs" : "cos";
+}
+
+absl::StatusOr<SegmentMethod> ParseSegmentMethod(std::string_view text) {
+  if (text == "cos") return SegmentMethod::kCos;
+  if (text == "ebs") return SegmentMethod::kEbs;
+  return absl::InvalidArgumentError(absl::StrCat(
+      "unknown segmentation method '", AbslView(text), "' (known: cos, ebs)"));
+}
+
+absl::Status Validate(const SegmentOptions& options) {
+  if (absl::Status s = Validate(options.detect); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("detect: ", s.message()));
+  }
+  if (absl::Status s = Validate(options.cos); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("cos.", s.message()));
+  }
+  if (options.max_objects < 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "max_objects must not be negative, got ", options.max_objects));
+  }
+  if (options.seeds.size() > static_cast<size_t>(kMaxAttentionPoints)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("seeds: ", options.seeds.size(), " given, at most ",
+                     kMaxAttentionPoints, " allowed"));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<SegmentSummary> RunSegment(const RgbdFrame& frame,
+                                          const SegmentOptions& options,
+                                          const SegmentModels& models,
+                                          const SegmentSinks& sinks,
+                                          const InterruptCheck& interrupt,
+                                          SteadyClock::time_point start) {
+  // Nothing throws out of core/: OpenCV, qhull's wrapper and the standard
+  // library can.
+  try {
+    return RunSegmentUnguarded(frame, options, models, sinks, interrupt, start);
+  } catch (const std::bad_alloc&) {
+    return absl::ResourceExhaustedError("segment: out of memory");
+  } catch (const std::exception& e) {
+    return absl::InternalError(absl::StrCat("segment: ", e.what()));
+  }
+}
+
+absl::StatusOr<std::vector<SvmSample>> CollectCosSamples(
+    const LabelledFrame& frame, int group, const DetectOptions& detect,
+    const CosOptions& cos) {
+  try {
+    absl::StatusOr<PreparedScene> scene = PrepareScene(frame.frame, detect);
+    if (!scene.ok()) return scene.status();
+    absl::StatusOr<CosScene> cos_scene =
+        BuildCosScene(scene->cloud, scene->plane, cos);
+    if (!cos_scene.ok()) return cos_scene.status();
+    return CosTrainingSamples(*cos_scene, frame.labels, group, cos);
+  } catch (const std::bad_alloc&) {
+    return absl::ResourceExhaustedError("cos samples: out of memory");
+  } catch (const std::exception& e) {
+    return absl::InternalError(absl::StrCat("cos samples: ", e.what()));
+  }
+}
+
+}  // namespace fovea

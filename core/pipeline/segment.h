@@ -1,0 +1,116 @@
+#ifndef FOVEA_CORE_PIPELINE_SEGMENT_H_
+#define FOVEA_CORE_PIPELINE_SEGMENT_H_
+
+#include <Eigen/Core>
+#include <chrono>
+#include <functional>
+#include <opencv2/core.hpp>
+#include <string_view>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/attention/attention_point.h"
+#include "core/base/interrupt.h"
+#include "core/frame/osd_pcd.h"
+#include "core/frame/rgbd_frame.h"
+#include "core/pipeline/detect.h"
+#include "core/segmentation/cos.h"
+#include "core/segmentation/linear_svm.h"
+
+namespace fovea {
+
+// Attention-driven segmentation (thesis section 3.2): seeds from Detect or
+// from the caller, one object per seed, cut out by COS or EBS.
+
+enum class SegmentMethod { kCos, kEbs };
+
+std::string_view SegmentMethodName(SegmentMethod method);  // "cos", "ebs"
+// "cos" or "ebs"; INVALID_ARGUMENT naming the known ones otherwise.
+absl::StatusOr<SegmentMethod> ParseSegmentMethod(std::string_view text);
+
+struct SegmentOptions {
+  SegmentMethod method = SegmentMethod::kCos;
+  // Seeds: these pixels (x = column u, y = row v), in this order, when not
+  // empty; otherwise Detect's attention points with `detect`. `detect`
+  // also prepares the scene (normals, support plane) either way.
+  std::vector<cv::Point> seeds;
+  DetectOptions detect;
+  // Objects to cut out at most; 0 = one per seed.
+  int max_objects = 0;
+  CosOptions cos;
+};
+
+// INVALID_ARGUMENT naming the field: detect.*, cos.*, a negative
+// max_objects, more than kMaxAttentionPoints seeds.
+absl::Status Validate(const SegmentOptions& options);
+
+// The trained models segmentation uses; not owned, may be null when the
+// method does not need them.
+struct SegmentModels {
+  const LinearSvm* cos = nullptr;
+};
+
+struct SegmentedObject {
+  int index = 0;        // 0 = first object emitted
+  AttentionPoint seed;  // the seed that started it (3D filled in)
+  cv::Mat mask;         // CV_8UC1, 255 on the object
+  cv::Rect box;         // the mask's bounding box, pixels
+  int area = 0;         // mask pixels
+  double score = 0.0;   // [0, 1], the method's confidence
+  // Of the mask's pixels with depth, metres, camera frame: the mean point
+  // and the axis-aligned size.
+  Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
+  Eigen::Vector3f extent = Eigen::Vector3f::Zero();
+  double seconds_since_start = 0.0;  // since RunSegment's `start`
+};
+
+enum class SegmentStop {
+  kDone,        // every seed was used
+  kMaxObjects,  // options.max_objects objects were emitted
+};
+
+struct SegmentSummary {
+  SegmentStop stop = SegmentStop::kDone;
+  int objects = 0;
+  // Fraction of the pixels standing on the table (height above
+  // detect.table_scene.min_object_height) inside an emitted mask, [0, 1].
+  double scene_coverage = 0.0;
+  // "cloud", "normals", "support_plane", Detect's stages when it ran,
+  // "segment.prepare" (the method's per-frame work) and one
+  // "segment.object" per seed.
+  std::vector<StageTiming> timings;
+  double total_seconds = 0.0;
+};
+
+// Where the results go as they are made. A non-OK status from a sink
+// stops the work and is returned (the caller's client has gone).
+struct SegmentSinks {
+  // The seeds, once, before the first object (may be empty).
+  std::function<absl::Status(const std::vector<AttentionPoint>&)> points;
+  std::function<absl::Status(SegmentedObject)> object;
+};
+
+// Prepares the scene, takes the seeds, and for each seed in order cuts out
+// its object and hands it to `sinks.object` at once. A seed whose object
+// was already cut out, or that lies on the table or on nothing, yields no
+// object (COS: see CosSegmenter). `interrupt` is checked between stages,
+// between objects and inside the methods' loops; its status is returned as
+// is. Errors: Validate's; FAILED_PRECONDITION when the method's model is
+// null; NOT_FOUND without a support plane; UNIMPLEMENTED for EBS until it
+// is built; RESOURCE_EXHAUSTED / INTERNAL for what throws underneath.
+absl::StatusOr<SegmentSummary> RunSegment(
+    const RgbdFrame& frame, const SegmentOptions& options,
+    const SegmentModels& models, const SegmentSinks& sinks,
+    const InterruptCheck& interrupt = {},
+    std::chrono::steady_clock::time_point start =
+        std::chrono::steady_clock::now());
+
+// COS training examples of one labelled frame (CosTrainingSamples on the
+// scene `detect` prepares), tagged with `group`.
+absl::StatusOr<std::vector<SvmSample>> CollectCosSamples(
+    const LabelledFrame& frame, int group, const DetectOptions& detect,
+    const CosOptions& cos);
+
+}  // namespace fovea
+
+#endif  // FOVEA_CORE_PIPELINE_SEGMENT_H_

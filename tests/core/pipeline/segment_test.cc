@@ -1,0 +1,158 @@
+#include "core/pipeline/segment.h"
+
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "tests/core/testing/scenes.h"
+
+namespace fovea {
+namespace {
+
+// The argued SVM of cos_test: faces of one box join, the other box not.
+LinearSvm ArguedSvm() {
+  return LinearSvm("cos", CosFeatureNames(), {1.0, -3.0}, 0.0, "test");
+}
+
+struct SegmentRun {
+  absl::StatusOr<SegmentSummary> summary;
+  std::vector<AttentionPoint> points;
+  std::vector<SegmentedObject> objects;
+  int points_calls = 0;
+};
+
+SegmentRun RunOn(const synth::SynthScene& scene, const SegmentOptions& options,
+                 const InterruptCheck& interrupt = {}) {
+  static const LinearSvm svm = ArguedSvm();
+  SegmentModels models;
+  models.cos = &svm;
+  SegmentRun run;
+  SegmentSinks sinks;
+  sinks.points = [&](const std::vector<AttentionPoint>& points) {
+    EXPECT_TRUE(run.objects.empty()) << "points come before objects";
+    run.points = points;
+    ++run.points_calls;
+    return absl::OkStatus();
+  };
+  sinks.object = [&](SegmentedObject object) {
+    run.objects.push_back(std::move(object));
+    return absl::OkStatus();
+  };
+  run.summary =
+      RunSegment(scene.frame.frame, options, models, sinks, interrupt);
+  return run;
+}
+
+TEST(RunSegmentTest, GivenSeedsAreKeptInOrderAndEachGivesItsObject) {
+  const synth::SynthScene scene = testing::TwoBoxesOnTable();
+  const cv::Point blue = testing::CentreOfLabel(scene.frame.labels, 30);
+  const cv::Point red = testing::CentreOfLabel(scene.frame.labels, 20);
+  SegmentOptions options;
+  options.seeds = {blue, red, {320, 470} /* table */};
+  const SegmentRun run = RunOn(scene, options);
+  ASSERT_TRUE(run.summary.ok()) << run.summary.status();
+  EXPECT_EQ(run.points_calls, 1);
+  ASSERT_EQ(run.points.size(), 3u);
+  EXPECT_EQ(run.points[0].u, blue.x);
+  EXPECT_EQ(run.points[1].u, red.x);
+  ASSERT_EQ(run.objects.size(), 2u);  // the table seed yields nothing
+  EXPECT_EQ(run.objects[0].index, 0);
+  EXPECT_EQ(run.objects[0].seed.u, blue.x);
+  EXPECT_EQ(run.objects[1].seed.u, red.x);
+  EXPECT_EQ(run.summary->objects, 2);
+  EXPECT_EQ(run.summary->stop, SegmentStop::kDone);
+  // The red box: 8 cm wide, 10 cm tall, 8 cm deep; its centroid is about
+  // 0.75 * sqrt(2) = 1.06 m away, a little left of the image centre.
+  const SegmentedObject& r = run.objects[1];
+  EXPECT_NEAR(r.extent.x(), 0.08, 0.015);
+  EXPECT_LT(r.centroid.x(), 0.0);
+  EXPECT_NEAR(r.centroid.z(), 1.0, 0.1);
+  EXPECT_EQ(r.area, cv::countNonZero(r.mask));
+  EXPECT_TRUE(r.box.contains(red));
+  EXPECT_GE(r.seconds_since_start, run.objects[0].seconds_since_start);
+  EXPECT_GT(run.summary->scene_coverage, 0.8);
+  EXPECT_LE(run.summary->scene_coverage, 1.0);
+}
+
+TEST(RunSegmentTest, StopsAtMaxObjects) {
+  const synth::SynthScene scene = testing::TwoBoxesOnTable();
+  SegmentOptions options;
+  options.seeds = {testing::CentreOfLabel(scene.frame.labels, 20),
+                   testing::CentreOfLabel(scene.frame.labels, 30)};
+  options.max_objects = 1;
+  const SegmentRun run = RunOn(scene, options);
+  ASSERT_TRUE(run.summary.ok()) << run.summary.status();
+  EXPECT_EQ(run.objects.size(), 1u);
+  EXPECT_EQ(run.summary->stop, SegmentStop::kMaxObjects);
+}
+
+TEST(RunSegmentTest, SeedsFromDetectFindBothBoxes) {
+  const synth::SynthScene scene = testing::TwoBoxesOnTable();
+  const SegmentRun run = RunOn(scene, SegmentOptions{});
+  ASSERT_TRUE(run.summary.ok()) << run.summary.status();
+  ASSERT_FALSE(run.points.empty());
+  std::set<int> found;
+  for (const SegmentedObject& o : run.objects) {
+    found.insert(scene.frame.labels.at<int>(o.seed.v, o.seed.u));
+  }
+  EXPECT_TRUE(found.count(20) && found.count(30));
+  bool has_detect_stage = false;
+  for (const StageTiming& t : run.summary->timings) {
+    has_detect_stage |= t.stage == "saliency.sym3d";
+  }
+  EXPECT_TRUE(has_detect_stage);
+}
+
+TEST(RunSegmentTest, AnInterruptOrAFailingSinkStopsTheWork) {
+  const synth::SynthScene scene = testing::TwoBoxesOnTable();
+  SegmentOptions options;
+  options.seeds = {testing::CentreOfLabel(scene.frame.labels, 20),
+                   testing::CentreOfLabel(scene.frame.labels, 30)};
+  int calls = 0;
+  const SegmentRun interrupted = RunOn(scene, options, [&] {
+    return ++calls > 3 ? absl::DeadlineExceededError("late") : absl::OkStatus();
+  });
+  EXPECT_EQ(interrupted.summary.status().code(),
+            absl::StatusCode::kDeadlineExceeded);
+
+  static const LinearSvm svm = ArguedSvm();
+  SegmentModels models;
+  models.cos = &svm;
+  SegmentSinks sinks;
+  int objects = 0;
+  sinks.object = [&](SegmentedObject) {
+    ++objects;
+    return absl::CancelledError("client gone");
+  };
+  const absl::StatusOr<SegmentSummary> gone =
+      RunSegment(scene.frame.frame, options, models, sinks);
+  EXPECT_EQ(gone.status().code(), absl::StatusCode::kCancelled);
+  EXPECT_EQ(objects, 1);  // nothing computed after the sink failed
+}
+
+TEST(RunSegmentTest, BadRequestsAreNamedErrors) {
+  const synth::SynthScene scene = testing::TwoBoxesOnTable();
+  SegmentOptions options;
+  options.seeds = {{640, 10}};
+  EXPECT_EQ(RunOn(scene, options).summary.status().code(),
+            absl::StatusCode::kInvalidArgument);
+  options = {};
+  options.max_objects = -1;
+  const absl::Status negative = RunOn(scene, options).summary.status();
+  EXPECT_NE(negative.message().find("max_objects"), std::string::npos);
+  options = {};
+  const absl::StatusOr<SegmentSummary> no_model =
+      RunSegment(scene.frame.frame, options, SegmentModels{}, {});
+  EXPECT_EQ(no_model.status().code(), absl::StatusCode::kFailedPrecondition);
+}
+
+TEST(ParseSegmentMethodTest, KnowsCosAndEbs) {
+  EXPECT_EQ(*ParseSegmentMethod("cos"), SegmentMethod::kCos);
+  EXPECT_EQ(*ParseSegmentMethod("ebs"), SegmentMethod::kEbs);
+  EXPECT_NE(ParseSegmentMethod("inc").status().message().find("cos, ebs"),
+            std::string::npos);
+  EXPECT_EQ(SegmentMethodName(SegmentMethod::kEbs), "ebs");
+}
+
+}  // namespace
+}  // namespace fovea

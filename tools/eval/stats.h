@@ -1,0 +1,24 @@
+#ifndef FOVEA_TOOLS_EVAL_STATS_H_
+#define FOVEA_TOOLS_EVAL_STATS_H_
+
+#include <algorithm>
+#include <vector>
+
+namespace fovea::eval {
+
+// The median; the mean of the two middle values for an even count; 0 for
+// none.
+inline double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  double m = values[mid];
+  if (values.size() % 2 == 0) {
+    m = (m + *std::max_element(values.begin(), values.begin() + mid)) / 2.0;
+  }
+  return m;
+}
+
+}  // namespace fovea::eval
+
+#endif  // FOVEA_TOOLS_EVAL_STATS_H_

@@ -1,0 +1,175 @@
+// fovea-train: the trained models of segmentation, from labelled scenes.
+//
+//   fovea-train cos --data DIR --out models/cos_svm.txt [--folds 5] [--c 1]
+//
+// Prints the k-fold cross-validated accuracy (folds by scene) and writes
+// the model trained on every scene, with that accuracy in its provenance.
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "absl/flags/flag.h"
+#include "absl/flags/parse.h"
+#include "absl/flags/usage.h"
+#include "absl/strings/str_format.h"
+#include "core/pipeline/segment.h"
+#include "core/segmentation/cos.h"
+#include "core/segmentation/linear_svm.h"
+#include "tools/eval/detect_eval.h"
+
+ABSL_FLAG(std::string, data, "",
+          "OSD-format folder: *.pcd files, or a folder with learn/ inside. "
+          "Defaults to $FOVEA_OSD_DIR.");
+ABSL_FLAG(std::string, out, "", "Model file to write.");
+ABSL_FLAG(int, folds, 5,
+          "Cross-validation folds; scene i is in fold i mod folds.");
+ABSL_FLAG(std::string, samples_csv, "",
+          "Also write the training samples (features, label, scene) as CSV.");
+ABSL_FLAG(double, c, fovea::LinearSvmTrainingOptions().c,
+          "cos: the SVM's soft-margin penalty C.");
+
+namespace fovea {
+namespace {
+
+constexpr int kUsageError = 64;
+constexpr int kRunError = 1;
+
+std::string DataDir() {
+  std::string data = absl::GetFlag(FLAGS_data);
+  if (data.empty()) {
+    const char* env = std::getenv("FOVEA_OSD_DIR");
+    if (env != nullptr) data = env;
+  }
+  return data;
+}
+
+bool WriteFile(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  out.close();
+  return static_cast<bool>(out);
+}
+
+// Mean features of each class, for the log: what the SVM separates.
+void PrintClassMeans(const std::vector<SvmSample>& samples) {
+  const std::vector<std::string>& names = CosFeatureNames();
+  for (const int label : {1, -1}) {
+    std::vector<double> mean(names.size(), 0.0);
+    int n = 0;
+    for (const SvmSample& s : samples) {
+      if (s.label != label) continue;
+      for (size_t i = 0; i < mean.size(); ++i) mean[i] += s.x[i];
+      ++n;
+    }
+    std::printf("  %s: %d samples, mean", label == 1 ? "join" : "reject", n);
+    for (size_t i = 0; i < mean.size(); ++i) {
+      std::printf(" %s %.3f", names[i].c_str(), n > 0 ? mean[i] / n : 0.0);
+    }
+    std::printf("\n");
+  }
+}
+
+int TrainCos() {
+  const std::string data = DataDir();
+  const std::string out = absl::GetFlag(FLAGS_out);
+  if (data.empty() || out.empty()) {
+    std::fprintf(stderr,
+                 "fovea-train cos: --data (or FOVEA_OSD_DIR) and --out are "
+                 "required\n");
+    return kUsageError;
+  }
+  absl::StatusOr<std::vector<LabelledFrame>> scenes = eval::LoadScenes(data);
+  if (!scenes.ok()) {
+    std::fprintf(stderr, "fovea-train: %s\n",
+                 scenes.status().ToString().c_str());
+    return kRunError;
+  }
+  const SegmentOptions segment;
+  std::vector<SvmSample> samples;
+  for (size_t i = 0; i < scenes->size(); ++i) {
+    absl::StatusOr<std::vector<SvmSample>> s = CollectCosSamples(
+        (*scenes)[i], static_cast<int>(i), segment.detect, segment.cos);
+    if (!s.ok()) {
+      std::fprintf(stderr, "fovea-train: %s: %s\n", (*scenes)[i].name.c_str(),
+                   s.status().ToString().c_str());
+      return kRunError;
+    }
+    samples.insert(samples.end(), s->begin(), s->end());
+  }
+  std::printf("cos: %zu samples from %zu scenes\n", samples.size(),
+              scenes->size());
+  PrintClassMeans(samples);
+  if (const std::string csv = absl::GetFlag(FLAGS_samples_csv); !csv.empty()) {
+    std::string text;
+    for (const std::string& name : CosFeatureNames()) text += name + ",";
+    text += "label,scene\n";
+    for (const SvmSample& s : samples) {
+      for (const double x : s.x) text += absl::StrFormat("%.5g,", x);
+      text += absl::StrFormat("%d,%d\n", s.label, s.group);
+    }
+    if (!WriteFile(csv, text)) {
+      std::fprintf(stderr, "fovea-train: cannot write %s\n", csv.c_str());
+      return kRunError;
+    }
+  }
+  LinearSvmTrainingOptions svm;
+  svm.c = absl::GetFlag(FLAGS_c);
+  const int folds = absl::GetFlag(FLAGS_folds);
+  absl::StatusOr<CrossValidation> cv =
+      CrossValidateLinearSvm(samples, folds, svm);
+  if (!cv.ok()) {
+    std::fprintf(stderr, "fovea-train: %s\n", cv.status().ToString().c_str());
+    return kRunError;
+  }
+  std::printf("cos: %d-fold cross-validated accuracy %.3f, balanced %.3f\n",
+              cv->folds, cv->accuracy, cv->balanced_accuracy);
+  absl::StatusOr<LinearSvm> model =
+      TrainLinearSvm(samples, CosFeatureNames(), "cos", svm);
+  if (!model.ok()) {
+    std::fprintf(stderr, "fovea-train: %s\n",
+                 model.status().ToString().c_str());
+    return kRunError;
+  }
+  const LinearSvm trained(
+      "cos", model->feature_names(), model->weights(), model->bias(),
+      absl::StrFormat("fovea-train cos, %zu scenes, %zu samples, C %g; "
+                      "%d-fold cross-validated accuracy %.3f (balanced %.3f)",
+                      scenes->size(), samples.size(), svm.c, cv->folds,
+                      cv->accuracy, cv->balanced_accuracy));
+  if (!WriteFile(out, trained.Serialize())) {
+    std::fprintf(stderr, "fovea-train: cannot write %s\n", out.c_str());
+    return kRunError;
+  }
+  std::printf("cos: weights");
+  for (size_t i = 0; i < trained.weights().size(); ++i) {
+    std::printf(" %s %.4f", trained.feature_names()[i].c_str(),
+                trained.weights()[i]);
+  }
+  std::printf(", bias %.4f\nwrote %s (%s)\n", trained.bias(), out.c_str(),
+              trained.Version().c_str());
+  return 0;
+}
+
+}  // namespace
+}  // namespace fovea
+
+int main(int argc, char** argv) {
+  absl::SetProgramUsageMessage(
+      "Trains segmentation models on labelled OSD scenes.\n"
+      "  fovea-train cos --data DIR --out FILE [--folds 5] [--c 1]");
+  std::vector<char*> args = absl::ParseCommandLine(argc, argv);
+  if (args.size() < 2) {
+    std::fprintf(stderr, "%s\n",
+                 std::string(absl::ProgramUsageMessage()).c_str());
+    return fovea::kUsageError;
+  }
+  const std::string command = args[1];
+  if (command == "cos") return fovea::TrainCos();
+  std::fprintf(stderr, "fovea-train: unknown command '%s'\n%s\n",
+               command.c_str(),
+               std::string(absl::ProgramUsageMessage()).c_str());
+  return fovea::kUsageError;
+}
