@@ -373,6 +373,25 @@ absl::StatusOr<std::vector<std::string>> WriteDetectOutputs(
   return written;
 }
 
+absl::StatusOr<std::string> WriteObjectMask(
+    const std::string& dir, const fovea::v1::ObjectResult& object) {
+  if (absl::Status status = CreateDir(dir); !status.ok()) return status;
+  absl::StatusOr<ByteMask> mask = DecodeRle(object.mask());
+  if (!mask.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("object ", object.index(), ": ", mask.status().message()));
+  }
+  cv::Mat mask_image(static_cast<int>(mask->height),
+                     static_cast<int>(mask->width), CV_8UC1,
+                     mask->pixels.data());
+  mask_image = mask_image * 255;
+  const std::filesystem::path path =
+      std::filesystem::path(dir) /
+      absl::StrCat("mask_", object.index(), ".png");
+  if (absl::Status s = WritePng(path, mask_image); !s.ok()) return s;
+  return path.string();
+}
+
 absl::StatusOr<std::vector<std::string>> WriteSegmentOutputs(
     const std::string& dir,
     const std::vector<fovea::v1::SegmentResponse>& messages,
@@ -403,10 +422,6 @@ absl::StatusOr<std::vector<std::string>> WriteSegmentOutputs(
                        static_cast<int>(mask->width), CV_8UC1,
                        mask->pixels.data());
     mask_image = mask_image * 255;
-    const std::filesystem::path path =
-        root / absl::StrCat("mask_", object.index(), ".png");
-    if (absl::Status s = WritePng(path, mask_image); !s.ok()) return s;
-    written.push_back(path.string());
 
     if (overlay.empty() || mask_image.size() != overlay.size()) continue;
     const cv::Scalar colour = DistinctColour(static_cast<int>(object.index()));

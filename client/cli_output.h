@@ -47,10 +47,16 @@ absl::StatusOr<std::vector<std::string>> WriteDetectOutputs(
     const std::string& dir, const fovea::v1::DetectResponse& response,
     const cv::Mat& color_bgr);
 
-// Writes into `dir`: responses.jsonl (one message per line), mask_<i>.png
-// per object (255 inside), and overlay.png with every mask tinted, its box
-// and index drawn, and the attention points of the first message. Returns
-// the paths written.
+// Writes mask_<index>.png (255 inside) of one object into `dir` (created
+// if needed): called as each object arrives. Returns the path written.
+absl::StatusOr<std::string> WriteObjectMask(
+    const std::string& dir, const fovea::v1::ObjectResult& object);
+
+// Writes into `dir`, once the stream has ended: responses.jsonl (one
+// message per line) and overlay.png with every mask tinted, its box and
+// index drawn, and the attention points of the first message (the masks
+// themselves were written as they arrived, WriteObjectMask). Returns the
+// paths written.
 absl::StatusOr<std::vector<std::string>> WriteSegmentOutputs(
     const std::string& dir,
     const std::vector<fovea::v1::SegmentResponse>& messages,

@@ -26,8 +26,10 @@
 #include "absl/flags/usage_config.h"
 #include "absl/status/status.h"
 #include "absl/strings/match.h"
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_split.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
 #include "client/cli_frame.h"
@@ -94,6 +96,9 @@ ABSL_FLAG(int32_t, points, 0,
 // Segmentation.
 ABSL_FLAG(std::string, method, "", "segment: cos | ebs");
 ABSL_FLAG(int32_t, max_objects, 0, "segment: most objects, 0 = no limit");
+ABSL_FLAG(std::string, seeds, "",
+          "segment: seed pixels 'u,v;u,v;...' used in this order instead of "
+          "the server's attention points (e.g. where a person pointed)");
 ABSL_FLAG(double, time_budget_ms, 0.0,
           "segment-incremental: time budget, milliseconds, 0 = none");
 
@@ -296,6 +301,24 @@ int RunDetect() {
   return kExitOk;
 }
 
+// "u,v;u,v" into pixels; empty text is no seeds.
+absl::StatusOr<std::vector<std::pair<uint32_t, uint32_t>>> ParseSeeds(
+    const std::string& text) {
+  std::vector<std::pair<uint32_t, uint32_t>> seeds;
+  for (absl::string_view item : absl::StrSplit(text, ';', absl::SkipEmpty())) {
+    const std::vector<absl::string_view> uv = absl::StrSplit(item, ',');
+    uint32_t u = 0;
+    uint32_t v = 0;
+    if (uv.size() != 2 || !absl::SimpleAtoi(uv[0], &u) ||
+        !absl::SimpleAtoi(uv[1], &v)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "seeds: '", item, "' is not a pixel 'u,v' (columns, rows)"));
+    }
+    seeds.emplace_back(u, v);
+  }
+  return seeds;
+}
+
 int RunSegment(bool incremental) {
   absl::StatusOr<fovea::v1::DetectOptions> options = DetectOptionsFromFlags();
   if (!options.ok()) return Fail(kExitUsage, options.status());
@@ -313,6 +336,9 @@ int RunSegment(bool incremental) {
     return Fail(kExitUsage, absl::InvalidArgumentError(
                                 "max_objects, time_budget_ms: must be >= 0"));
   }
+  absl::StatusOr<std::vector<std::pair<uint32_t, uint32_t>>> seeds =
+      ParseSeeds(absl::GetFlag(FLAGS_seeds));
+  if (!seeds.ok()) return Fail(kExitUsage, seeds.status());
   absl::StatusOr<LoadedFrame> frame = FrameFromFlags();
   if (!frame.ok()) return FailLocal(frame.status());
   absl::StatusOr<std::unique_ptr<FoveaClient>> client = MakeClient();
@@ -336,7 +362,18 @@ int RunSegment(bool incremental) {
       std::cout << DescribeSegmentMessage(message, absl::Now() - start)
                 << std::endl;
     }
-    if (!out.empty()) messages.push_back(message);
+    if (!out.empty()) {
+      messages.push_back(message);
+      if (message.has_object()) {
+        absl::StatusOr<std::string> path =
+            WriteObjectMask(out, message.object());
+        if (path.ok()) {
+          std::cerr << "wrote " << *path << "\n";
+        } else {
+          std::cerr << "fovea-client: " << path.status() << "\n";
+        }
+      }
+    }
   };
 
   absl::Status status;
@@ -356,6 +393,11 @@ int RunSegment(bool incremental) {
     *request.mutable_detect_options() = *std::move(options);
     request.set_method(method);
     request.set_max_objects(static_cast<uint32_t>(max_objects));
+    for (const auto& [u, v] : *seeds) {
+      fovea::v1::AttentionPixel* seed = request.add_seeds();
+      seed->set_u(u);
+      seed->set_v(v);
+    }
     start = absl::Now();
     status = (*client)->Segment(request, Deadline(), on_message);
   }

@@ -68,8 +68,9 @@ std::vector<ExtractionKind> ImplementedExtractions() {
                   });
 }
 
-v1::Capabilities BuildCapabilities(const FrameLimits& limits,
-                                   uint64_t max_message_bytes) {
+v1::Capabilities BuildCapabilities(
+    const FrameLimits& limits, uint64_t max_message_bytes,
+    const std::vector<std::pair<std::string, std::string>>& model_versions) {
   v1::Capabilities out;
   out.set_server_version(std::string(ServerVersion()));
   for (const char* encoding : {"rgb8", "bgr8"})
@@ -93,7 +94,13 @@ v1::Capabilities BuildCapabilities(const FrameLimits& limits,
   for (ExtractionKind kind : ImplementedExtractions()) {
     out.add_extractions(ToProtoEnum(kind));
   }
-  // Segmentation and models arrive with their issues.
+  out.add_segmentation_methods(v1::COS);
+  for (const auto& [name, version] : model_versions) {
+    v1::ModelVersion* model = out.add_models();
+    model->set_name(name);
+    model->set_version(version);
+  }
+  // Incremental segmentation arrives with its issue.
   out.set_segment_incremental(false);
   *out.mutable_default_detect_options() = ToProtoDetectOptions(DetectOptions{});
   return out;

@@ -2,7 +2,9 @@
 #define FOVEA_SERVER_CAPABILITIES_H_
 
 #include <cstdint>
+#include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "core/frame/frame_decode.h"
@@ -26,8 +28,10 @@ std::vector<ExtractionKind> ImplementedExtractions();
 // 16UC1, 32FC1), compressed formats (png, jpeg), the frame limits and
 // largest message, the implemented operators and strategies above, no
 // segmentation methods or models yet, and core's default DetectOptions.
-v1::Capabilities BuildCapabilities(const FrameLimits& limits,
-                                   uint64_t max_message_bytes);
+v1::Capabilities BuildCapabilities(
+    const FrameLimits& limits, uint64_t max_message_bytes,
+    const std::vector<std::pair<std::string, std::string>>& model_versions =
+        {});
 
 }  // namespace fovea::server
 

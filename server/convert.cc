@@ -1,5 +1,6 @@
 #include "server/convert.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <exception>
@@ -528,6 +529,130 @@ absl::StatusOr<v1::DetectResponse> ToDetectResponse(
     out->set_seconds(timing.seconds);
   }
   return response;
+}
+
+absl::StatusOr<SegmentOptions> ToSegmentOptions(
+    const v1::SegmentRequest& request) {
+  SegmentOptions options;
+  absl::StatusOr<DetectOptions> detect =
+      ToDetectOptions(request.detect_options());
+  if (!detect.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("detect_options.", detect.status().message()));
+  }
+  options.detect = *std::move(detect);
+  switch (request.method()) {
+    case v1::SEGMENTATION_METHOD_UNSPECIFIED:
+    case v1::COS:
+      options.method = SegmentMethod::kCos;
+      break;
+    case v1::EBS:
+      options.method = SegmentMethod::kEbs;
+      break;
+    default:
+      return absl::InvalidArgumentError(absl::StrCat(
+          "method: unknown value ", static_cast<int>(request.method())));
+  }
+  if (request.seeds_size() > kMaxAttentionPoints) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("seeds: ", request.seeds_size(), " given, at most ",
+                     kMaxAttentionPoints, " allowed"));
+  }
+  for (int i = 0; i < request.seeds_size(); ++i) {
+    const v1::AttentionPixel& p = request.seeds(i);
+    // Beyond any frame a server accepts; core checks the frame's size.
+    constexpr uint32_t kMaxCoordinate = 1 << 16;
+    if (p.u() >= kMaxCoordinate || p.v() >= kMaxCoordinate) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "seeds[", i, "]: (", p.u(), ", ", p.v(), ") is beyond any frame"));
+    }
+    options.seeds.emplace_back(static_cast<int>(p.u()),
+                               static_cast<int>(p.v()));
+  }
+  options.max_objects =
+      static_cast<int>(std::min<uint32_t>(request.max_objects(), 1u << 20));
+  return options;
+}
+
+v1::RleMask ToRleMask(const cv::Mat& mask) {
+  v1::RleMask rle;
+  rle.set_height(static_cast<uint32_t>(mask.rows));
+  rle.set_width(static_cast<uint32_t>(mask.cols));
+  // Column-major runs, starting with a (possibly empty) run of zeros.
+  bool inside = false;
+  uint32_t run = 0;
+  for (int u = 0; u < mask.cols; ++u) {
+    for (int v = 0; v < mask.rows; ++v) {
+      const bool here = mask.at<unsigned char>(v, u) != 0;
+      if (here != inside) {
+        rle.add_counts(run);
+        run = 0;
+        inside = here;
+      }
+      ++run;
+    }
+  }
+  if (mask.total() > 0) rle.add_counts(run);
+  return rle;
+}
+
+v1::SegmentResponse ToPointsMessage(const std::vector<AttentionPoint>& points,
+                                    const std::string& request_id) {
+  v1::SegmentResponse message;
+  message.set_request_id(request_id);
+  for (size_t i = 0; i < points.size(); ++i) {
+    v1::AttentionPoint* out = message.add_attention_points();
+    out->set_u(static_cast<uint32_t>(points[i].u));
+    out->set_v(static_cast<uint32_t>(points[i].v));
+    *out->mutable_point() = ToPoint3(points[i].point);
+    out->set_saliency(points[i].saliency);
+    out->set_rank(static_cast<uint32_t>(i));
+  }
+  return message;
+}
+
+v1::SegmentResponse ToObjectMessage(const SegmentedObject& object,
+                                    const std::string& request_id) {
+  v1::SegmentResponse message;
+  message.set_request_id(request_id);
+  v1::ObjectResult* out = message.mutable_object();
+  out->set_index(static_cast<uint32_t>(object.index));
+  v1::AttentionPoint* seed = out->mutable_seed();
+  seed->set_u(static_cast<uint32_t>(object.seed.u));
+  seed->set_v(static_cast<uint32_t>(object.seed.v));
+  *seed->mutable_point() = ToPoint3(object.seed.point);
+  seed->set_saliency(object.seed.saliency);
+  *out->mutable_mask() = ToRleMask(object.mask);
+  v1::BoundingBox* box = out->mutable_box();
+  box->set_u(static_cast<uint32_t>(object.box.x));
+  box->set_v(static_cast<uint32_t>(object.box.y));
+  box->set_width(static_cast<uint32_t>(object.box.width));
+  box->set_height(static_cast<uint32_t>(object.box.height));
+  out->set_area(static_cast<uint32_t>(object.area));
+  out->set_score(object.score);
+  *out->mutable_centroid() = ToPoint3(object.centroid);
+  *out->mutable_extent() = ToPoint3(object.extent);
+  out->set_seconds_since_request(object.seconds_since_start);
+  return message;
+}
+
+v1::SegmentResponse ToSummaryMessage(const SegmentSummary& summary,
+                                     v1::StopReason stop_reason,
+                                     const std::string& request_id) {
+  v1::SegmentResponse message;
+  message.set_request_id(request_id);
+  message.set_last(true);
+  v1::SegmentSummary* out = message.mutable_summary();
+  out->set_stop_reason(stop_reason);
+  out->set_object_count(static_cast<uint32_t>(summary.objects));
+  out->set_scene_coverage(summary.scene_coverage);
+  for (const StageTiming& timing : summary.timings) {
+    v1::StageTiming* t = out->add_timings();
+    t->set_stage(timing.stage);
+    t->set_seconds(timing.seconds);
+  }
+  out->set_seconds_total(summary.total_seconds);
+  return message;
 }
 
 }  // namespace fovea::server

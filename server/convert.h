@@ -7,8 +7,10 @@
 #include "absl/status/statusor.h"
 #include "core/frame/frame_decode.h"
 #include "core/pipeline/detect.h"
+#include "core/pipeline/segment.h"
 #include "fovea/v1/detect.pb.h"
 #include "fovea/v1/frame.pb.h"
+#include "fovea/v1/segment.pb.h"
 
 namespace fovea::server {
 
@@ -73,6 +75,31 @@ absl::StatusOr<std::string> EncodeSaliencyPng(const cv::Mat& map);
 // cannot be encoded.
 absl::StatusOr<v1::DetectResponse> ToDetectResponse(
     const DetectResult& result, const v1::DetectRequest& request);
+
+// Segment's options from the request: method (UNSPECIFIED = COS), seeds
+// as given (checked against the frame by core), detect_options as
+// ToDetectOptions, max_objects (0 = no limit). Errors: INVALID_ARGUMENT
+// naming the field (detect_options.*, seeds: more than kMaxAttentionPoints
+// or a coordinate beyond any frame, method: unknown value).
+absl::StatusOr<SegmentOptions> ToSegmentOptions(
+    const v1::SegmentRequest& request);
+
+// COCO RLE (segment.proto RleMask) of a CV_8UC1 mask, non-zero = inside.
+v1::RleMask ToRleMask(const cv::Mat& mask);
+
+// The first message of a segmentation stream: the seeds used, ranked in
+// order.
+v1::SegmentResponse ToPointsMessage(const std::vector<AttentionPoint>& points,
+                                    const std::string& request_id);
+
+// One object's message.
+v1::SegmentResponse ToObjectMessage(const SegmentedObject& object,
+                                    const std::string& request_id);
+
+// The last message: `last` set and the summary, with `stop_reason`.
+v1::SegmentResponse ToSummaryMessage(const SegmentSummary& summary,
+                                     v1::StopReason stop_reason,
+                                     const std::string& request_id);
 
 }  // namespace fovea::server
 

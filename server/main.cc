@@ -53,6 +53,10 @@ ABSL_FLAG(uint32_t, max_height, fovea::FrameLimits{}.max_height,
 ABSL_FLAG(double, grace_period_s, 10.0,
           "On SIGTERM/SIGINT: seconds in-flight calls get to finish before "
           "they are cancelled.");
+ABSL_FLAG(
+    std::string, models_dir, fovea::server::ServerConfig{}.models_dir,
+    "Folder of the trained models (cos_svm.txt, ...; see models/README.md). "
+    "The server does not start without them.");
 ABSL_FLAG(std::string, log_level, "info", "debug, info, warn or error.");
 
 int main(int argc, char** argv) {
@@ -105,6 +109,7 @@ int main(int argc, char** argv) {
   config.max_message_bytes = absl::GetFlag(FLAGS_max_message_bytes);
   config.limits.max_width = absl::GetFlag(FLAGS_max_width);
   config.limits.max_height = absl::GetFlag(FLAGS_max_height);
+  config.models_dir = absl::GetFlag(FLAGS_models_dir);
 
   absl::StatusOr<std::unique_ptr<fovea::server::FoveaServer>> server =
       fovea::server::FoveaServer::Start(config);

@@ -82,6 +82,17 @@ class Metrics {
     return stage_family_.Add({{"stage", std::string(stage)}}, StageBuckets());
   }
 
+  prometheus::Histogram& FirstObject(std::string_view method) {
+    return first_object_family_.Add({{"grpc_method", std::string(method)}},
+                                    HandlingBuckets());
+  }
+  prometheus::Histogram& Objects(std::string_view method) {
+    static const auto* buckets = new prometheus::Histogram::BucketBoundaries{
+        0, 1, 2, 3, 5, 8, 13, 21, 34, 55, 100};
+    return objects_family_.Add({{"grpc_method", std::string(method)}},
+                               *buckets);
+  }
+
   prometheus::Gauge& inflight() { return inflight_; }
   prometheus::Histogram& queue_wait() { return queue_wait_; }
 
@@ -124,6 +135,16 @@ class Metrics {
                 .Name("fovea_stage_duration_seconds")
                 .Help("Wall time of one pipeline stage of one call, seconds.")
                 .Register(*registry_)),
+        first_object_family_(
+            prometheus::BuildHistogram()
+                .Name("fovea_time_to_first_object_seconds")
+                .Help("From the start of a segmentation call to its first "
+                      "object message, seconds.")
+                .Register(*registry_)),
+        objects_family_(prometheus::BuildHistogram()
+                            .Name("fovea_objects_per_request")
+                            .Help("Objects sent by one segmentation call.")
+                            .Register(*registry_)),
         inflight_(prometheus::BuildGauge()
                       .Name("fovea_inflight_requests")
                       .Help("Calls started and not yet finished, queued "
@@ -150,6 +171,10 @@ class Metrics {
       series.received = &received_family_.Add(labels);
       series.sent = &sent_family_.Add(labels);
       series.handling = &handling_family_.Add(labels, HandlingBuckets());
+      if (kMethods[i].type == "server_stream") {
+        FirstObject(kMethods[i].name);
+        Objects(kMethods[i].name);
+      }
       for (size_t c = 0; c < kAllStatusCodes.size(); ++c) {
         prometheus::Labels with_code = labels;
         with_code["grpc_code"] = std::string(GrpcCodeName(kAllStatusCodes[c]));
@@ -165,6 +190,8 @@ class Metrics {
   prometheus::Family<prometheus::Counter>& sent_family_;
   prometheus::Family<prometheus::Histogram>& handling_family_;
   prometheus::Family<prometheus::Histogram>& stage_family_;
+  prometheus::Family<prometheus::Histogram>& first_object_family_;
+  prometheus::Family<prometheus::Histogram>& objects_family_;
   prometheus::Gauge& inflight_;
   prometheus::Histogram& queue_wait_;
   prometheus::Family<prometheus::Gauge>& build_info_family_;
@@ -215,6 +242,14 @@ void RecordStage(std::string_view stage, double seconds) {
 
 void RecordQueueWait(double seconds) {
   Metrics::Get().queue_wait().Observe(seconds);
+}
+
+void RecordFirstObject(std::string_view method, double seconds) {
+  Metrics::Get().FirstObject(method).Observe(seconds);
+}
+
+void RecordObjectsPerRequest(std::string_view method, int objects) {
+  Metrics::Get().Objects(method).Observe(objects);
 }
 
 void IncrementInflight() { Metrics::Get().inflight().Increment(); }

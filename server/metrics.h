@@ -32,6 +32,12 @@ namespace fovea::server {
 //   fovea_stage_duration_seconds{stage}  histogram; stages are core's
 //                                        timings plus "queue", "decode",
 //                                        "encode"
+//   fovea_time_to_first_object_seconds{grpc_method}  histogram (gRPC
+//                                        buckets): call start to the first
+//                                        object message of Segment /
+//                                        SegmentIncremental
+//   fovea_objects_per_request{grpc_method}  histogram: objects sent by one
+//                                        segmentation call
 //   fovea_inflight_requests              gauge: calls started, not finished
 //   fovea_queue_wait_seconds             histogram: submit to start of work
 //   fovea_build_info{version}            gauge, always 1
@@ -59,6 +65,9 @@ void RecordCallHandled(std::string_view method, absl::StatusCode code,
 
 void RecordStage(std::string_view stage, double seconds);
 void RecordQueueWait(double seconds);
+// Segmentation calls ("Segment", "SegmentIncremental").
+void RecordFirstObject(std::string_view method, double seconds);
+void RecordObjectsPerRequest(std::string_view method, int objects);
 void IncrementInflight();
 void DecrementInflight();
 

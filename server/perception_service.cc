@@ -1,8 +1,12 @@
 #include "server/perception_service.h"
 
 #include <chrono>
+#include <condition_variable>
+#include <deque>
 #include <exception>
+#include <mutex>
 #include <new>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -14,6 +18,7 @@
 #include "server/clock.h"
 #include "server/convert.h"
 #include "server/handle_detect.h"
+#include "server/handle_segment.h"
 #include "server/log.h"
 #include "server/metrics.h"
 #include "server/status_util.h"
@@ -166,6 +171,162 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
   Clock::time_point submitted_;
 };
 
+// One Segment call: options converted at once, the work on a worker, the
+// messages written one at a time as the worker makes them. The worker
+// waits while kMaxPendingMessages are unwritten (a client that stops
+// reading holds at most that many messages in memory) and stops when the
+// client cancels or a write fails. Finishes exactly once, after every
+// queued message was written; deletes itself in OnDone, which gRPC calls
+// only after Finish, and Finish only comes after the worker's last touch.
+class SegmentReactor final
+    : public grpc::ServerWriteReactor<v1::SegmentResponse> {
+ public:
+  SegmentReactor(const ServiceConfig& config, WorkQueue& work,
+                 grpc::CallbackServerContext* context,
+                 const v1::SegmentRequest* request)
+      : config_(config),
+        context_(context),
+        request_(request),
+        call_("Segment", request->request_id()),
+        start_(Clock::now()) {
+    absl::StatusOr<SegmentOptions> options = ToSegmentOptions(*request);
+    if (!options.ok()) {
+      FinishOnce(options.status());
+      return;
+    }
+    options_ = *std::move(options);
+    if (!work.TrySubmit([this] { Run(); })) {
+      FinishOnce(absl::ResourceExhaustedError(
+          absl::StrCat("server busy: ", work.workers(), " frames in work and ",
+                       work.queue_capacity(), " queued; retry later")));
+    }
+  }
+
+  void OnWriteDone(bool ok) override {
+    std::optional<absl::Status> finish;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      writing_ = false;
+      if (!ok) {
+        broken_ = true;
+        pending_.clear();
+      } else {
+        RecordMessageSent("Segment");
+      }
+      if (!pending_.empty()) {
+        StartNextWriteLocked();
+      } else if (final_status_ && !finished_) {
+        finished_ = true;
+        finish = *final_status_;
+      }
+    }
+    changed_.notify_all();
+    if (finish) Finish(call_.EndStream(*finish));
+  }
+
+  void OnCancel() override {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      broken_ = true;
+    }
+    changed_.notify_all();
+  }
+
+  void OnDone() override { delete this; }
+
+ private:
+  // At most this many messages wait unwritten before the worker blocks.
+  static constexpr size_t kMaxPendingMessages = 2;
+
+  // On a worker thread.
+  void Run() {
+    absl::Status status;
+    try {
+      status = Compute();
+    } catch (const std::bad_alloc&) {
+      status = absl::ResourceExhaustedError("Segment: out of memory");
+    } catch (const std::exception& e) {
+      status = absl::InternalError(
+          absl::StrCat("Segment: unexpected exception: ", e.what()));
+    } catch (...) {
+      status = absl::InternalError(
+          "Segment: unexpected exception of a non-standard type");
+    }
+    FinishOnce(status);
+  }
+
+  absl::Status Compute() {
+    const double queue_seconds = SecondsSince(start_);
+    RecordQueueWait(queue_seconds);
+    if (absl::Status status = CheckInterrupt(*context_); !status.ok()) {
+      return status;
+    }
+    return HandleSegment(
+        *request_, options_, config_.segment_models, config_.limits,
+        [this] {
+          if (config_.at_stage_boundary) config_.at_stage_boundary();
+          return CheckInterrupt(*context_);
+        },
+        [this](v1::SegmentResponse message) {
+          return Send(std::move(message));
+        },
+        start_, queue_seconds);
+  }
+
+  // Queues one message; blocks while kMaxPendingMessages wait. CANCELLED
+  // once the client has gone.
+  absl::Status Send(v1::SegmentResponse message) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait(lock, [this] {
+      return broken_ || pending_.size() < kMaxPendingMessages;
+    });
+    if (broken_) {
+      return absl::CancelledError("the client cancelled or stopped reading");
+    }
+    pending_.push_back(std::move(message));
+    if (!writing_) StartNextWriteLocked();
+    return absl::OkStatus();
+  }
+
+  void StartNextWriteLocked() {
+    current_ = std::move(pending_.front());
+    pending_.pop_front();
+    writing_ = true;
+    StartWrite(&current_);
+  }
+
+  // Finishes now when nothing is being written, else after the last write.
+  void FinishOnce(const absl::Status& status) {
+    bool now = false;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (finished_ || final_status_) return;
+      final_status_ = status;
+      if (!writing_ && pending_.empty()) {
+        finished_ = true;
+        now = true;
+      }
+    }
+    if (now) Finish(call_.EndStream(status));
+  }
+
+  const ServiceConfig& config_;
+  grpc::CallbackServerContext* const context_;  // gRPC's, valid until OnDone
+  const v1::SegmentRequest* const request_;     // gRPC's, valid until OnDone
+  CallRecord call_;
+  const Clock::time_point start_;
+  SegmentOptions options_;
+
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<v1::SegmentResponse> pending_;  // guarded by mutex_
+  v1::SegmentResponse current_;  // being written; guarded by writing_
+  bool writing_ = false;         // guarded by mutex_
+  bool broken_ = false;          // guarded by mutex_
+  bool finished_ = false;        // guarded by mutex_
+  std::optional<absl::Status> final_status_;  // guarded by mutex_
+};
+
 // A server-streaming call refused with `status` before any message.
 class RefusedStream final
     : public grpc::ServerWriteReactor<v1::SegmentResponse> {
@@ -187,8 +348,8 @@ class RefusedStream final
 PerceptionService::PerceptionService(ServiceConfig config, WorkQueue* work)
     : config_(std::move(config)),
       work_(work),
-      capabilities_(
-          BuildCapabilities(config_.limits, config_.max_message_bytes)) {}
+      capabilities_(BuildCapabilities(config_.limits, config_.max_message_bytes,
+                                      config_.model_versions)) {}
 
 grpc::ServerUnaryReactor* PerceptionService::Detect(
     grpc::CallbackServerContext* context, const v1::DetectRequest* request,
@@ -198,11 +359,7 @@ grpc::ServerUnaryReactor* PerceptionService::Detect(
 
 grpc::ServerWriteReactor<v1::SegmentResponse>* PerceptionService::Segment(
     grpc::CallbackServerContext* context, const v1::SegmentRequest* request) {
-  return new RefusedStream(
-      "Segment", request->request_id(),
-      absl::UnimplementedError(
-          "Segment is not built yet: object segmentation arrives in a later "
-          "issue (see GetCapabilities.segmentation_methods)"));
+  return new SegmentReactor(config_, *work_, context, request);
 }
 
 grpc::ServerWriteReactor<v1::SegmentResponse>*

@@ -7,6 +7,7 @@
 #include <functional>
 
 #include "core/frame/frame_decode.h"
+#include "core/pipeline/segment.h"
 #include "fovea/v1/perception.grpc.pb.h"
 #include "server/work_queue.h"
 
@@ -24,6 +25,10 @@ struct ServiceConfig {
   // stages), right before the deadline and cancellation check there.
   // Tests block it to let a deadline pass in the middle of the pipeline.
   std::function<void()> at_stage_boundary;
+  // The trained models (not owned: they outlive the service) and their
+  // (name, version) pairs for GetCapabilities.
+  SegmentModels segment_models;
+  std::vector<std::pair<std::string, std::string>> model_versions;
 };
 
 // fovea.v1.Perception on gRPC's callback API. Handlers are thin: they
@@ -41,7 +46,15 @@ struct ServiceConfig {
 // the call was cancelled (by the client, or by a shutdown past its grace
 // period). An exception thrown in the job completes the call with INTERNAL
 // (RESOURCE_EXHAUSTED when out of memory); the server goes on.
-// Segment, SegmentIncremental: UNIMPLEMENTED until their issues land.
+// Segment: options converted on the callback thread; the work on a worker
+// (RESOURCE_EXHAUSTED at once when the queue is full); messages streamed
+// as HandleSegment makes them, the worker blocking while two are
+// unwritten (a client that stops reading costs bounded memory); the
+// client's deadline and cancellation are checked between stages, between
+// objects and inside the methods' loops, and a failed write stops the
+// work. What was made before a deadline has been sent; the call then ends
+// DEADLINE_EXCEEDED.
+// SegmentIncremental: UNIMPLEMENTED until its issue lands.
 // GetCapabilities: BuildCapabilities, computed once.
 class PerceptionService final : public v1::Perception::CallbackService {
  public:

@@ -91,6 +91,13 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
   InitStageSeries(DetectStages());
 
   std::unique_ptr<FoveaServer> server(new FoveaServer);
+  absl::StatusOr<LoadedModels> models = LoadModels(config.models_dir);
+  if (!models.ok()) {
+    return absl::Status(
+        models.status().code(),
+        absl::StrCat("--models_dir: ", models.status().message()));
+  }
+  server->models_ = std::make_unique<LoadedModels>(*std::move(models));
   if (!config.metrics_listen.empty()) {
     absl::StatusOr<std::unique_ptr<MetricsEndpoint>> metrics =
         MetricsEndpoint::Start(config.metrics_listen);
@@ -101,7 +108,8 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
   server->service_ = std::make_unique<PerceptionService>(
       ServiceConfig{config.limits,
                     static_cast<uint64_t>(config.max_message_bytes),
-                    config.before_detect_job, config.at_stage_boundary},
+                    config.before_detect_job, config.at_stage_boundary,
+                    server->models_->View(), server->models_->versions},
       server->work_.get());
 
   grpc::EnableDefaultHealthCheckService(true);

@@ -13,6 +13,7 @@
 #include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
 #include "core/frame/frame_decode.h"
+#include "core/pipeline/models.h"
 #include "server/metrics.h"
 #include "server/perception_service.h"
 #include "server/work_queue.h"
@@ -31,6 +32,9 @@ struct ServerConfig {
   int max_message_bytes = kDefaultMaxMessageBytes;  // largest request, > 0
   FrameLimits limits;                               // largest frame
   bool warm_up = true;  // run one Detect before reporting SERVING
+  // Folder of the trained models (LoadModels); start-up fails when a model
+  // is missing or corrupt.
+  std::string models_dir = FOVEA_DEFAULT_MODELS_DIR;
   // Test hooks, null in production: see ServiceConfig::before_detect_job
   // and ServiceConfig::at_stage_boundary.
   std::function<void()> before_detect_job;
@@ -58,8 +62,10 @@ absl::Status Validate(const ServerConfig& config);
 // and each call reports its own error.
 class FoveaServer {
  public:
-  // Validates `config`, starts listening and returns at once (the warm-up
-  // runs in the background). UNAVAILABLE when an address cannot be bound.
+  // Validates `config`, loads the models, starts listening and returns at
+  // once (the warm-up runs in the background). UNAVAILABLE when an address
+  // cannot be bound; LoadModels' errors (NOT_FOUND, INVALID_ARGUMENT)
+  // prefixed with "--models_dir".
   static absl::StatusOr<std::unique_ptr<FoveaServer>> Start(
       ServerConfig config);
 
@@ -96,6 +102,7 @@ class FoveaServer {
               const std::function<void()>& before_warm_up);
 
   int port_ = 0;
+  std::unique_ptr<LoadedModels> models_;  // the service points into it
   std::unique_ptr<WorkQueue> work_;
   std::unique_ptr<PerceptionService> service_;
   std::unique_ptr<MetricsEndpoint> metrics_;

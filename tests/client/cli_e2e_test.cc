@@ -1,5 +1,8 @@
 // fovea-client against an in-process fovea server on a loopback port.
 
+#include <unistd.h>
+
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -111,18 +114,31 @@ TEST_F(FoveaClientCliE2eTest, FailedCallPrintsCodeAndExits2) {
   EXPECT_THAT(run.err, HasSubstr("INVALID_ARGUMENT"));
 }
 
-// Segment is UNIMPLEMENTED until segmentation lands; either way the client
-// must end cleanly: exit 0 after a last message, or exit 2 naming the code.
-TEST_F(FoveaClientCliE2eTest, SegmentEndsCleanly) {
-  const CliRun run =
-      RunCli(absl::StrCat("--server ", address_, " segment --synthetic 3"));
-  if (run.exit_code == 0) {
-    EXPECT_THAT(run.out, HasSubstr("last:"));
-  } else {
-    EXPECT_EQ(run.exit_code, 2);
-    EXPECT_THAT(run.err,
-                AnyOf(HasSubstr("UNIMPLEMENTED"), HasSubstr("fovea-client: ")));
-  }
+TEST_F(FoveaClientCliE2eTest, SegmentStreamsObjectsAndWritesEachMask) {
+  const std::string out =
+      ::testing::TempDir() + "/segment_cli_" + std::to_string(::getpid());
+  const CliRun run = RunCli(absl::StrCat("--server ", address_,
+                                         " segment --synthetic 3 --out ", out));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_THAT(run.out, HasSubstr("object 0:"));
+  EXPECT_THAT(run.out, HasSubstr("last: DONE"));
+  EXPECT_TRUE(std::filesystem::exists(out + "/mask_0.png"));
+  EXPECT_TRUE(std::filesystem::exists(out + "/overlay.png"));
+  EXPECT_TRUE(std::filesystem::exists(out + "/responses.jsonl"));
+  std::filesystem::remove_all(out);
+}
+
+TEST_F(FoveaClientCliE2eTest, SegmentSeedsAreSentAndBadOnesAreUsageErrors) {
+  // A seed in the corner sees no object: the stream ends with none.
+  const CliRun corner = RunCli(absl::StrCat(
+      "--server ", address_, " segment --synthetic 3 --seeds 2,2"));
+  ASSERT_EQ(corner.exit_code, 0) << corner.err;
+  EXPECT_THAT(corner.out, HasSubstr("attention points 1: (2,2)"));
+  EXPECT_THAT(corner.out, HasSubstr("0 objects"));
+  const CliRun bad = RunCli(absl::StrCat(
+      "--server ", address_, " segment --synthetic 3 --seeds '2;x'"));
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_THAT(bad.err, HasSubstr("seeds"));
 }
 
 }  // namespace

@@ -8,6 +8,8 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <future>
 #include <optional>
 #include <string>
@@ -74,9 +76,10 @@ std::pair<std::string, int> RunToCompletion(const std::string& args) {
 
 TEST(ServerBinaryTest, HelpListsEveryFlagWithItsDefault) {
   const auto [output, status] = RunToCompletion("--help");
-  for (const char* flag : {"--listen", "--metrics_listen", "--concurrency",
-                           "--queue", "--max_message_bytes", "--max_width",
-                           "--max_height", "--grace_period_s", "--log_level"}) {
+  for (const char* flag :
+       {"--listen", "--metrics_listen", "--concurrency", "--queue",
+        "--max_message_bytes", "--max_width", "--max_height",
+        "--grace_period_s", "--log_level", "--models_dir"}) {
     EXPECT_THAT(output, HasSubstr(flag));
   }
   EXPECT_THAT(output, HasSubstr("default: 67108864"));
@@ -89,6 +92,31 @@ TEST(ServerBinaryTest, BadFlagValueExitsNonZeroNamingIt) {
   EXPECT_TRUE(WIFEXITED(status));
   EXPECT_NE(WEXITSTATUS(status), 0);
   EXPECT_THAT(output, HasSubstr("--concurrency"));
+}
+
+TEST(ServerBinaryTest, MissingOrCorruptModelsStopStartUpNamingTheFile) {
+  const std::string dir =
+      ::testing::TempDir() + "/fovea_models_" + std::to_string(getpid());
+  std::filesystem::create_directories(dir);
+  {
+    const auto [output, status] =
+        RunToCompletion("--models_dir=" + dir + " --metrics_listen=");
+    EXPECT_TRUE(WIFEXITED(status));
+    EXPECT_NE(WEXITSTATUS(status), 0);
+    EXPECT_THAT(output, HasSubstr("cos_svm.txt is missing"));
+    EXPECT_THAT(output, HasSubstr("fovea-train cos"));
+  }
+  {
+    std::ofstream(dir + "/cos_svm.txt") << "fovea-linear-svm 1\nkind cos\n"
+                                           "features a b\nweights 1 x\n";
+    const auto [output, status] =
+        RunToCompletion("--models_dir=" + dir + " --metrics_listen=");
+    EXPECT_TRUE(WIFEXITED(status));
+    EXPECT_NE(WEXITSTATUS(status), 0);
+    EXPECT_THAT(output, HasSubstr("is not a COS model"));
+    EXPECT_THAT(output, HasSubstr("not a finite number"));
+  }
+  std::filesystem::remove_all(dir);
 }
 
 // A fovea-server process on loopback, started with `flags` plus --listen

@@ -288,34 +288,145 @@ TEST_F(ServerTest, Sym3dOnAnIttiPyramidWithTJunctionsFindsObjects) {
   ASSERT_GT(response.points_size(), 0);
 }
 
-TEST_F(ServerTest, SegmentMethodsAreUnimplemented) {
-  StartServer();
-  {
-    grpc::ClientContext context;
-    v1::SegmentRequest request;
-    auto reader = stub_->Segment(&context, request);
-    v1::SegmentResponse response;
-    EXPECT_FALSE(reader->Read(&response));
-    const grpc::Status status = reader->Finish();
-    EXPECT_EQ(status.error_code(), grpc::StatusCode::UNIMPLEMENTED);
-    EXPECT_THAT(status.error_message(), HasSubstr("not built yet"));
+// Every message of a Segment call, and its status.
+struct SegmentCall {
+  std::vector<v1::SegmentResponse> messages;
+  grpc::Status status;
+};
+
+SegmentCall CallSegment(v1::Perception::Stub& stub,
+                        const v1::SegmentRequest& request,
+                        int read_at_most = 1000) {
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() +
+                       std::chrono::seconds(60));
+  auto reader = stub.Segment(&context, request);
+  SegmentCall call;
+  v1::SegmentResponse response;
+  while (static_cast<int>(call.messages.size()) < read_at_most &&
+         reader->Read(&response)) {
+    call.messages.push_back(response);
   }
-  {
-    grpc::ClientContext context;
-    v1::SegmentIncrementalRequest request;
-    auto reader = stub_->SegmentIncremental(&context, request);
-    v1::SegmentResponse response;
-    EXPECT_FALSE(reader->Read(&response));
-    const grpc::Status status = reader->Finish();
-    EXPECT_EQ(status.error_code(), grpc::StatusCode::UNIMPLEMENTED);
-    EXPECT_THAT(status.error_message(), HasSubstr("not built yet"));
+  if (static_cast<int>(call.messages.size()) >= read_at_most) {
+    context.TryCancel();
+    while (reader->Read(&response)) {
+    }
+  }
+  call.status = reader->Finish();
+  return call;
+}
+
+TEST_F(ServerTest, SegmentStreamsPointsThenObjectsThenTheSummary) {
+  StartServer();
+  v1::SegmentRequest request;
+  request.set_request_id("seg-1");
+  *request.mutable_frame() = MakeSyntheticRequest(3, false).request.frame();
+  const SegmentCall call = CallSegment(*stub_, request);
+  ASSERT_TRUE(call.status.ok()) << call.status.error_message();
+  ASSERT_GE(call.messages.size(), 3u);
+  EXPECT_GT(call.messages.front().attention_points_size(), 0);
+  EXPECT_FALSE(call.messages.front().has_object());
+  const v1::SegmentResponse& last = call.messages.back();
+  EXPECT_TRUE(last.last());
+  EXPECT_EQ(last.summary().stop_reason(), v1::DONE);
+  const int objects = static_cast<int>(call.messages.size()) - 2;
+  EXPECT_EQ(last.summary().object_count(), static_cast<uint32_t>(objects));
+  double previous = 0.0;
+  for (int i = 1; i <= objects; ++i) {
+    const v1::ObjectResult& object = call.messages[i].object();
+    EXPECT_EQ(call.messages[i].request_id(), "seg-1");
+    EXPECT_EQ(object.index(), static_cast<uint32_t>(i - 1));
+    EXPECT_GT(object.area(), 0u);
+    EXPECT_EQ(object.mask().width(), 640u);
+    uint64_t pixels = 0;
+    for (const uint32_t run : object.mask().counts()) pixels += run;
+    EXPECT_EQ(pixels, 640u * 480u);
+    EXPECT_GE(object.seconds_since_request(), previous);
+    previous = object.seconds_since_request();
   }
   const std::string text = Scrape();
-  EXPECT_EQ(
-      MetricValue(text, "grpc_server_handled_total",
-                  {"grpc_method=\"Segment\"", "grpc_code=\"Unimplemented\"",
-                   "grpc_type=\"server_stream\""}),
-      1);
+  EXPECT_EQ(MetricValue(text, "fovea_objects_per_request_count",
+                        {"grpc_method=\"Segment\""}),
+            1);
+  EXPECT_EQ(MetricValue(text, "fovea_time_to_first_object_seconds_count",
+                        {"grpc_method=\"Segment\""}),
+            objects > 0 ? 1 : 0);
+  EXPECT_EQ(MetricValue(text, "grpc_server_msg_sent_total",
+                        {"grpc_method=\"Segment\""}),
+            static_cast<double>(call.messages.size()));
+}
+
+TEST_F(ServerTest, SegmentKeepsGivenSeedsAndStopsAtMaxObjects) {
+  StartServer();
+  v1::SegmentRequest request;
+  *request.mutable_frame() = MakeSyntheticRequest(3, false).request.frame();
+  // Seeds from a Detect on the same frame: on objects, in this order.
+  v1::DetectRequest detect = MakeSyntheticRequest(3, false).request;
+  v1::DetectResponse points;
+  ASSERT_TRUE(Detect(detect, &points).ok());
+  ASSERT_GE(points.points_size(), 2);
+  for (int i = 1; i >= 0; --i) {
+    v1::AttentionPixel* seed = request.add_seeds();
+    seed->set_u(points.points(i).u());
+    seed->set_v(points.points(i).v());
+  }
+  request.set_max_objects(1);
+  const SegmentCall call = CallSegment(*stub_, request);
+  ASSERT_TRUE(call.status.ok()) << call.status.error_message();
+  ASSERT_EQ(call.messages.front().attention_points_size(), 2);
+  EXPECT_EQ(call.messages.front().attention_points(0).u(),
+            points.points(1).u());
+  EXPECT_EQ(call.messages.back().summary().object_count(), 1u);
+  EXPECT_EQ(call.messages.back().summary().stop_reason(), v1::MAX_OBJECTS);
+}
+
+TEST_F(ServerTest,
+       SegmentRejectsBadRequestsByFieldAndIncrementalIsUnimplemented) {
+  StartServer();
+  v1::SegmentRequest request;
+  *request.mutable_frame() = MakeSyntheticRequest(3, false).request.frame();
+  request.add_seeds()->set_u(5000);
+  SegmentCall call = CallSegment(*stub_, request);
+  EXPECT_EQ(call.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(call.status.error_message(), HasSubstr("seeds"));
+  EXPECT_TRUE(call.messages.empty());
+  request.clear_seeds();
+  request.mutable_detect_options()->set_max_points(1000);
+  call = CallSegment(*stub_, request);
+  EXPECT_EQ(call.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(call.status.error_message(), HasSubstr("detect_options."));
+  request.clear_detect_options();
+  request.mutable_frame()->clear_intrinsics();
+  call = CallSegment(*stub_, request);
+  EXPECT_EQ(call.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(call.status.error_message(), HasSubstr("intrinsics"));
+
+  grpc::ClientContext context;
+  v1::SegmentIncrementalRequest incremental;
+  auto reader = stub_->SegmentIncremental(&context, incremental);
+  v1::SegmentResponse response;
+  EXPECT_FALSE(reader->Read(&response));
+  const grpc::Status status = reader->Finish();
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::UNIMPLEMENTED);
+  EXPECT_THAT(status.error_message(), HasSubstr("not built yet"));
+}
+
+TEST_F(ServerTest, SegmentCancelledAfterTheFirstMessageEndsCancelled) {
+  StartServer();
+  v1::SegmentRequest request;
+  *request.mutable_frame() = MakeSyntheticRequest(3, false).request.frame();
+  const SegmentCall call = CallSegment(*stub_, request, /*read_at_most=*/1);
+  EXPECT_EQ(call.status.error_code(), grpc::StatusCode::CANCELLED);
+  // The server finishes the call and goes on serving.
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        return MetricValue(
+                   Scrape(), "grpc_server_handled_total",
+                   {"grpc_method=\"Segment\"", "grpc_code=\"Canceled\""}) == 1;
+      },
+      std::chrono::seconds(10)));
+  const SegmentCall again = CallSegment(*stub_, request);
+  EXPECT_TRUE(again.status.ok()) << again.status.error_message();
 }
 
 TEST_F(ServerTest, CapabilitiesReportWhatCoreImplements) {
@@ -343,7 +454,11 @@ TEST_F(ServerTest, CapabilitiesReportWhatCoreImplements) {
   EXPECT_EQ(capabilities.max_width(), 1920u);
   EXPECT_EQ(capabilities.max_message_bytes(),
             static_cast<uint64_t>(kDefaultMaxMessageBytes));
-  EXPECT_TRUE(capabilities.segmentation_methods().empty());
+  EXPECT_THAT(capabilities.segmentation_methods(),
+              ::testing::ElementsAre(v1::COS));
+  ASSERT_EQ(capabilities.models_size(), 1);
+  EXPECT_EQ(capabilities.models(0).name(), "cos_svm");
+  EXPECT_THAT(capabilities.models(0).version(), ::testing::StartsWith("cos-"));
   EXPECT_FALSE(capabilities.segment_incremental());
   EXPECT_EQ(capabilities.default_detect_options().max_points(), 10u);
 }

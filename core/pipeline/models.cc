@@ -1,0 +1,78 @@
+#include "core/pipeline/models.h"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "absl/strings/str_cat.h"
+#include "core/base/strings.h"
+
+namespace fovea {
+namespace {
+
+// Model files are a few hundred bytes to a few kilobytes; anything much
+// larger is not one.
+constexpr std::uintmax_t kMaxModelFileBytes = 16 << 20;
+
+absl::StatusOr<std::string> ReadModelFile(const std::filesystem::path& path,
+                                          std::string_view how_to_make) {
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) {
+    return absl::NotFoundError(
+        absl::StrCat("model file ", path.string(),
+                     " is missing; make it with `", AbslView(how_to_make),
+                     "` or point --models_dir at a folder that has it"));
+  }
+  const std::uintmax_t size = std::filesystem::file_size(path, error);
+  if (error || size > kMaxModelFileBytes) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "model file ", path.string(), " is unreadable or too large"));
+  }
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  if (!in && !in.eof()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("model file ", path.string(), " cannot be read"));
+  }
+  return text.str();
+}
+
+}  // namespace
+
+SegmentModels LoadedModels::View() const {
+  SegmentModels models;
+  models.cos = cos ? &*cos : nullptr;
+  return models;
+}
+
+absl::StatusOr<LoadedModels> LoadModels(const std::string& dir) {
+  std::error_code error;
+  if (!std::filesystem::is_directory(dir, error)) {
+    return absl::NotFoundError(
+        absl::StrCat("models folder '", dir, "' does not exist"));
+  }
+  LoadedModels models;
+  const std::filesystem::path cos_path =
+      std::filesystem::path(dir) / kCosModelFile;
+  absl::StatusOr<std::string> cos_text = ReadModelFile(
+      cos_path, "fovea-train cos --data DIR --out models/cos_svm.txt");
+  if (!cos_text.ok()) return cos_text.status();
+  absl::StatusOr<LinearSvm> cos = LinearSvm::Parse(*cos_text, "cos");
+  if (!cos.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("model file ", cos_path.string(),
+                     " is not a COS model: ", cos.status().message()));
+  }
+  if (cos->feature_names() != CosFeatureNames()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "model file ", cos_path.string(),
+        " was trained on other features than this build computes; retrain "
+        "it with fovea-train cos"));
+  }
+  models.versions.emplace_back("cos_svm", cos->Version());
+  models.cos = *std::move(cos);
+  return models;
+}
+
+}  // namespace fovea

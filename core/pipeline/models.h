@@ -1,0 +1,36 @@
+#ifndef FOVEA_CORE_PIPELINE_MODELS_H_
+#define FOVEA_CORE_PIPELINE_MODELS_H_
+
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/pipeline/segment.h"
+#include "core/segmentation/linear_svm.h"
+
+namespace fovea {
+
+// The trained models of a models folder (models/ in the repository; see
+// its README for how each was made).
+inline constexpr char kCosModelFile[] = "cos_svm.txt";
+
+struct LoadedModels {
+  std::optional<LinearSvm> cos;
+  // (name, version) of each model, as GetCapabilities reports them.
+  std::vector<std::pair<std::string, std::string>> versions;
+
+  // Pointers into this struct: valid while it lives and is not moved.
+  SegmentModels View() const;
+};
+
+// Reads every model of `dir`. Errors name the file and what is wrong, and
+// say how to make it: NOT_FOUND for a missing folder or file,
+// INVALID_ARGUMENT for a file that does not parse (LinearSvm::Parse's
+// message).
+absl::StatusOr<LoadedModels> LoadModels(const std::string& dir);
+
+}  // namespace fovea
+
+#endif  // FOVEA_CORE_PIPELINE_MODELS_H_
