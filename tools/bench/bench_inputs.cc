@@ -19,6 +19,10 @@
 namespace fovea::bench {
 namespace {
 
+// Synthetic scenes the EBS model of the benchmarks is trained on (the timed
+// ones are main.cc's kSynthSeeds, 1-4).
+constexpr uint64_t kEbsTrainingSeeds[] = {101, 102, 103};
+
 // Largest depth a 16UC1 millimetre pixel holds.
 constexpr float kMaxWireDepthUnits = 65535.0f;
 
@@ -158,7 +162,32 @@ absl::Status PrepareScene(const RgbdFrame& frame, BenchScene& scene) {
       ComputeRsoSaliency(scene.cloud, scene.plane, scene.table, options.rso);
   if (!rso.ok()) return StageError(scene, "saliency.rso", rso.status());
   scene.rso_map = *std::move(rso);
+
+  const absl::StatusOr<EbsModel>& ebs = BenchEbsModel();
+  if (!ebs.ok()) return StageError(scene, "ebs model", ebs.status());
+  scene.edge_probability = ebs->EdgeProbability(scene.cloud);
+  absl::StatusOr<std::vector<AttentionPoint>> points =
+      ExtractAttentionPoints(scene.rso_map, options);
+  if (!points.ok()) return StageError(scene, "attention", points.status());
+  scene.fixation =
+      points->empty()
+          ? cv::Point(scene.cloud.width() / 2, scene.cloud.height() / 2)
+          : cv::Point(points->front().u, points->front().v);
   return absl::OkStatus();
+}
+
+const absl::StatusOr<EbsModel>& BenchEbsModel() {
+  static const absl::StatusOr<EbsModel>* const model = [] {
+    std::vector<synth::SynthScene> scenes;
+    std::vector<const LabelledFrame*> frames;
+    for (const uint64_t seed : kEbsTrainingSeeds) {
+      scenes.push_back(synth::GenerateScene(seed));
+    }
+    for (const synth::SynthScene& s : scenes) frames.push_back(&s.frame);
+    return new absl::StatusOr<EbsModel>(
+        EbsModel::Train(frames, EbsTrainOptions{}));
+  }();
+  return *model;
 }
 
 void AddSyntheticScenes(const std::vector<uint64_t>& seeds, SceneList& scenes) {

@@ -13,6 +13,7 @@
 #include "core/frame/rgbd_frame.h"
 #include "core/frame/support_plane.h"
 #include "core/frame/table_scene.h"
+#include "core/segmentation/ebs.h"
 
 namespace fovea::bench {
 
@@ -42,6 +43,11 @@ struct BenchScene {
   SupportPlane plane;
   TableScene table;
   cv::Mat rso_map;  // CV_32FC1, input to the MSR case
+  // EBS inputs: the edge probability map of BenchEbsModel() and the first
+  // attention point of `rso_map` (default extraction; the image centre if
+  // there is none), where the contour case segments.
+  cv::Mat edge_probability;  // CV_32FC1, [0, 1]
+  cv::Point fixation;
 };
 
 using SceneList = std::vector<std::unique_ptr<BenchScene>>;
@@ -55,9 +61,13 @@ inline FrameLimits BenchFrameLimits() { return FrameLimits{}; }
 // Fills the wire forms of `scene` from `scene.frame` (depth rounded to
 // whole millimetres), decodes the raw form back into `scene.frame` (so all
 // cases see exactly what the wire carries) and runs the stages up to the
-// RSO map. FAILED_PRECONDITION naming the scene and the stage when one
-// fails (e.g. no support plane).
+// RSO map and the EBS edge probability map. FAILED_PRECONDITION naming the
+// scene and the stage when one fails (e.g. no support plane).
 absl::Status PrepareScene(const RgbdFrame& frame, BenchScene& scene);
+
+// The EBS model of the EBS cases, trained once (on first use) on synthetic
+// scenes other than the timed ones.
+const absl::StatusOr<EbsModel>& BenchEbsModel();
 
 // Synthetic scenes from core/synth, one per seed. Scenes whose preparation
 // fails are left out with a line on stderr.

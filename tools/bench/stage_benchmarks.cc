@@ -17,6 +17,7 @@
 #include "core/saliency/rso.h"
 #include "core/saliency/sh.h"
 #include "core/saliency/sym3d.h"
+#include "core/segmentation/ebs.h"
 #include "core/segmentation/planar_patches.h"
 
 namespace fovea::bench {
@@ -35,6 +36,8 @@ constexpr double kMsrMs = 2.0;
 constexpr double kSurfaceEdgesMs = 3.0;
 constexpr double kPlanarPatchesMs = 15.0;
 constexpr double kSym3dLevel0Ms = 40.0;
+constexpr double kEbsEdgeProbabilityMs = 12.0;
+constexpr double kEbsContourMs = 4.0;
 constexpr double kDetectMs = 30.0;
 
 using SceneBody = std::function<absl::Status(const BenchScene&)>;
@@ -162,6 +165,24 @@ void RegisterSaliencyCases(const SceneList* scenes, const std::string& set,
              cv::Mat edges = FindSurfaceEdges(scene.cloud, options);
              benchmark::DoNotOptimize(edges);
              return absl::OkStatus();
+           });
+  // EBS (thesis section 3.2.3): the three edge maps and their naive-Bayes
+  // fusion on the whole frame, then one fixation's polar contour.
+  Register("BM_EbsEdgeProbability" + suffix, scenes, set, sweep,
+           kEbsEdgeProbabilityMs, [](const BenchScene& scene) {
+             const absl::StatusOr<EbsModel>& model = BenchEbsModel();
+             if (!model.ok()) return model.status();
+             cv::Mat p = model->EdgeProbability(
+                 ComputeEdgeMaps(scene.cloud, model->edge_map_options()));
+             benchmark::DoNotOptimize(p.data);
+             return absl::OkStatus();
+           });
+  Register("BM_EbsContour" + suffix, scenes, set, sweep, kEbsContourMs,
+           [](const BenchScene& scene) {
+             absl::StatusOr<cv::Mat> mask = SegmentAtFixation(
+                 scene.edge_probability, scene.fixation, PolarContourOptions{});
+             benchmark::DoNotOptimize(mask);
+             return mask.status();
            });
   Register("BM_SaliencyRso" + suffix, scenes, set, sweep, kSaliencyMs,
            [options = defaults.rso](const BenchScene& scene) {
