@@ -95,6 +95,7 @@ v1::Capabilities BuildCapabilities(
     out.add_extractions(ToProtoEnum(kind));
   }
   out.add_segmentation_methods(v1::COS);
+  out.add_segmentation_methods(v1::EBS);
   for (const auto& [name, version] : model_versions) {
     v1::ModelVersion* model = out.add_models();
     model->set_name(name);

@@ -43,6 +43,7 @@ absl::StatusOr<std::string> ReadModelFile(const std::filesystem::path& path,
 SegmentModels LoadedModels::View() const {
   SegmentModels models;
   models.cos = cos ? &*cos : nullptr;
+  models.ebs = ebs ? &*ebs : nullptr;
   return models;
 }
 
@@ -72,6 +73,20 @@ absl::StatusOr<LoadedModels> LoadModels(const std::string& dir) {
   }
   models.versions.emplace_back("cos_svm", cos->Version());
   models.cos = *std::move(cos);
+
+  const std::filesystem::path ebs_path =
+      std::filesystem::path(dir) / kEbsModelFile;
+  absl::StatusOr<std::string> ebs_text = ReadModelFile(
+      ebs_path, "fovea-train ebs --data DIR --out models/ebs_edges.txt");
+  if (!ebs_text.ok()) return ebs_text.status();
+  absl::StatusOr<EbsModel> ebs = EbsModel::Parse(*ebs_text);
+  if (!ebs.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("model file ", ebs_path.string(),
+                     " is not an EBS model: ", ebs.status().message()));
+  }
+  models.versions.emplace_back("ebs_edges", ebs->Version());
+  models.ebs = *std::move(ebs);
   return models;
 }
 

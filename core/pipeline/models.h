@@ -8,6 +8,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/pipeline/segment.h"
+#include "core/segmentation/ebs.h"
 #include "core/segmentation/linear_svm.h"
 
 namespace fovea {
@@ -15,9 +16,11 @@ namespace fovea {
 // The trained models of a models folder (models/ in the repository; see
 // its README for how each was made).
 inline constexpr char kCosModelFile[] = "cos_svm.txt";
+inline constexpr char kEbsModelFile[] = "ebs_edges.txt";
 
 struct LoadedModels {
   std::optional<LinearSvm> cos;
+  std::optional<EbsModel> ebs;
   // (name, version) of each model, as GetCapabilities reports them.
   std::vector<std::pair<std::string, std::string>> versions;
 
@@ -27,8 +30,7 @@ struct LoadedModels {
 
 // Reads every model of `dir`. Errors name the file and what is wrong, and
 // say how to make it: NOT_FOUND for a missing folder or file,
-// INVALID_ARGUMENT for a file that does not parse (LinearSvm::Parse's
-// message).
+// INVALID_ARGUMENT for a file that does not parse (the parser's message).
 absl::StatusOr<LoadedModels> LoadModels(const std::string& dir);
 
 }  // namespace fovea

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <memory>
 #include <new>
 #include <opencv2/imgproc.hpp>
 #include <optional>
@@ -55,6 +56,124 @@ cv::Mat ObjectRegion(const TableScene& table, float min_height) {
   return region;
 }
 
+// One object per seed, by one method; remembers what earlier seeds took.
+struct CutObject {
+  cv::Mat mask;  // CV_8UC1, 255 on the object
+  double score = 0.0;
+};
+class ObjectCutter {
+ public:
+  virtual ~ObjectCutter() = default;
+  // nullopt: the seed yields no object.
+  virtual absl::StatusOr<std::optional<CutObject>> Cut(
+      cv::Point seed, const InterruptCheck& interrupt) = 0;
+};
+
+class CosCutter final : public ObjectCutter {
+ public:
+  static absl::StatusOr<std::unique_ptr<ObjectCutter>> Create(
+      const PreparedScene& scene, const LinearSvm& svm,
+      const CosOptions& options) {
+    absl::StatusOr<CosScene> cos =
+        BuildCosScene(scene.cloud, scene.plane, options);
+    if (!cos.ok()) return cos.status();
+    return std::unique_ptr<ObjectCutter>(
+        new CosCutter(*std::move(cos), svm, options));
+  }
+
+  absl::StatusOr<std::optional<CutObject>> Cut(
+      cv::Point seed, const InterruptCheck& interrupt) override {
+    absl::StatusOr<std::optional<CosObject>> object =
+        segmenter_.Segment(seed, interrupt);
+    if (!object.ok()) return object.status();
+    if (!object->has_value()) return std::nullopt;
+    return CutObject{std::move((*object)->mask), (*object)->score};
+  }
+
+ private:
+  CosCutter(CosScene scene, const LinearSvm& svm, const CosOptions& options)
+      : scene_(std::move(scene)), segmenter_(scene_, svm, options) {}
+
+  const CosScene scene_;  // before segmenter_, which refers to it
+  CosSegmenter segmenter_;
+};
+
+// Two masks overlapping by more than this intersection over union are one
+// object found twice.
+constexpr double kSameObjectIou = 0.5;
+
+// Edge probability once per frame; a contour per seed.
+class EbsCutter final : public ObjectCutter {
+ public:
+  EbsCutter(const PreparedScene& scene, const EbsModel& model,
+            const PolarContourOptions& options)
+      : probability_(model.EdgeProbability(scene.cloud)), options_(options) {
+    // Pixels an object may cover: with depth, off the support plane.
+    allowed_ = scene.cloud.xyz.size() == probability_.size()
+                   ? cv::Mat(probability_.size(), CV_8UC1, cv::Scalar(0))
+                   : cv::Mat();
+    for (int v = 0; v < allowed_.rows; ++v) {
+      const cv::Vec3f* xyz = scene.cloud.xyz.ptr<cv::Vec3f>(v);
+      unsigned char* out = allowed_.ptr<unsigned char>(v);
+      for (int u = 0; u < allowed_.cols; ++u) {
+        const bool on_plane = !scene.plane.inliers.empty() &&
+                              scene.plane.inliers.at<unsigned char>(v, u) != 0;
+        out[u] = !std::isnan(xyz[u][2]) && !on_plane ? 255 : 0;
+      }
+    }
+  }
+
+  absl::StatusOr<std::optional<CutObject>> Cut(
+      cv::Point seed, const InterruptCheck& interrupt) override {
+    if (allowed_.at<unsigned char>(seed) == 0) return std::nullopt;
+    absl::StatusOr<PolarContour> contour =
+        FindPolarContour(probability_, seed, options_, interrupt);
+    if (!contour.ok()) return contour.status();
+    CutObject object;
+    object.mask = FillPolarContour(*contour, probability_.size()) & allowed_;
+    const int area = cv::countNonZero(object.mask);
+    if (area == 0) return std::nullopt;
+    for (const cv::Mat& earlier : masks_) {
+      const int both = cv::countNonZero(earlier & object.mask);
+      const int either = area + cv::countNonZero(earlier) - both;
+      if (both > kSameObjectIou * either) return std::nullopt;
+    }
+    masks_.push_back(object.mask);
+    object.score = MeanAlongContour(*contour);
+    return object;
+  }
+
+ private:
+  // The edge probability under the contour, [0, 1]: how clearly edges
+  // bound the object.
+  double MeanAlongContour(const PolarContour& contour) const {
+    double sum = 0.0;
+    int n = 0;
+    const size_t angles = contour.radii.size();
+    for (size_t i = 0; i < angles; ++i) {
+      const double a = 2.0 * M_PI * i / angles;
+      const cv::Point p(static_cast<int>(std::lround(
+                            contour.seed.x + contour.radii[i] * std::cos(a))),
+                        static_cast<int>(std::lround(
+                            contour.seed.y + contour.radii[i] * std::sin(a))));
+      if (p.x < 0 || p.y < 0 || p.x >= probability_.cols ||
+          p.y >= probability_.rows) {
+        continue;
+      }
+      const float q = probability_.at<float>(p);
+      if (std::isnan(q)) continue;
+      sum += q;
+      ++n;
+    }
+    return n > 0 ? sum / n : 0.0;
+  }
+
+  const cv::Mat probability_;
+  const PolarContourOptions options_;
+  cv::Mat allowed_;
+  std::vector<cv::Mat> masks_;  // of the objects cut so far
+};
+
 absl::StatusOr<std::vector<AttentionPoint>> TakeSeeds(
     const PreparedScene& scene, const SegmentOptions& options,
     const InterruptCheck& interrupt, std::vector<StageTiming>& timings) {
@@ -89,11 +208,11 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
                        frame.width(), "x", frame.height(), " frame"));
     }
   }
-  if (options.method == SegmentMethod::kEbs) {
-    return absl::UnimplementedError("segment: EBS is not built yet");
-  }
-  if (models.cos == nullptr) {
+  if (options.method == SegmentMethod::kCos && models.cos == nullptr) {
     return absl::FailedPreconditionError("segment: no COS model is loaded");
+  }
+  if (options.method == SegmentMethod::kEbs && models.ebs == nullptr) {
+    return absl::FailedPreconditionError("segment: no EBS model is loaded");
   }
   SegmentSummary summary;
   absl::StatusOr<PreparedScene> scene =
@@ -110,10 +229,16 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
   if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
 
   SteadyClock::time_point lap = SteadyClock::now();
-  absl::StatusOr<CosScene> cos =
-      BuildCosScene(scene->cloud, scene->plane, options.cos);
-  if (!cos.ok()) return cos.status();
-  CosSegmenter segmenter(*cos, *models.cos, options.cos);
+  std::unique_ptr<ObjectCutter> cutter;
+  if (options.method == SegmentMethod::kCos) {
+    absl::StatusOr<std::unique_ptr<ObjectCutter>> cos =
+        CosCutter::Create(*scene, *models.cos, options.cos);
+    if (!cos.ok()) return cos.status();
+    cutter = *std::move(cos);
+  } else {
+    cutter =
+        std::make_unique<EbsCutter>(*scene, *models.ebs, options.ebs_contour);
+  }
   summary.timings.push_back({"segment.prepare", SecondsSince(lap)});
 
   const cv::Mat region =
@@ -126,8 +251,8 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
     }
     if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
     lap = SteadyClock::now();
-    absl::StatusOr<std::optional<CosObject>> cut =
-        segmenter.Segment({seed.u, seed.v}, interrupt);
+    absl::StatusOr<std::optional<CutObject>> cut =
+        cutter->Cut({seed.u, seed.v}, interrupt);
     if (!cut.ok()) return cut.status();
     summary.timings.push_back({"segment.object", SecondsSince(lap)});
     if (!cut->has_value()) continue;
@@ -172,6 +297,10 @@ absl::Status Validate(const SegmentOptions& options) {
   }
   if (absl::Status s = Validate(options.cos); !s.ok()) {
     return absl::InvalidArgumentError(absl::StrCat("cos.", s.message()));
+  }
+  if (absl::Status s = Validate(options.ebs_contour); !s.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("ebs_contour.", s.message()));
   }
   if (options.max_objects < 0) {
     return absl::InvalidArgumentError(absl::StrCat(

@@ -15,6 +15,7 @@
 #include "core/frame/rgbd_frame.h"
 #include "core/pipeline/detect.h"
 #include "core/segmentation/cos.h"
+#include "core/segmentation/ebs.h"
 #include "core/segmentation/linear_svm.h"
 
 namespace fovea {
@@ -38,6 +39,8 @@ struct SegmentOptions {
   // Objects to cut out at most; 0 = one per seed.
   int max_objects = 0;
   CosOptions cos;
+  // EBS's contour search at each seed.
+  PolarContourOptions ebs_contour;
 };
 
 // INVALID_ARGUMENT naming the field: detect.*, cos.*, a negative
@@ -48,6 +51,7 @@ absl::Status Validate(const SegmentOptions& options);
 // method does not need them.
 struct SegmentModels {
   const LinearSvm* cos = nullptr;
+  const EbsModel* ebs = nullptr;
 };
 
 struct SegmentedObject {
@@ -93,11 +97,17 @@ struct SegmentSinks {
 // Prepares the scene, takes the seeds, and for each seed in order cuts out
 // its object and hands it to `sinks.object` at once. A seed whose object
 // was already cut out, or that lies on the table or on nothing, yields no
-// object (COS: see CosSegmenter). `interrupt` is checked between stages,
+// object. COS: see CosSegmenter (objects are disjoint patch sets). EBS:
+// the inside of the minimum-cost contour around the seed on the model's
+// edge probability map, less the pixels without depth or on the support
+// plane; a contour is independent of earlier ones (a seed on a box that an
+// earlier, too large contour also covered still gets its own mask), and a
+// mask overlapping an earlier one by more than half (IoU) is that object
+// found again and yields none. `interrupt` is checked between stages,
 // between objects and inside the methods' loops; its status is returned as
 // is. Errors: Validate's; FAILED_PRECONDITION when the method's model is
-// null; NOT_FOUND without a support plane; UNIMPLEMENTED for EBS until it
-// is built; RESOURCE_EXHAUSTED / INTERNAL for what throws underneath.
+// null; NOT_FOUND without a support plane; RESOURCE_EXHAUSTED / INTERNAL
+// for what throws underneath.
 absl::StatusOr<SegmentSummary> RunSegment(
     const RgbdFrame& frame, const SegmentOptions& options,
     const SegmentModels& models, const SegmentSinks& sinks,

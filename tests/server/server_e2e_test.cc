@@ -455,10 +455,13 @@ TEST_F(ServerTest, CapabilitiesReportWhatCoreImplements) {
   EXPECT_EQ(capabilities.max_message_bytes(),
             static_cast<uint64_t>(kDefaultMaxMessageBytes));
   EXPECT_THAT(capabilities.segmentation_methods(),
-              ::testing::ElementsAre(v1::COS));
-  ASSERT_EQ(capabilities.models_size(), 1);
+              ::testing::ElementsAre(v1::COS, v1::EBS));
+  ASSERT_EQ(capabilities.models_size(), 2);
   EXPECT_EQ(capabilities.models(0).name(), "cos_svm");
   EXPECT_THAT(capabilities.models(0).version(), ::testing::StartsWith("cos-"));
+  EXPECT_EQ(capabilities.models(1).name(), "ebs_edges");
+  EXPECT_THAT(capabilities.models(1).version(),
+              ::testing::StartsWith("ebs-v1-"));
   EXPECT_FALSE(capabilities.segment_incremental());
   EXPECT_EQ(capabilities.default_detect_options().max_points(), 10u);
 }

@@ -108,9 +108,11 @@ absl::StatusOr<SegmentEvalSummary> EvaluateSegment(
     std::filesystem::create_directories(options.out_dir);
   }
 
-  // Training examples of every scene, once; each fold trains on the others'.
+  // COS: training examples of every scene, once; each fold trains on the
+  // others'.
   std::vector<std::vector<SvmSample>> samples(scenes.size());
-  for (size_t i = 0; i < scenes.size(); ++i) {
+  for (size_t i = 0; segment.method == SegmentMethod::kCos && i < scenes.size();
+       ++i) {
     absl::StatusOr<std::vector<SvmSample>> s = CollectCosSamples(
         scenes[i], static_cast<int>(i), segment.detect, segment.cos);
     if (!s.ok()) {
@@ -125,15 +127,28 @@ absl::StatusOr<SegmentEvalSummary> EvaluateSegment(
   std::vector<double> cv_accuracy;
   for (int fold = 0; fold < options.folds; ++fold) {
     std::vector<SvmSample> train;
+    std::vector<const LabelledFrame*> train_frames;
     for (size_t i = 0; i < scenes.size(); ++i) {
       if (static_cast<int>(i) % options.folds == fold) continue;
       train.insert(train.end(), samples[i].begin(), samples[i].end());
+      train_frames.push_back(&scenes[i]);
     }
-    absl::StatusOr<LinearSvm> cos =
-        TrainLinearSvm(train, CosFeatureNames(), "cos", options.svm);
-    if (!cos.ok()) return cos.status();
+    std::optional<LinearSvm> cos;
+    std::optional<EbsModel> ebs;
     SegmentModels models;
-    models.cos = &*cos;
+    if (segment.method == SegmentMethod::kCos) {
+      absl::StatusOr<LinearSvm> trained =
+          TrainLinearSvm(train, CosFeatureNames(), "cos", options.svm);
+      if (!trained.ok()) return trained.status();
+      cos = *std::move(trained);
+      models.cos = &*cos;
+    } else {
+      absl::StatusOr<EbsModel> trained =
+          EbsModel::Train(train_frames, EbsTrainOptions{});
+      if (!trained.ok()) return trained.status();
+      ebs = *std::move(trained);
+      models.ebs = &*ebs;
+    }
     for (size_t i = fold; i < scenes.size(); i += options.folds) {
       const LabelledFrame& scene = scenes[i];
       std::vector<SeededMask> masks;

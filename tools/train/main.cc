@@ -1,6 +1,7 @@
 // fovea-train: the trained models of segmentation, from labelled scenes.
 //
 //   fovea-train cos --data DIR --out models/cos_svm.txt [--folds 5] [--c 1]
+//   fovea-train ebs --data DIR --out models/ebs_edges.txt [--folds 5]
 //
 // Prints the k-fold cross-validated accuracy (folds by scene) and writes
 // the model trained on every scene, with that accuracy in its provenance.
@@ -17,6 +18,7 @@
 #include "absl/strings/str_format.h"
 #include "core/pipeline/segment.h"
 #include "core/segmentation/cos.h"
+#include "core/segmentation/ebs.h"
 #include "core/segmentation/linear_svm.h"
 #include "tools/eval/detect_eval.h"
 
@@ -153,13 +155,86 @@ int TrainCos() {
   return 0;
 }
 
+int TrainEbs() {
+  const std::string data = DataDir();
+  const std::string out = absl::GetFlag(FLAGS_out);
+  if (data.empty() || out.empty()) {
+    std::fprintf(stderr,
+                 "fovea-train ebs: --data (or FOVEA_OSD_DIR) and --out are "
+                 "required\n");
+    return kUsageError;
+  }
+  absl::StatusOr<std::vector<LabelledFrame>> scenes = eval::LoadScenes(data);
+  if (!scenes.ok()) {
+    std::fprintf(stderr, "fovea-train: %s\n",
+                 scenes.status().ToString().c_str());
+    return kRunError;
+  }
+  const int folds = absl::GetFlag(FLAGS_folds);
+  if (folds < 2) {
+    std::fprintf(stderr, "fovea-train: --folds must be at least 2\n");
+    return kUsageError;
+  }
+  const EbsTrainOptions options;
+  // Cross-validation by scene: train on the other folds, classify the
+  // fold's pixels (edge or not, at p = 0.5).
+  int64_t correct = 0;
+  int64_t total = 0;
+  double balanced = 0.0;
+  for (int fold = 0; fold < folds; ++fold) {
+    std::vector<const LabelledFrame*> train;
+    std::vector<const LabelledFrame*> test;
+    for (size_t i = 0; i < scenes->size(); ++i) {
+      (static_cast<int>(i) % folds == fold ? test : train)
+          .push_back(&(*scenes)[i]);
+    }
+    absl::StatusOr<EbsModel> model = EbsModel::Train(train, options);
+    if (!model.ok()) {
+      std::fprintf(stderr, "fovea-train: %s\n",
+                   model.status().ToString().c_str());
+      return kRunError;
+    }
+    absl::StatusOr<EbsEvaluation> evaluation = model->Evaluate(test);
+    if (!evaluation.ok()) {
+      std::fprintf(stderr, "fovea-train: %s\n",
+                   evaluation.status().ToString().c_str());
+      return kRunError;
+    }
+    const EdgeCounts& fused = evaluation->fused;
+    correct += fused.true_edge + fused.true_no_edge;
+    total += fused.true_edge + fused.missed_edge + fused.true_no_edge +
+             fused.false_edge;
+    balanced += fused.BalancedAccuracy() / folds;
+  }
+  const double accuracy = total > 0 ? static_cast<double>(correct) / total : 0;
+  std::printf(
+      "ebs: %d-fold cross-validated edge accuracy %.3f, balanced %.3f\n", folds,
+      accuracy, balanced);
+  std::vector<const LabelledFrame*> all;
+  for (const LabelledFrame& scene : *scenes) all.push_back(&scene);
+  absl::StatusOr<EbsModel> model = EbsModel::Train(all, options);
+  if (!model.ok()) {
+    std::fprintf(stderr, "fovea-train: %s\n",
+                 model.status().ToString().c_str());
+    return kRunError;
+  }
+  if (!WriteFile(out, model->Serialize())) {
+    std::fprintf(stderr, "fovea-train: cannot write %s\n", out.c_str());
+    return kRunError;
+  }
+  std::printf("wrote %s (%s), trained on %zu scenes\n", out.c_str(),
+              model->Version().c_str(), scenes->size());
+  return 0;
+}
+
 }  // namespace
 }  // namespace fovea
 
 int main(int argc, char** argv) {
   absl::SetProgramUsageMessage(
       "Trains segmentation models on labelled OSD scenes.\n"
-      "  fovea-train cos --data DIR --out FILE [--folds 5] [--c 1]");
+      "  fovea-train cos --data DIR --out FILE [--folds 5] [--c 1]\n"
+      "  fovea-train ebs --data DIR --out FILE [--folds 5]");
   std::vector<char*> args = absl::ParseCommandLine(argc, argv);
   if (args.size() < 2) {
     std::fprintf(stderr, "%s\n",
@@ -168,6 +243,7 @@ int main(int argc, char** argv) {
   }
   const std::string command = args[1];
   if (command == "cos") return fovea::TrainCos();
+  if (command == "ebs") return fovea::TrainEbs();
   std::fprintf(stderr, "fovea-train: unknown command '%s'\n%s\n",
                command.c_str(),
                std::string(absl::ProgramUsageMessage()).c_str());

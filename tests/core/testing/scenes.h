@@ -58,15 +58,17 @@ inline synth::SynthScene BoxOnTable(const Eigen::Vector3f& half_extents,
 // would merge coplanar faces: they see geometry only).
 // Camera as in BoxOnTable; no noise. The blue top lies below the red top, so
 // the two together are not convex.
-inline synth::SynthScene TwoBoxesOnTable() {
+// With `gap` > 0 the blue box stands that many metres further right.
+inline synth::SynthScene TwoBoxesOnTable(float gap = 0.0f) {
   synth::SceneSpec spec;
   spec.camera_pose = synth::LookAt({0.0f, -0.75f, 0.75f}, {0.0f, 0.0f, 0.0f});
   for (const float side : {-1.0f, 1.0f}) {
     synth::Primitive box;
     box.shape = synth::Shape::kBox;
     box.half_extents = {0.04f, 0.04f, side < 0.0f ? 0.05f : 0.03f};
-    box.pose.translation() = Eigen::Vector3f(
-        side * 0.04f, side < 0.0f ? 0.0f : 0.02f, box.half_extents.z());
+    box.pose.translation() =
+        Eigen::Vector3f(side * 0.04f + (side < 0.0f ? 0.0f : gap),
+                        side < 0.0f ? 0.0f : 0.02f, box.half_extents.z());
     box.rgb = side < 0.0f ? Eigen::Vector3f(0.9f, 0.2f, 0.1f)
                           : Eigen::Vector3f(0.1f, 0.3f, 0.9f);
     spec.objects.push_back(box);
