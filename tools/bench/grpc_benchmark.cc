@@ -115,6 +115,43 @@ void BenchmarkGrpcDetect(benchmark::State& state, const SceneList& scenes,
   });
 }
 
+// One Segment call per scene with the server's default options and
+// `method`; max_objects 1 ends the stream after the first object (the time
+// to the first mask), 0 cuts them all.
+void BenchmarkGrpcSegment(benchmark::State& state, const SceneList& scenes,
+                          const std::string& set_name,
+                          v1::SegmentationMethod method, int max_objects) {
+  absl::StatusOr<Loopback*> loopback = StartLoopback();
+  if (!loopback.ok()) {
+    state.SkipWithError(loopback.status().ToString().c_str());
+    return;
+  }
+  std::unordered_map<const BenchScene*, v1::SegmentRequest> requests;
+  for (const auto& scene : scenes) {
+    v1::SegmentRequest request;
+    request.set_request_id(scene->name);
+    *request.mutable_frame() = server::ToProtoFrame(
+        scene->frame, server::DepthEncoding::k16UC1, kWireDepthScale);
+    request.set_method(method);
+    request.set_max_objects(static_cast<uint32_t>(max_objects));
+    requests.emplace(scene.get(), std::move(request));
+  }
+  SweepScenes(state, scenes, set_name, [&](const BenchScene& scene) {
+    grpc::ClientContext context;
+    auto reader = (*loopback)->stub->Segment(&context, requests.at(&scene));
+    v1::SegmentResponse response;
+    int messages = 0;
+    while (reader->Read(&response)) ++messages;
+    const grpc::Status status = reader->Finish();
+    if (!status.ok()) {
+      return absl::Status(static_cast<absl::StatusCode>(status.error_code()),
+                          status.error_message());
+    }
+    benchmark::DoNotOptimize(messages);
+    return absl::OkStatus();
+  });
+}
+
 }  // namespace
 
 void RegisterGrpcBenchmarks(const SceneList* scenes,
@@ -137,6 +174,23 @@ void RegisterGrpcBenchmarks(const SceneList* scenes,
         ->Iterations(SweepIterations(sweep, static_cast<int>(scenes->size()),
                                      kGrpcDetectMs))
         ->Unit(benchmark::kMillisecond);
+  }
+  for (const auto& [name, method] :
+       {std::pair<const char*, v1::SegmentationMethod>{"cos", v1::COS},
+        {"ebs", v1::EBS}}) {
+    for (const int max_objects : {1, 0}) {
+      benchmark::RegisterBenchmark(
+          absl::StrCat("BM_SegmentGrpc/", name,
+                       max_objects == 1 ? "/first" : "/all", suffix)
+              .c_str(),
+          [scenes, set_name, method = method,
+           max_objects](benchmark::State& state) {
+            BenchmarkGrpcSegment(state, *scenes, set_name, method, max_objects);
+          })
+          ->Iterations(SweepIterations(sweep, static_cast<int>(scenes->size()),
+                                       2 * kGrpcDetectMs))
+          ->Unit(benchmark::kMillisecond);
+    }
   }
 }
 

@@ -13,6 +13,8 @@
 #include "core/frame/surface_edges.h"
 #include "core/frame/table_scene.h"
 #include "core/pipeline/detect.h"
+#include "core/pipeline/models.h"
+#include "core/pipeline/segment.h"
 #include "core/saliency/ph.h"
 #include "core/saliency/rso.h"
 #include "core/saliency/sh.h"
@@ -39,6 +41,7 @@ constexpr double kSym3dLevel0Ms = 40.0;
 constexpr double kEbsEdgeProbabilityMs = 12.0;
 constexpr double kEbsContourMs = 4.0;
 constexpr double kDetectMs = 30.0;
+constexpr double kSegmentMs = 60.0;
 
 using SceneBody = std::function<absl::Status(const BenchScene&)>;
 
@@ -207,6 +210,41 @@ void RegisterSaliencyCases(const SceneList* scenes, const std::string& set,
   }
 }
 
+// The models of the source tree's models/ (the server's default), loaded
+// once.
+const absl::StatusOr<LoadedModels>& BenchModels() {
+  static const auto* models =
+      new absl::StatusOr<LoadedModels>(LoadModels(FOVEA_BENCH_MODELS_DIR));
+  return *models;
+}
+
+// Segment in-process with the default options: "first" stops after the
+// first object (the time a robot waits for it), "all" cuts one object per
+// attention point.
+void RegisterSegmentCases(const SceneList* scenes, const std::string& set,
+                          const std::string& suffix,
+                          const SweepOptions& sweep) {
+  for (const SegmentMethod method :
+       {SegmentMethod::kCos, SegmentMethod::kEbs}) {
+    for (const bool first : {true, false}) {
+      SegmentOptions options;
+      options.method = method;
+      options.max_objects = first ? 1 : 0;
+      Register(absl::StrCat("BM_Segment/", AbslView(SegmentMethodName(method)),
+                            first ? "/first" : "/all", suffix),
+               scenes, set, sweep, kSegmentMs,
+               [options](const BenchScene& scene) {
+                 const absl::StatusOr<LoadedModels>& models = BenchModels();
+                 if (!models.ok()) return models.status();
+                 absl::StatusOr<SegmentSummary> summary = RunSegment(
+                     scene.frame, options, models->View(), SegmentSinks{});
+                 benchmark::DoNotOptimize(summary);
+                 return summary.status();
+               });
+    }
+  }
+}
+
 void RegisterDetectCases(const SceneList* scenes, const std::string& set,
                          const std::string& suffix, const SweepOptions& sweep) {
   // What a request without options gets.
@@ -325,6 +363,7 @@ void RegisterStageBenchmarks(const SceneList* scenes,
   RegisterFrameCases(scenes, set_name, suffix, sweep);
   RegisterSaliencyCases(scenes, set_name, suffix, sweep);
   RegisterDetectCases(scenes, set_name, suffix, sweep);
+  RegisterSegmentCases(scenes, set_name, suffix, sweep);
   RegisterAttentionCases(scenes, set_name, suffix, sweep);
 }
 
