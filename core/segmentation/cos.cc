@@ -119,6 +119,41 @@ std::vector<int> PatchObjects(const CosScene& scene, const cv::Mat& labels) {
   return result;
 }
 
+// Gives the pixels with depth but no patch (no normal: along occluding
+// edges and object rims, where normals cannot be estimated) the patch of a
+// 4-neighbour with nearly the same depth, one ring per pass, `passes`
+// times; the ground truth counts those pixels as the object's.
+void ExtendIntoUnlabelled(const OrganizedCloud& cloud, int passes,
+                          float max_depth_step_fraction, cv::Mat& labels) {
+  for (int pass = 0; pass < passes; ++pass) {
+    cv::Mat next = labels.clone();
+    int changed = 0;
+    for (int v = 0; v < labels.rows; ++v) {
+      for (int u = 0; u < labels.cols; ++u) {
+        if (labels.at<int>(v, u) >= 0) continue;
+        const float z = cloud.xyz.at<cv::Vec3f>(v, u)[2];
+        if (std::isnan(z)) continue;
+        constexpr int kDu[4] = {1, -1, 0, 0};
+        constexpr int kDv[4] = {0, 0, 1, -1};
+        for (int k = 0; k < 4; ++k) {
+          const int x = u + kDu[k];
+          const int y = v + kDv[k];
+          if (x < 0 || y < 0 || x >= labels.cols || y >= labels.rows) continue;
+          const int l = labels.at<int>(y, x);
+          const float zn = cloud.xyz.at<cv::Vec3f>(y, x)[2];
+          if (l >= 0 && std::abs(zn - z) <= max_depth_step_fraction * z) {
+            next.at<int>(v, u) = l;
+            ++changed;
+            break;
+          }
+        }
+      }
+    }
+    labels = next;
+    if (changed == 0) break;
+  }
+}
+
 }  // namespace
 
 absl::Status Validate(const CosOptions& options) {
@@ -135,6 +170,10 @@ absl::Status Validate(const CosOptions& options) {
     return absl::InvalidArgumentError(absl::StrCat(
         "max_hull_points must be at least hull_points_per_patch, got ",
         options.max_hull_points));
+  }
+  if (options.rim_passes < 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "rim_passes must not be negative, got ", options.rim_passes));
   }
   if (options.max_object_patches < 1) {
     return absl::InvalidArgumentError(
@@ -176,6 +215,10 @@ absl::StatusOr<CosScene> BuildCosScene(const OrganizedCloud& cloud,
       LabelColorHistograms(cloud.color, scene.patches.labels, n, options.color);
   scene.samples = SampleLabelPoints(cloud, scene.patches.labels, n,
                                     options.hull_points_per_patch);
+  // After the features: the extended pixels have no trustworthy normal.
+  ExtendIntoUnlabelled(cloud, options.rim_passes,
+                       options.patches.max_depth_step_fraction,
+                       scene.patches.labels);
   // Each sample onto its patch's plane: the sensor's noise (1-2 mm at a
   // metre) would otherwise push the hull's faces out by its peaks, as far
   // as the concavities compactness is to measure.

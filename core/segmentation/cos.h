@@ -46,6 +46,12 @@ struct CosOptions {
   // Removing the support surface first is how the thesis's table-top
   // pipeline starts; the SVM then decides between objects.
   float max_support_fraction = 0.5f;
+  // Pixels with depth but no normal (object rims, occluding edges) join a
+  // 4-neighbouring patch at nearly the same depth, one pixel ring per pass,
+  // this many passes: 8 is NormalOptions::max_half_window, the farthest a
+  // pixel can be from the edge that left it without a normal. 0 leaves
+  // them out of every mask (learn scenes: F(all) 0.79 instead of 0.89).
+  int rim_passes = 8;
   PatchColorOptions color;
   PlanarPatchOptions patches;
 };

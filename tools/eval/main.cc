@@ -86,6 +86,11 @@ ABSL_FLAG(double, svm_c, fovea::LinearSvmTrainingOptions().c,
           "segment: the COS SVM's soft-margin penalty C.");
 ABSL_FLAG(double, cos_min_decision, fovea::CosOptions().min_decision,
           "segment: COS joins a patch when the SVM's decision exceeds this.");
+ABSL_FLAG(double, patch_angle, fovea::CosOptions().patches.max_normal_angle_deg,
+          "segment: COS planar patches' largest normal angle, degrees.");
+ABSL_FLAG(double, patch_distance,
+          fovea::CosOptions().patches.max_plane_distance,
+          "segment: COS planar patches' plane distance at 0 m, metres.");
 ABSL_FLAG(std::string, filter, "",
           "sweep: only the rows whose label saliency/pyramid/combine/norm/"
           "extract contains this.");
@@ -277,6 +282,10 @@ int RunSegmentEval() {
   options.folds = absl::GetFlag(FLAGS_folds);
   options.svm.c = absl::GetFlag(FLAGS_svm_c);
   options.segment.cos.min_decision = absl::GetFlag(FLAGS_cos_min_decision);
+  options.segment.cos.patches.max_normal_angle_deg =
+      static_cast<float>(absl::GetFlag(FLAGS_patch_angle));
+  options.segment.cos.patches.max_plane_distance =
+      static_cast<float>(absl::GetFlag(FLAGS_patch_distance));
   options.out_dir = absl::GetFlag(FLAGS_out);
   options.verbose = absl::GetFlag(FLAGS_verbose);
   absl::StatusOr<std::vector<LabelledFrame>> scenes = LoadScenes(data);
