@@ -411,6 +411,57 @@ TEST_F(ServerTest,
   EXPECT_THAT(status.error_message(), HasSubstr("not built yet"));
 }
 
+TEST_F(ServerTest, SegmentDeadlineMidStreamKeepsWhatWasSentAndEndsDeadline) {
+  StartServer();
+  v1::SegmentRequest request;
+  *request.mutable_frame() = MakeSyntheticRequest(3, false).request.frame();
+  request.add_seeds()->set_u(320);
+  request.mutable_seeds(0)->set_v(240);
+  // Stage boundaries with given seeds: 1 after decoding, 2 after normals,
+  // 3 after the support plane; the seeds message is sent; 4 is the check
+  // after it. Hold there until the deadline has passed.
+  constexpr int kAfterSeedsMessage = 4;
+  stage_gate_.CloseAtPass(kAfterSeedsMessage);
+  const auto deadline =
+      std::chrono::system_clock::now() + std::chrono::seconds(2);
+  std::future<SegmentCall> call = std::async(std::launch::async, [&] {
+    grpc::ClientContext context;
+    context.set_deadline(deadline);
+    auto reader = stub_->Segment(&context, request);
+    SegmentCall result;
+    v1::SegmentResponse response;
+    while (reader->Read(&response)) result.messages.push_back(response);
+    result.status = reader->Finish();
+    return result;
+  });
+  ASSERT_TRUE(
+      WaitFor([this] { return stage_gate_.entered() == kAfterSeedsMessage; },
+              kCallTimeout));
+  const SegmentCall ended = call.get();  // returns once the deadline passed
+  // The server's copy of the deadline is re-based on the request's arrival,
+  // a loopback transit later than the client's: release the worker only
+  // once that has surely passed too.
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        return std::chrono::system_clock::now() >
+               deadline + std::chrono::milliseconds(200);
+      },
+      kCallTimeout));
+  stage_gate_.Open();
+  EXPECT_EQ(ended.status.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED);
+  ASSERT_EQ(ended.messages.size(), 1u);
+  EXPECT_EQ(ended.messages[0].attention_points_size(), 1);
+  // The worker stops at its next check and the server goes on.
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        return MetricValue(Scrape(), "grpc_server_handled_total",
+                           {"grpc_method=\"Segment\"",
+                            "grpc_code=\"DeadlineExceeded\""}) == 1;
+      },
+      std::chrono::seconds(10)));
+  EXPECT_EQ(stage_gate_.entered(), kAfterSeedsMessage);  // stopped there
+}
+
 TEST_F(ServerTest, SegmentCancelledAfterTheFirstMessageEndsCancelled) {
   StartServer();
   v1::SegmentRequest request;
