@@ -74,21 +74,31 @@ void PrintClassMeans(const std::vector<SvmSample>& samples) {
   }
 }
 
-int TrainCos() {
+// The scenes of --data, or an exit code (after a message) when --data or
+// --out is missing or the scenes cannot be read.
+int LoadScenesOrExit(const char* command,
+                     absl::StatusOr<std::vector<LabelledFrame>>& scenes) {
   const std::string data = DataDir();
-  const std::string out = absl::GetFlag(FLAGS_out);
-  if (data.empty() || out.empty()) {
+  if (data.empty() || absl::GetFlag(FLAGS_out).empty()) {
     std::fprintf(stderr,
-                 "fovea-train cos: --data (or FOVEA_OSD_DIR) and --out are "
-                 "required\n");
+                 "fovea-train %s: --data (or FOVEA_OSD_DIR) and --out are "
+                 "required\n",
+                 command);
     return kUsageError;
   }
-  absl::StatusOr<std::vector<LabelledFrame>> scenes = eval::LoadScenes(data);
+  scenes = eval::LoadScenes(data);
   if (!scenes.ok()) {
     std::fprintf(stderr, "fovea-train: %s\n",
                  scenes.status().ToString().c_str());
     return kRunError;
   }
+  return 0;
+}
+
+int TrainCos() {
+  const std::string out = absl::GetFlag(FLAGS_out);
+  absl::StatusOr<std::vector<LabelledFrame>> scenes;
+  if (const int code = LoadScenesOrExit("cos", scenes); code != 0) return code;
   const SegmentOptions segment;
   std::vector<SvmSample> samples;
   for (size_t i = 0; i < scenes->size(); ++i) {
@@ -156,20 +166,9 @@ int TrainCos() {
 }
 
 int TrainEbs() {
-  const std::string data = DataDir();
   const std::string out = absl::GetFlag(FLAGS_out);
-  if (data.empty() || out.empty()) {
-    std::fprintf(stderr,
-                 "fovea-train ebs: --data (or FOVEA_OSD_DIR) and --out are "
-                 "required\n");
-    return kUsageError;
-  }
-  absl::StatusOr<std::vector<LabelledFrame>> scenes = eval::LoadScenes(data);
-  if (!scenes.ok()) {
-    std::fprintf(stderr, "fovea-train: %s\n",
-                 scenes.status().ToString().c_str());
-    return kRunError;
-  }
+  absl::StatusOr<std::vector<LabelledFrame>> scenes;
+  if (const int code = LoadScenesOrExit("ebs", scenes); code != 0) return code;
   const int folds = absl::GetFlag(FLAGS_folds);
   if (folds < 2) {
     std::fprintf(stderr, "fovea-train: --folds must be at least 2\n");

@@ -12,18 +12,12 @@
 #include "core/frame/frame_decode.h"
 #include "core/frame/osd_pcd.h"
 #include "core/pipeline/detect.h"
+#include "tests/core/testing/osd.h"
 
 namespace fovea {
 namespace {
 
-std::string OsdDir() {
-  const char* root = std::getenv("FOVEA_OSD_DIR");
-  if (root == nullptr) return "";
-  if (!std::filesystem::is_directory(std::filesystem::path(root) / "learn")) {
-    return "";
-  }
-  return root;
-}
+using testing::OsdDir;
 
 std::string ReadFile(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);

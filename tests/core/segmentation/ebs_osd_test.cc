@@ -15,18 +15,12 @@
 #include "core/frame/organized_cloud.h"
 #include "core/frame/osd_pcd.h"
 #include "core/segmentation/ebs.h"
+#include "tests/core/testing/osd.h"
 
 namespace fovea {
 namespace {
 
-std::string OsdDir() {
-  const char* root = std::getenv("FOVEA_OSD_DIR");
-  if (root == nullptr) return "";
-  if (!std::filesystem::is_directory(std::filesystem::path(root) / "learn")) {
-    return "";
-  }
-  return root;
-}
+using testing::OsdDir;
 
 // Scene kinds of the learn set (shared/data/README.md), by index.
 int KindOf(int index) {

@@ -10,18 +10,12 @@
 #include "core/frame/organized_cloud.h"
 #include "core/frame/osd_pcd.h"
 #include "core/segmentation/planar_patches.h"
+#include "tests/core/testing/osd.h"
 
 namespace fovea {
 namespace {
 
-std::string OsdDir() {
-  const char* root = std::getenv("FOVEA_OSD_DIR");
-  if (root == nullptr) return "";
-  if (!std::filesystem::is_directory(std::filesystem::path(root) / "learn")) {
-    return "";
-  }
-  return root;
-}
+using testing::OsdDir;
 
 // A patch must not mix objects: over all patch pixels of a scene, the
 // fraction whose object (label / 10) is their patch's majority object.
