@@ -11,8 +11,11 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 
+#include "core/pipeline/models.h"
 #include "core/synth/synth_scene.h"
+#include "tests/core/testing/scenes.h"
 #include "tests/testing/run_command.h"
 #include "tools/eval/scene_kind.h"
 
@@ -30,9 +33,9 @@ using ::testing::HasSubstr;
   return run;
 }
 
-// Writes synthetic scene `seed` as an organized PCD with label and rgba.
-void WritePcd(const std::filesystem::path& path, uint64_t seed) {
-  const synth::SynthScene scene = synth::GenerateScene(seed);
+// Writes a synthetic scene as an organized PCD with label and rgba.
+void WritePcd(const std::filesystem::path& path,
+              const synth::SynthScene& scene) {
   const RgbdFrame& f = scene.frame.frame;
   pcl::PointCloud<pcl::PointXYZRGBL> cloud(f.width(), f.height());
   for (int v = 0; v < f.height(); ++v) {
@@ -58,7 +61,22 @@ std::filesystem::path SyntheticDataDir() {
       std::filesystem::path(::testing::TempDir()) / "fovea_eval_test_data";
   std::filesystem::create_directories(dir / "learn");
   for (int i = 0; i < 3; ++i) {
-    WritePcd(dir / "learn" / ("learn" + std::to_string(i) + ".pcd"), i + 1);
+    WritePcd(dir / "learn" / ("learn" + std::to_string(i) + ".pcd"),
+             synth::GenerateScene(i + 1));
+  }
+  return dir;
+}
+
+// Three scenes of two boxes side by side, touching in the first two and
+// 5 cm apart in the third: every fold has patches to join and to reject.
+std::filesystem::path SegmentationDataDir() {
+  const std::filesystem::path dir =
+      std::filesystem::path(::testing::TempDir()) / "fovea_segment_test_data";
+  std::filesystem::create_directories(dir / "learn");
+  const float gaps[3] = {0.0f, 0.0f, 0.05f};
+  for (int i = 0; i < 3; ++i) {
+    WritePcd(dir / "learn" / ("learn" + std::to_string(i) + ".pcd"),
+             testing::TwoBoxesOnTable(gaps[i]));
   }
   return dir;
 }
@@ -112,6 +130,58 @@ TEST(FoveaEvalTest, SweepWritesTheGridAsMarkdownAndCsv) {
   int lines = 0;
   while (std::getline(csv, line)) ++lines;
   EXPECT_EQ(lines, 5);  // header and four rows
+}
+
+// The value of `key` in a JSON line of numbers.
+double JsonNumber(const std::string& line, const std::string& key) {
+  const size_t at = line.find("\"" + key + "\": ");
+  if (at == std::string::npos) return -1.0;
+  return std::stod(line.substr(at + key.size() + 4));
+}
+
+TEST(FoveaEvalTest, SegmentCrossValidatesBothMethodsWithAJsonLastLine) {
+  const std::filesystem::path dir = SegmentationDataDir();
+  for (const char* method : {"cos", "ebs"}) {
+    const ::fovea::testing::CommandRun run =
+        RunEval(std::string("segment --method ") + method + " --data " +
+                dir.string() + " --folds 3 --json");
+    ASSERT_EQ(run.exit_code, 0) << run.out;
+    EXPECT_THAT(run.out, HasSubstr("3-fold cross-validated"));
+    const std::string last =
+        run.out.substr(run.out.rfind('\n', run.out.size() - 2) + 1);
+    for (const char* key :
+         {"f_all", "f_best", "f_first", "object_recall", "false_masks",
+          "first_mask_ms_median", "all_masks_ms_median"}) {
+      EXPECT_GE(JsonNumber(last, key), 0.0) << key << " in " << last;
+    }
+    EXPECT_EQ(JsonNumber(last, "scenes"), 3.0);
+    // Two noise-free boxes on a clean table: both are cut out.
+    EXPECT_GT(JsonNumber(last, "f_all"), 0.6) << method << ": " << last;
+    EXPECT_GT(JsonNumber(last, "object_recall"), 0.6) << method << ": " << last;
+  }
+}
+
+TEST(FoveaTrainTest, WritesModelsTheServerLoads) {
+  const std::filesystem::path dir = SegmentationDataDir();
+  const std::filesystem::path models =
+      std::filesystem::path(::testing::TempDir()) / "fovea_train_models";
+  std::filesystem::create_directories(models);
+  for (const auto& [command, file] :
+       {std::pair<std::string, std::string>{"cos", kCosModelFile},
+        {"ebs", kEbsModelFile}}) {
+    const ::fovea::testing::CommandRun run = ::fovea::testing::RunCommand(
+        std::string(FOVEA_TRAIN_BIN) + " " + command + " --data " +
+        dir.string() + " --folds 3 --out " + (models / file).string());
+    ASSERT_EQ(run.exit_code, 0) << run.out << run.err;
+    EXPECT_THAT(run.out, HasSubstr("3-fold cross-validated"));
+  }
+  const absl::StatusOr<LoadedModels> loaded = LoadModels(models.string());
+  ASSERT_TRUE(loaded.ok()) << loaded.status();
+  EXPECT_EQ(loaded->versions.size(), 2u);
+  const ::fovea::testing::CommandRun usage = ::fovea::testing::RunCommand(
+      std::string(FOVEA_TRAIN_BIN) + " cos --data " + dir.string());
+  EXPECT_EQ(usage.exit_code, 64);
+  EXPECT_THAT(usage.err, HasSubstr("--out"));
 }
 
 TEST(FoveaEvalTest, UnknownSaliencyIsAUsageErrorNamingIt) {
