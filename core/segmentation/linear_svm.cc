@@ -13,6 +13,7 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
 #include "core/base/strings.h"
+#include "core/segmentation/svm_common.h"
 
 extern "C" {
 #include "libsvm/svm.h"
@@ -21,108 +22,36 @@ extern "C" {
 namespace fovea {
 namespace {
 
+using svm_internal::CheckSamples;
+using svm_internal::ParseNumber;
+
 constexpr std::string_view kMagic = "fovea-linear-svm 1";
 // Longest model text Parse reads, bytes (a model is a few hundred).
 constexpr size_t kMaxModelBytes = 1 << 20;
-
-void Quiet(const char*) {}
-
-// FNV-1a, 64 bits: a stable content hash for Version().
-uint64_t Fnv1a(std::string_view text) {
-  uint64_t hash = 14695981039346656037ULL;
-  for (const char c : text) {
-    hash ^= static_cast<unsigned char>(c);
-    hash *= 1099511628211ULL;
-  }
-  return hash;
-}
-
-absl::Status CheckSamples(const std::vector<SvmSample>& samples) {
-  if (samples.empty()) return absl::InvalidArgumentError("no samples");
-  bool positive = false;
-  bool negative = false;
-  for (const SvmSample& s : samples) {
-    if (s.x.size() != samples[0].x.size()) {
-      return absl::InvalidArgumentError("samples have different lengths");
-    }
-    if (s.label != 1 && s.label != -1) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("sample label must be +1 or -1, got ", s.label));
-    }
-    positive |= s.label == 1;
-    negative |= s.label == -1;
-  }
-  if (!positive || !negative) {
-    return absl::InvalidArgumentError(
-        "samples of both classes (+1 and -1) are needed");
-  }
-  return absl::OkStatus();
-}
 
 // libsvm's training on `samples`; w and b read back from the model.
 std::pair<std::vector<double>, double> TrainWeights(
     const std::vector<SvmSample>& samples,
     const LinearSvmTrainingOptions& options) {
-  const size_t dims = samples[0].x.size();
-  // Each sample: dims nodes plus the terminator (index -1).
-  std::vector<std::vector<svm_node>> nodes(samples.size());
-  std::vector<svm_node*> rows(samples.size());
-  std::vector<double> labels(samples.size());
-  int positives = 0;
-  for (size_t i = 0; i < samples.size(); ++i) {
-    for (size_t d = 0; d < dims; ++d) {
-      nodes[i].push_back({static_cast<int>(d + 1), samples[i].x[d]});
-    }
-    nodes[i].push_back({-1, 0.0});
-    rows[i] = nodes[i].data();
-    labels[i] = samples[i].label;
-    positives += samples[i].label == 1 ? 1 : 0;
-  }
-  svm_problem problem{};
-  problem.l = static_cast<int>(samples.size());
-  problem.y = labels.data();
-  problem.x = rows.data();
-
-  int weight_labels[2] = {1, -1};
-  const double n = static_cast<double>(samples.size());
-  double weights[2] = {n / (2.0 * positives), n / (2.0 * (n - positives))};
   svm_parameter param{};
-  param.svm_type = C_SVC;
   param.kernel_type = LINEAR;
   param.cache_size = 100;
   param.eps = options.epsilon;
   param.C = options.c;
   param.shrinking = 1;
-  if (options.balance_classes) {
-    param.nr_weight = 2;
-    param.weight_label = weight_labels;
-    param.weight = weights;
-  }
-  svm_set_print_string_function(&Quiet);
-  svm_model* model = svm_train(&problem, &param);
-  std::vector<double> w(dims, 0.0);
-  for (int i = 0; i < model->l; ++i) {
-    for (const svm_node* node = model->SV[i]; node->index != -1; ++node) {
-      w[node->index - 1] += model->sv_coef[0][i] * node->value;
+  const std::unique_ptr<svm_internal::TrainedModel> trained =
+      svm_internal::Train(samples, param, options.balance_classes);
+  const svm_model& model = *trained->model;
+  std::vector<double> w(samples[0].x.size(), 0.0);
+  for (int i = 0; i < model.l; ++i) {
+    for (const svm_node* node = model.SV[i]; node->index != -1; ++node) {
+      w[node->index - 1] += model.sv_coef[0][i] * node->value;
     }
   }
-  double b = -model->rho[0];
   // libsvm's decision is positive for its first label.
-  if (model->label[0] != 1) {
-    for (double& v : w) v = -v;
-    b = -b;
-  }
-  svm_free_and_destroy_model(&model);
-  return {std::move(w), b};
-}
-
-absl::StatusOr<double> ParseNumber(std::string_view text, int line) {
-  double value = 0.0;
-  if (!absl::SimpleAtod(AbslView(text), &value) || !std::isfinite(value)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "line ", line, ": '", AbslView(text), "' is not a finite number"));
-  }
-  return value;
+  const double sign = svm_internal::PositiveSign(model);
+  for (double& v : w) v *= sign;
+  return {std::move(w), -model.rho[0] * sign};
 }
 
 }  // namespace
@@ -145,7 +74,7 @@ double LinearSvm::Decision(const std::vector<double>& x) const {
 }
 
 std::string LinearSvm::Version() const {
-  return absl::StrFormat("%s-%016x", kind_, Fnv1a(Serialize()));
+  return absl::StrFormat("%s-%016x", kind_, svm_internal::Fnv1a(Serialize()));
 }
 
 std::string LinearSvm::Serialize() const {
@@ -280,61 +209,15 @@ absl::StatusOr<LinearSvm> TrainLinearSvm(
 absl::StatusOr<CrossValidation> CrossValidateLinearSvm(
     const std::vector<SvmSample>& samples, int folds,
     const LinearSvmTrainingOptions& options) {
-  if (folds < 2) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("folds must be at least 2, got ", folds));
-  }
   if (absl::Status s = Validate(options); !s.ok()) return s;
-  if (absl::Status s = CheckSamples(samples); !s.ok()) return s;
-  int correct = 0;
-  int tested = 0;
-  int true_pos = 0;
-  int positives = 0;
-  int true_neg = 0;
-  int negatives = 0;
-  int used_folds = 0;
-  for (int fold = 0; fold < folds; ++fold) {
-    std::vector<SvmSample> train;
-    std::vector<const SvmSample*> test;
-    for (const SvmSample& s : samples) {
-      if (((s.group % folds) + folds) % folds == fold) {
-        test.push_back(&s);
-      } else {
-        train.push_back(s);
-      }
-    }
-    if (test.empty() || CheckSamples(train) != absl::OkStatus()) continue;
-    ++used_folds;
-    const auto [w, b] = TrainWeights(train, options);
-    const LinearSvm svm("cv", std::vector<std::string>(w.size()), w, b, "");
-    for (const SvmSample* s : test) {
-      const bool accept = svm.Decision(s->x) > 0.0;
-      const bool right = accept == (s->label == 1);
-      correct += right ? 1 : 0;
-      ++tested;
-      if (s->label == 1) {
-        ++positives;
-        true_pos += right ? 1 : 0;
-      } else {
-        ++negatives;
-        true_neg += right ? 1 : 0;
-      }
-    }
-  }
-  if (tested == 0) {
-    return absl::InvalidArgumentError(
-        "no fold had both a test set and two training classes");
-  }
-  CrossValidation cv;
-  cv.folds = used_folds;
-  cv.samples = tested;
-  cv.accuracy = static_cast<double>(correct) / tested;
-  const double pos_recall =
-      positives > 0 ? static_cast<double>(true_pos) / positives : 0.0;
-  const double neg_recall =
-      negatives > 0 ? static_cast<double>(true_neg) / negatives : 0.0;
-  cv.balanced_accuracy = 0.5 * (pos_recall + neg_recall);
-  return cv;
+  return svm_internal::CrossValidate(
+      samples, folds, [&options](const std::vector<SvmSample>& training) {
+        auto [w, b] = TrainWeights(training, options);
+        const LinearSvm svm("cv", std::vector<std::string>(w.size()),
+                            std::move(w), b, "");
+        return svm_internal::DecisionFunction(
+            [svm](const std::vector<double>& x) { return svm.Decision(x); });
+      });
 }
 
 }  // namespace fovea

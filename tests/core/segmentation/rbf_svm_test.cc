@@ -1,0 +1,87 @@
+#include "core/segmentation/rbf_svm.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace fovea {
+namespace {
+
+// Inside the disc of radius 0.5 around (0.5, 0.5): +1; outside, in the unit
+// square: -1. Not linearly separable. group = index mod 5.
+std::vector<SvmSample> Disc(int n, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  std::vector<SvmSample> samples;
+  while (static_cast<int>(samples.size()) < n) {
+    const double x = uniform(rng);
+    const double y = uniform(rng);
+    const double r = std::hypot(x - 0.5, y - 0.5);
+    if (std::abs(r - 0.35) < 0.03) continue;
+    samples.push_back(
+        {{x, y}, r < 0.35 ? 1 : -1, static_cast<int>(samples.size() % 5)});
+  }
+  return samples;
+}
+
+TEST(RbfSvmTest, SeparatesADiscWithCalibratedProbabilities) {
+  absl::StatusOr<RbfSvm> svm =
+      TrainRbfSvm(Disc(400, 1), {"x", "y"}, "test", RbfSvmTrainingOptions{});
+  ASSERT_TRUE(svm.ok()) << svm.status();
+  int right = 0;
+  for (const SvmSample& s : Disc(200, 2)) {
+    right += (svm->Probability(s.x) > 0.5) == (s.label == 1) ? 1 : 0;
+  }
+  EXPECT_GE(right, 185);
+  // The centre is surely inside, a corner surely outside.
+  EXPECT_GT(svm->Probability({0.5, 0.5}), 0.9);
+  EXPECT_LT(svm->Probability({0.02, 0.02}), 0.1);
+  const absl::StatusOr<CrossValidation> cv =
+      CrossValidateRbfSvm(Disc(300, 3), 5, RbfSvmTrainingOptions{});
+  ASSERT_TRUE(cv.ok()) << cv.status();
+  EXPECT_GT(cv->accuracy, 0.9);
+}
+
+TEST(RbfSvmTest, SerializeAndParseGiveTheSameDecisions) {
+  absl::StatusOr<RbfSvm> svm =
+      TrainRbfSvm(Disc(100, 4), {"x", "y"}, "inc", RbfSvmTrainingOptions{});
+  ASSERT_TRUE(svm.ok());
+  absl::StatusOr<RbfSvm> back = RbfSvm::Parse(svm->Serialize(), "inc");
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->Version(), svm->Version());
+  for (const SvmSample& s : Disc(20, 5)) {
+    EXPECT_DOUBLE_EQ(back->Probability(s.x), svm->Probability(s.x));
+  }
+}
+
+TEST(RbfSvmTest, ParseRejectsCorruptText) {
+  absl::StatusOr<RbfSvm> svm =
+      TrainRbfSvm(Disc(60, 6), {"x", "y"}, "inc", RbfSvmTrainingOptions{});
+  ASSERT_TRUE(svm.ok());
+  const std::string good = svm->Serialize();
+  const std::string cases[] = {
+      "",
+      "fovea-linear-svm 1\n",
+      good.substr(0, good.size() / 2),
+      good + "1 2 3\n",
+      "fovea-rbf-svm 1\nkind inc\nfeatures x y\ngamma -1\nrho 0\n"
+      "probability 1 0\nprovenance\nvectors 0\n",
+      "fovea-rbf-svm 1\nkind inc\nfeatures x y\ngamma 1\nrho 0\n"
+      "probability 1 0\nprovenance\nvectors 99999999\n",
+      "fovea-rbf-svm 1\nkind inc\nfeatures x y\ngamma 1\nrho 0\n"
+      "probability 1 0\nprovenance\nvectors 1\n1 2\n",
+      "fovea-rbf-svm 1\nkind cos\nfeatures x y\ngamma 1\nrho 0\n"
+      "probability 1 0\nprovenance\nvectors 0\n",
+  };
+  for (const std::string& text : cases) {
+    const absl::StatusOr<RbfSvm> parsed = RbfSvm::Parse(text, "inc");
+    EXPECT_EQ(parsed.status().code(), absl::StatusCode::kInvalidArgument)
+        << text.substr(0, 60);
+  }
+  RbfSvmTrainingOptions bad;
+  bad.gamma = 0.0;
+  EXPECT_NE(Validate(bad).message().find("gamma"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace fovea
