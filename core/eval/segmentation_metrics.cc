@@ -81,4 +81,44 @@ SegmentationScore ScoreSegmentation(const cv::Mat& labels,
   return score;
 }
 
+double WholeSceneF(const cv::Mat& labels, const cv::Mat& segments,
+                   int min_object_pixels) {
+  std::map<int, int> object_pixels;
+  std::map<int, int> segment_pixels;
+  std::map<std::pair<int, int>, int> overlap;  // (object, segment)
+  for (int v = 0; v < labels.rows; ++v) {
+    const int* label = labels.ptr<int>(v);
+    const int* segment = segments.ptr<int>(v);
+    for (int u = 0; u < labels.cols; ++u) {
+      const int object = ObjectId(label[u]);
+      if (object > 0) ++object_pixels[object];
+      if (segment[u] >= 0) {
+        ++segment_pixels[segment[u]];
+        if (object > 0) ++overlap[{object, segment[u]}];
+      }
+    }
+  }
+  double sum = 0.0;
+  int objects = 0;
+  for (const auto& [object, pixels] : object_pixels) {
+    if (pixels < min_object_pixels) continue;
+    ++objects;
+    int best_overlap = 0;
+    int best_segment = -1;
+    for (auto it = overlap.lower_bound({object, -1});
+         it != overlap.end() && it->first.first == object; ++it) {
+      if (it->second > best_overlap) {
+        best_overlap = it->second;
+        best_segment = it->first.second;
+      }
+    }
+    if (best_segment < 0) continue;
+    const double p =
+        static_cast<double>(best_overlap) / segment_pixels[best_segment];
+    const double r = static_cast<double>(best_overlap) / pixels;
+    sum += 2.0 * p * r / (p + r);
+  }
+  return objects > 0 ? sum / objects : 1.0;
+}
+
 }  // namespace fovea

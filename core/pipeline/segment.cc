@@ -23,8 +23,9 @@ double SecondsSince(SteadyClock::time_point start) {
   return std::chrono::duration<double>(SteadyClock::now() - start).count();
 }
 
-// The object's box, area, centroid and extent from its mask.
-void Describe(const OrganizedCloud& cloud, SegmentedObject& object) {
+}  // namespace
+
+void DescribeObject(const OrganizedCloud& cloud, SegmentedObject& object) {
   object.area = cv::countNonZero(object.mask);
   object.box = object.area > 0 ? cv::boundingRect(object.mask) : cv::Rect();
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -49,6 +50,8 @@ void Describe(const OrganizedCloud& cloud, SegmentedObject& object) {
     object.extent = hi - lo;
   }
 }
+
+namespace {
 
 // Pixels standing on the table: what scene_coverage is a fraction of.
 cv::Mat ObjectRegion(const TableScene& table, float min_height) {
@@ -261,7 +264,7 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
     object.seed = seed;
     object.mask = std::move((*cut)->mask);
     object.score = (*cut)->score;
-    Describe(scene->cloud, object);
+    DescribeObject(scene->cloud, object);
     covered.setTo(255, object.mask);
     object.seconds_since_start = SecondsSince(start);
     if (sinks.object) {

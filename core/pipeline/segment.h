@@ -68,9 +68,14 @@ struct SegmentedObject {
   double seconds_since_start = 0.0;  // since RunSegment's `start`
 };
 
+// Fills the object's box, area, centroid and extent from its mask and the
+// cloud's points under it.
+void DescribeObject(const OrganizedCloud& cloud, SegmentedObject& object);
+
 enum class SegmentStop {
   kDone,        // every seed was used
   kMaxObjects,  // options.max_objects objects were emitted
+  kTimeBudget,  // the request's time budget ran out (incremental only)
 };
 
 struct SegmentSummary {

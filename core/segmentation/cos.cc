@@ -70,55 +70,6 @@ std::vector<int> Frontier(const CosScene& scene, const std::vector<int>& object,
   return result;
 }
 
-cv::Mat PatchMask(const CosScene& scene, const std::vector<int>& patches) {
-  std::vector<unsigned char> in(scene.patches.patches.size(), 0);
-  for (const int p : patches) in[p] = 1;
-  const cv::Mat& labels = scene.patches.labels;
-  cv::Mat mask(labels.size(), CV_8UC1, cv::Scalar(0));
-  for (int v = 0; v < labels.rows; ++v) {
-    const int* label = labels.ptr<int>(v);
-    unsigned char* out = mask.ptr<unsigned char>(v);
-    for (int u = 0; u < labels.cols; ++u) {
-      if (label[u] >= 0 && in[label[u]]) out[u] = 255;
-    }
-  }
-  return mask;
-}
-
-// Per patch: the ObjectId most of its pixels carry (0 = table or none).
-std::vector<int> PatchObjects(const CosScene& scene, const cv::Mat& labels) {
-  const int n = static_cast<int>(scene.patches.patches.size());
-  std::vector<std::vector<std::pair<int, int>>> votes(n);  // (object, count)
-  const cv::Mat& patch_labels = scene.patches.labels;
-  for (int v = 0; v < labels.rows; ++v) {
-    const int* gt = labels.ptr<int>(v);
-    const int* patch = patch_labels.ptr<int>(v);
-    for (int u = 0; u < labels.cols; ++u) {
-      if (patch[u] < 0) continue;
-      const int object = ObjectId(gt[u]);
-      auto& list = votes[patch[u]];
-      auto it = std::find_if(list.begin(), list.end(),
-                             [&](const auto& e) { return e.first == object; });
-      if (it == list.end()) {
-        list.emplace_back(object, 1);
-      } else {
-        ++it->second;
-      }
-    }
-  }
-  std::vector<int> result(n, 0);
-  for (int p = 0; p < n; ++p) {
-    int best = 0;
-    for (const auto& [object, count] : votes[p]) {
-      if (count > best) {
-        best = count;
-        result[p] = object;
-      }
-    }
-  }
-  return result;
-}
-
 // Gives the pixels with depth but no patch (no normal: along occluding
 // edges and object rims, where normals cannot be estimated) the patch of a
 // 4-neighbour with nearly the same depth, one ring per pass, `passes`
@@ -193,6 +144,54 @@ absl::Status Validate(const CosOptions& options) {
     return absl::InvalidArgumentError(absl::StrCat("patches.", s.message()));
   }
   return absl::OkStatus();
+}
+
+cv::Mat PatchesMask(const CosScene& scene, const std::vector<int>& patches) {
+  std::vector<unsigned char> in(scene.patches.patches.size(), 0);
+  for (const int p : patches) in[p] = 1;
+  const cv::Mat& labels = scene.patches.labels;
+  cv::Mat mask(labels.size(), CV_8UC1, cv::Scalar(0));
+  for (int v = 0; v < labels.rows; ++v) {
+    const int* label = labels.ptr<int>(v);
+    unsigned char* out = mask.ptr<unsigned char>(v);
+    for (int u = 0; u < labels.cols; ++u) {
+      if (label[u] >= 0 && in[label[u]]) out[u] = 255;
+    }
+  }
+  return mask;
+}
+
+std::vector<int> PatchObjectIds(const CosScene& scene, const cv::Mat& labels) {
+  const int n = static_cast<int>(scene.patches.patches.size());
+  std::vector<std::vector<std::pair<int, int>>> votes(n);  // (object, count)
+  const cv::Mat& patch_labels = scene.patches.labels;
+  for (int v = 0; v < labels.rows; ++v) {
+    const int* gt = labels.ptr<int>(v);
+    const int* patch = patch_labels.ptr<int>(v);
+    for (int u = 0; u < labels.cols; ++u) {
+      if (patch[u] < 0) continue;
+      const int object = ObjectId(gt[u]);
+      auto& list = votes[patch[u]];
+      auto it = std::find_if(list.begin(), list.end(),
+                             [&](const auto& e) { return e.first == object; });
+      if (it == list.end()) {
+        list.emplace_back(object, 1);
+      } else {
+        ++it->second;
+      }
+    }
+  }
+  std::vector<int> result(n, 0);
+  for (int p = 0; p < n; ++p) {
+    int best = 0;
+    for (const auto& [object, count] : votes[p]) {
+      if (count > best) {
+        best = count;
+        result[p] = object;
+      }
+    }
+  }
+  return result;
 }
 
 const std::vector<std::string>& CosFeatureNames() {
@@ -355,7 +354,7 @@ absl::StatusOr<std::optional<CosObject>> CosSegmenter::Segment(
   for (const int p : object) owner_[p] = objects_;
   ++objects_;
   CosObject result;
-  result.mask = PatchMask(scene_, object);
+  result.mask = PatchesMask(scene_, object);
   result.patches = std::move(object);
   result.score =
       std::isinf(min_margin) ? 1.0 : 1.0 / (1.0 + std::exp(-min_margin));
@@ -365,7 +364,7 @@ absl::StatusOr<std::optional<CosObject>> CosSegmenter::Segment(
 std::vector<SvmSample> CosTrainingSamples(const CosScene& scene,
                                           const cv::Mat& labels, int group,
                                           const CosOptions& options) {
-  const std::vector<int> patch_object = PatchObjects(scene, labels);
+  const std::vector<int> patch_object = PatchObjectIds(scene, labels);
   const int n = static_cast<int>(patch_object.size());
   const std::vector<int> owner(n, -1);
   std::vector<SvmSample> samples;

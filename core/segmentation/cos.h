@@ -78,6 +78,13 @@ absl::StatusOr<CosScene> BuildCosScene(const OrganizedCloud& cloud,
                                        const SupportPlane& plane,
                                        const CosOptions& options);
 
+// CV_8UC1 of the labels' size, 255 on the pixels of `patches`.
+cv::Mat PatchesMask(const CosScene& scene, const std::vector<int>& patches);
+
+// Per patch: the ObjectId most of its pixels carry in `labels` (CV_32SC1 of
+// a LabelledFrame; 0 = table or none).
+std::vector<int> PatchObjectIds(const CosScene& scene, const cv::Mat& labels);
+
 // The features of joining `candidate` to the object made of `object`
 // patches (CosFeatureNames order).
 std::vector<double> CosJoinFeatures(const CosScene& scene,

@@ -16,6 +16,7 @@
 #include "absl/strings/str_join.h"
 #include "core/pipeline/detect.h"
 #include "tools/eval/detect_eval.h"
+#include "tools/eval/inc_eval.h"
 #include "tools/eval/segment_eval.h"
 #include "tools/eval/sweep.h"
 
@@ -75,7 +76,12 @@ ABSL_FLAG(std::string, out, "",
           "Write <scene>.png (colour with object outlines | saliency map, "
           "points numbered) into this folder.");
 ABSL_FLAG(bool, verbose, false, "One line per scene on stderr.");
-ABSL_FLAG(std::string, method, "cos", "segment: cos or ebs.");
+ABSL_FLAG(std::string, method, "cos", "segment: cos, ebs or inc.");
+ABSL_FLAG(std::string, inc_saliency, "sym3d",
+          "segment --method inc: sym3d (Detect's map, F from one run) or "
+          "random-points (per object 5 sequences of 5 points, section 3.3.3).");
+ABSL_FLAG(double, inc_k, fovea::IncOptions().k,
+          "segment --method inc: the graph segmentation's k.");
 ABSL_FLAG(std::string, seeds, "",
           "segment: where the seeds come from, tj, wta or msr (Detect's "
           "extraction; overrides --extract).");
@@ -247,6 +253,64 @@ void PrintSegmentTable(const std::vector<SceneSegmentResult>& scenes) {
   }
 }
 
+void PrintIncTable(const std::vector<IncSceneResult>& scenes) {
+  std::printf("%-12s %7s %7s %7s %7s %8s %8s %8s %10s %10s\n", "kind", "scenes",
+              "F(all)", "F(best)", "F(first)", "recall", "false", "wholeF",
+              "first(ms)", "whole(ms)");
+  for (const char* kind :
+       {"boxes", "stacked", "occluded", "cylindric", "other", ""}) {
+    const IncEvalSummary s = SummarizeInc(scenes, kind);
+    if (s.scenes.empty()) continue;
+    std::printf(
+        "%-12s %7zu %7.3f %7.3f %7.3f %8.3f %8.3f %8.3f %10.1f %10.1f\n",
+        kind[0] ? kind : "all", s.scenes.size(), s.f_all, s.f_best, s.f_first,
+        s.object_recall, s.false_masks, s.whole_scene_f,
+        s.first_object_ms_median, s.whole_scene_ms_median);
+  }
+}
+
+int RunIncEval(std::optional<DetectOptions> detect,
+               const std::vector<LabelledFrame>& scenes) {
+  IncEvalOptions options;
+  options.incremental.detect = *std::move(detect);
+  const std::string saliency = absl::GetFlag(FLAGS_inc_saliency);
+  if (saliency != "sym3d" && saliency != "random-points") {
+    std::fprintf(stderr,
+                 "fovea-eval: --saliency for inc: sym3d or random-points\n");
+    return kUsageError;
+  }
+  options.saliency =
+      saliency == "sym3d" ? IncSaliency::kSym3d : IncSaliency::kRandomPoints;
+  options.folds = absl::GetFlag(FLAGS_folds);
+  options.out_dir = absl::GetFlag(FLAGS_out);
+  options.verbose = absl::GetFlag(FLAGS_verbose);
+  options.incremental.inc.k = absl::GetFlag(FLAGS_inc_k);
+  absl::StatusOr<IncEvalSummary> summary = EvaluateInc(scenes, options);
+  if (!summary.ok()) {
+    std::fprintf(stderr, "fovea-eval: %s\n",
+                 summary.status().ToString().c_str());
+    return kRunError;
+  }
+  std::printf(
+      "segment inc, saliency %s, %zu scenes, %d-fold cross-validated; "
+      "first-object time against whole-scene time: slope %.3f\n",
+      saliency.c_str(), summary->scenes.size(), options.folds,
+      summary->first_object_slope);
+  PrintIncTable(summary->scenes);
+  if (absl::GetFlag(FLAGS_json)) {
+    std::printf(
+        "{\"scenes\": %zu, \"f_all\": %.4f, \"f_best\": %.4f, "
+        "\"f_first\": %.4f, \"object_recall\": %.4f, \"false_masks\": "
+        "%.4f, \"whole_scene_f\": %.4f, \"first_object_ms_median\": %.1f, "
+        "\"whole_scene_ms_median\": %.1f, \"first_object_slope\": %.4f}\n",
+        summary->scenes.size(), summary->f_all, summary->f_best,
+        summary->f_first, summary->object_recall, summary->false_masks,
+        summary->whole_scene_f, summary->first_object_ms_median,
+        summary->whole_scene_ms_median, summary->first_object_slope);
+  }
+  return 0;
+}
+
 int RunSegmentEval() {
   std::string data = absl::GetFlag(FLAGS_data);
   if (data.empty()) {
@@ -270,6 +334,15 @@ int RunSegmentEval() {
       return kUsageError;
     }
     options.segment.detect.extraction = *kind;
+  }
+  if (absl::GetFlag(FLAGS_method) == "inc") {
+    absl::StatusOr<std::vector<LabelledFrame>> scenes = LoadScenes(data);
+    if (!scenes.ok()) {
+      std::fprintf(stderr, "fovea-eval: %s\n",
+                   scenes.status().ToString().c_str());
+      return kRunError;
+    }
+    return RunIncEval(options.segment.detect, *scenes);
   }
   absl::StatusOr<SegmentMethod> method =
       ParseSegmentMethod(absl::GetFlag(FLAGS_method));
@@ -361,7 +434,9 @@ int main(int argc, char** argv) {
       "[--norm lin|nms|nlm] [--extract wta|msr|tj] [--json] [--out DIR]\n"
       "  fovea-eval sweep --data DIR --out DIR [--filter TEXT]   (the grid "
       "of Tables 2.4/2.5 as Markdown and CSV)\n"
-      "  fovea-eval segment --method cos|ebs --data DIR [--seeds tj|wta|msr] "
+      "  fovea-eval segment --method cos|ebs|inc --data DIR [--seeds "
+      "tj|wta|msr] "
+      "[--inc_saliency sym3d|random-points] "
       "[--folds 5] [--json] [--out DIR]   (Table 3.1, cross-validated)");
   std::vector<char*> args = absl::ParseCommandLine(argc, argv);
   if (args.size() < 2) {

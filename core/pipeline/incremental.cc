@@ -1,0 +1,206 @@
+#include "core/pipeline/incremental.h"
+
+#include <cmath>
+#include <exception>
+#include <new>
+#include <optional>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+
+namespace fovea {
+namespace {
+
+using SteadyClock = std::chrono::steady_clock;
+
+// Focal length the attention sigma is given at, pixels.
+constexpr double kReferenceFocalPx = 525.0;
+
+double SecondsSince(SteadyClock::time_point start) {
+  return std::chrono::duration<double>(SteadyClock::now() - start).count();
+}
+
+absl::StatusOr<SegmentSummary> RunUnguarded(const RgbdFrame& frame,
+                                            const IncrementalOptions& options,
+                                            const RbfSvm* svm,
+                                            const SegmentSinks& sinks,
+                                            const InterruptCheck& interrupt,
+                                            SteadyClock::time_point start) {
+  if (absl::Status s = Validate(options); !s.ok()) return s;
+  for (const cv::Point& p : options.attention_points) {
+    if (p.x < 0 || p.y < 0 || p.x >= frame.width() || p.y >= frame.height()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "attention_points: (", p.x, ", ", p.y, ") lies outside the ",
+          frame.width(), "x", frame.height(), " frame"));
+    }
+  }
+  if (svm == nullptr) {
+    return absl::FailedPreconditionError(
+        "segment-incremental: no relation SVM is loaded");
+  }
+  SegmentSummary summary;
+  absl::StatusOr<PreparedScene> scene =
+      PrepareScene(frame, options.detect, interrupt);
+  if (!scene.ok()) return scene.status();
+  summary.timings = scene->timings;
+
+  std::vector<AttentionPoint> points;
+  cv::Mat saliency;
+  if (!options.attention_points.empty()) {
+    const float sigma = static_cast<float>(
+        options.attention_sigma_px * frame.intrinsics.fx / kReferenceFocalPx);
+    saliency = AttentionPointsSaliency(options.attention_points,
+                                       frame.depth.size(), sigma);
+    for (const cv::Point& p : options.attention_points) {
+      AttentionPoint a;
+      a.u = p.x;
+      a.v = p.y;
+      a.saliency = saliency.at<float>(p);
+      const cv::Vec3f& q = scene->cloud.xyz.at<cv::Vec3f>(p);
+      a.point = {q[0], q[1], q[2]};
+      points.push_back(a);
+    }
+  } else {
+    absl::StatusOr<DetectResult> detect =
+        DetectOnScene(*scene, options.detect, interrupt);
+    if (!detect.ok()) return detect.status();
+    summary.timings.insert(summary.timings.end(), detect->timings.begin(),
+                           detect->timings.end());
+    saliency = std::move(detect->master);
+    points = std::move(detect->points);
+  }
+  if (sinks.points) {
+    if (absl::Status s = sinks.points(points); !s.ok()) return s;
+  }
+  if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
+
+  SteadyClock::time_point lap = SteadyClock::now();
+  absl::StatusOr<IncScene> inc =
+      BuildIncScene(scene->cloud, scene->plane, saliency, options.inc);
+  if (!inc.ok()) return inc.status();
+  IncSegmenter segmenter(*inc, *svm, options.inc);
+  summary.timings.push_back({"segment.prepare", SecondsSince(lap)});
+
+  while (true) {
+    if (options.max_objects > 0 && summary.objects >= options.max_objects) {
+      summary.stop = SegmentStop::kMaxObjects;
+      break;
+    }
+    if (options.time_budget_seconds > 0.0 &&
+        SecondsSince(start) >= options.time_budget_seconds) {
+      summary.stop = SegmentStop::kTimeBudget;
+      break;
+    }
+    if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
+    lap = SteadyClock::now();
+    absl::StatusOr<std::optional<IncObject>> next = segmenter.Next(interrupt);
+    if (!next.ok()) return next.status();
+    summary.timings.push_back({"segment.object", SecondsSince(lap)});
+    if (!next->has_value()) break;  // the scene is exhausted
+    SegmentedObject object;
+    object.index = summary.objects++;
+    object.seed.u = (*next)->seed.x;
+    object.seed.v = (*next)->seed.y;
+    object.seed.saliency = static_cast<float>((*next)->saliency);
+    const cv::Vec3f& q = scene->cloud.xyz.at<cv::Vec3f>((*next)->seed);
+    object.seed.point = {q[0], q[1], q[2]};
+    object.mask = std::move((*next)->mask);
+    object.score = (*next)->score;
+    DescribeObject(scene->cloud, object);
+    object.seconds_since_start = SecondsSince(start);
+    if (sinks.object) {
+      if (absl::Status s = sinks.object(std::move(object)); !s.ok()) return s;
+    }
+  }
+  summary.scene_coverage = segmenter.coverage();
+  summary.total_seconds = SecondsSince(start);
+  return summary;
+}
+
+}  // namespace
+
+absl::Status Validate(const IncrementalOptions& options) {
+  if (absl::Status s = Validate(options.detect); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("detect: ", s.message()));
+  }
+  if (absl::Status s = Validate(options.inc); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("inc.", s.message()));
+  }
+  if (options.attention_points.size() >
+      static_cast<size_t>(kMaxAttentionPoints)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("attention_points: ", options.attention_points.size(),
+                     " given, at most ", kMaxAttentionPoints, " allowed"));
+  }
+  if (!(options.attention_sigma_px > 0.0f)) {
+    return absl::InvalidArgumentError("attention_sigma_px must be positive");
+  }
+  if (options.max_objects < 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "max_objects must not be negative, got ", options.max_objects));
+  }
+  if (!(options.time_budget_seconds >= 0.0) ||
+      !std::isfinite(options.time_budget_seconds)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("time_budget_seconds must be a non-negative number, got ",
+                     options.time_budget_seconds));
+  }
+  return absl::OkStatus();
+}
+
+cv::Mat AttentionPointsSaliency(const std::vector<cv::Point>& points,
+                                cv::Size size, float sigma_px) {
+  cv::Mat map(size, CV_32FC1, cv::Scalar(0));
+  const double n = static_cast<double>(points.size());
+  const double two_s2 = 2.0 * sigma_px * sigma_px;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const double weight = (n - static_cast<double>(i)) / n;
+    for (int v = 0; v < size.height; ++v) {
+      float* row = map.ptr<float>(v);
+      const double dv = v - points[i].y;
+      for (int u = 0; u < size.width; ++u) {
+        const double du = u - points[i].x;
+        row[u] += static_cast<float>(weight *
+                                     std::exp(-(du * du + dv * dv) / two_s2));
+      }
+    }
+  }
+  double max_value = 0.0;
+  cv::minMaxLoc(map, nullptr, &max_value);
+  if (max_value > 0.0) map /= max_value;
+  return map;
+}
+
+absl::StatusOr<SegmentSummary> RunSegmentIncremental(
+    const RgbdFrame& frame, const IncrementalOptions& options,
+    const RbfSvm* relation_svm, const SegmentSinks& sinks,
+    const InterruptCheck& interrupt, SteadyClock::time_point start) {
+  // Nothing throws out of core/.
+  try {
+    return RunUnguarded(frame, options, relation_svm, sinks, interrupt, start);
+  } catch (const std::bad_alloc&) {
+    return absl::ResourceExhaustedError("segment-incremental: out of memory");
+  } catch (const std::exception& e) {
+    return absl::InternalError(absl::StrCat("segment-incremental: ", e.what()));
+  }
+}
+
+absl::StatusOr<std::vector<SvmSample>> CollectIncSamples(
+    const LabelledFrame& frame, int group, const DetectOptions& detect,
+    const IncOptions& inc) {
+  try {
+    absl::StatusOr<PreparedScene> scene = PrepareScene(frame.frame, detect);
+    if (!scene.ok()) return scene.status();
+    const cv::Mat flat(frame.frame.depth.size(), CV_32FC1, cv::Scalar(0));
+    absl::StatusOr<IncScene> inc_scene =
+        BuildIncScene(scene->cloud, scene->plane, flat, inc);
+    if (!inc_scene.ok()) return inc_scene.status();
+    return IncTrainingSamples(*inc_scene, frame.labels, group);
+  } catch (const std::bad_alloc&) {
+    return absl::ResourceExhaustedError("inc samples: out of memory");
+  } catch (const std::exception& e) {
+    return absl::InternalError(absl::StrCat("inc samples: ", e.what()));
+  }
+}
+
+}  // namespace fovea

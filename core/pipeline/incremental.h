@@ -1,0 +1,68 @@
+#ifndef FOVEA_CORE_PIPELINE_INCREMENTAL_H_
+#define FOVEA_CORE_PIPELINE_INCREMENTAL_H_
+
+#include <chrono>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/base/interrupt.h"
+#include "core/frame/osd_pcd.h"
+#include "core/frame/rgbd_frame.h"
+#include "core/pipeline/detect.h"
+#include "core/pipeline/segment.h"
+#include "core/segmentation/inc.h"
+#include "core/segmentation/rbf_svm.h"
+
+namespace fovea {
+
+// Anytime incremental segmentation (thesis section 3.3): objects in order
+// of saliency, each as soon as it is final, until the scene is exhausted,
+// max_objects are out or the time budget is spent.
+
+struct IncrementalOptions {
+  // Saliency: a Gaussian at each of these pixels (x = column u, y = row v)
+  // when given, weighted (n - i) / n for the i-th of n so that the first is
+  // the most salient (section 3.3.3); otherwise Detect's master map with
+  // `detect` (SYM3D by default). `detect` prepares the scene either way.
+  std::vector<cv::Point> attention_points;
+  // The Gaussians' standard deviation at a 525 px focal length, scaled by
+  // fx / 525, pixels: about a small object's radius at a metre.
+  float attention_sigma_px = 20.0f;
+  DetectOptions detect;
+  int max_objects = 0;               // 0: no limit
+  double time_budget_seconds = 0.0;  // 0: no budget; checked between objects
+  IncOptions inc;
+};
+
+// INVALID_ARGUMENT naming the field.
+absl::Status Validate(const IncrementalOptions& options);
+
+// The saliency map of section 3.3.3 for given attention points (CV_32FC1,
+// `size`, max 1), as IncrementalOptions describes.
+cv::Mat AttentionPointsSaliency(const std::vector<cv::Point>& points,
+                                cv::Size size, float sigma_px);
+
+// Runs INC: the points sink gets the attention points used (given ones, or
+// Detect's), then each object goes to the object sink as it is final. The
+// summary's stop is kDone (every surface left the scene), kMaxObjects or
+// kTimeBudget; scene_coverage is the fraction of non-table surface pixels
+// that left the scene. Errors: Validate's; FAILED_PRECONDITION without the
+// relation SVM; NOT_FOUND without a support plane; `interrupt`'s (checked
+// between stages and at every growth step); a sink's.
+absl::StatusOr<SegmentSummary> RunSegmentIncremental(
+    const RgbdFrame& frame, const IncrementalOptions& options,
+    const RbfSvm* relation_svm, const SegmentSinks& sinks,
+    const InterruptCheck& interrupt = {},
+    std::chrono::steady_clock::time_point start =
+        std::chrono::steady_clock::now());
+
+// Relation SVM training examples of one labelled frame (IncTrainingSamples
+// on the scene `detect` prepares).
+absl::StatusOr<std::vector<SvmSample>> CollectIncSamples(
+    const LabelledFrame& frame, int group, const DetectOptions& detect,
+    const IncOptions& inc);
+
+}  // namespace fovea
+
+#endif  // FOVEA_CORE_PIPELINE_INCREMENTAL_H_

@@ -1,0 +1,290 @@
+#include "core/segmentation/inc.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <opencv2/imgproc.hpp>
+#include <set>
+#include <tuple>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+
+namespace fovea {
+namespace {
+
+uint64_t PairKey(int a, int b) {
+  return (static_cast<uint64_t>(std::min(a, b)) << 32) |
+         static_cast<uint32_t>(std::max(a, b));
+}
+
+// A pixel of the mask nearest its centroid (a point on the object to
+// report as the seed).
+cv::Point CentralPixel(const cv::Mat& mask) {
+  const cv::Moments m = cv::moments(mask, true);
+  if (m.m00 <= 0) return {0, 0};
+  const cv::Point2d c(m.m10 / m.m00, m.m01 / m.m00);
+  cv::Point best(0, 0);
+  double best_d = 1e30;
+  for (int v = 0; v < mask.rows; ++v) {
+    const unsigned char* row = mask.ptr<unsigned char>(v);
+    for (int u = 0; u < mask.cols; ++u) {
+      if (row[u] == 0) continue;
+      const double d = (u - c.x) * (u - c.x) + (v - c.y) * (v - c.y);
+      if (d < best_d) {
+        best_d = d;
+        best = {u, v};
+      }
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+absl::Status Validate(const IncOptions& options) {
+  if (absl::Status s = Validate(options.surfaces); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("surfaces.", s.message()));
+  }
+  if (absl::Status s = Validate(options.relations); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("relations.", s.message()));
+  }
+  if (!(options.k > 0.0) || !std::isfinite(options.k)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("k must be positive, got ", options.k));
+  }
+  if (options.min_object_points < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("min_object_points must not be negative, got ",
+                     options.min_object_points));
+  }
+  if (options.max_growth_steps < 1) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "max_growth_steps must be positive, got ", options.max_growth_steps));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<IncScene> BuildIncScene(const OrganizedCloud& cloud,
+                                       const SupportPlane& plane,
+                                       const cv::Mat& saliency_map,
+                                       const IncOptions& options) {
+  if (absl::Status s = Validate(options); !s.ok()) return s;
+  if (saliency_map.type() != CV_32FC1 ||
+      saliency_map.size() != cloud.xyz.size()) {
+    return absl::InvalidArgumentError(
+        "saliency map must be CV_32FC1 of the cloud's size");
+  }
+  absl::StatusOr<CosScene> surfaces =
+      BuildCosScene(cloud, plane, options.surfaces);
+  if (!surfaces.ok()) return surfaces.status();
+  IncScene scene;
+  scene.surfaces = *std::move(surfaces);
+  const cv::Mat& labels = scene.surfaces.patches.labels;
+  const int n = static_cast<int>(scene.surfaces.patches.patches.size());
+  scene.relations =
+      std::make_unique<RelationComputer>(cloud, labels, n, options.relations);
+  // Eq. 3.6: a surface's saliency is the mean saliency of its points.
+  std::vector<double> sum(n, 0.0);
+  std::vector<int> count(n, 0);
+  for (int v = 0; v < labels.rows; ++v) {
+    const int* label = labels.ptr<int>(v);
+    const float* s = saliency_map.ptr<float>(v);
+    for (int u = 0; u < labels.cols; ++u) {
+      const int l = label[u];
+      if (l < 0) continue;
+      sum[l] += std::isnan(s[u]) ? 0.0 : s[u];
+      ++count[l];
+    }
+  }
+  scene.saliency.assign(n, 0.0);
+  for (int l = 0; l < n; ++l) {
+    if (count[l] > 0) scene.saliency[l] = sum[l] / count[l];
+    if (!scene.surfaces.support[l]) scene.object_points += count[l];
+  }
+  return scene;
+}
+
+IncSegmenter::IncSegmenter(const IncScene& scene, const RbfSvm& svm,
+                           const IncOptions& options)
+    : scene_(scene),
+      svm_(svm),
+      options_(options),
+      removed_(scene.surfaces.patches.patches.size(), false) {
+  for (size_t s = 0; s < removed_.size(); ++s) {
+    if (scene_.surfaces.support[s]) removed_[s] = true;
+  }
+}
+
+double IncSegmenter::coverage() const {
+  return scene_.object_points > 0
+             ? static_cast<double>(removed_points_) / scene_.object_points
+             : 1.0;
+}
+
+double IncSegmenter::SameProbability(int a, int b) {
+  const uint64_t key = PairKey(a, b);
+  const auto found = probability_.find(key);
+  if (found != probability_.end()) return found->second;
+  const double p = svm_.Probability(scene_.relations->Relate(a, b));
+  probability_.emplace(key, p);
+  return p;
+}
+
+std::vector<int> IncSegmenter::GroupOf(const std::vector<int>& selection,
+                                       int seed, double* score) {
+  // Components by index into `selection`; union by the merge criterion.
+  const int n = static_cast<int>(selection.size());
+  std::map<int, int> index;
+  for (int i = 0; i < n; ++i) index[selection[i]] = i;
+  const std::vector<PlanarPatch>& patches = scene_.surfaces.patches.patches;
+
+  std::vector<int> parent(n), members(n, 1), version(n, 0);
+  std::vector<double> internal(n, 0.0);
+  for (int i = 0; i < n; ++i) parent[i] = i;
+  auto find = [&parent](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  // Eq. 3.7: the weight between two groups is the mean of their surface
+  // pairs' weights, each weighted by the pair's points; kept as sums.
+  struct EdgeSums {
+    double weighted = 0.0;
+    double weights = 0.0;
+    double Weight() const { return weighted / weights; }
+  };
+  std::vector<std::map<int, EdgeSums>> edges(n);
+  for (int i = 0; i < n; ++i) {
+    for (const int neighbour : scene_.surfaces.neighbours[selection[i]]) {
+      const auto j = index.find(neighbour);
+      if (j == index.end() || j->second <= i) continue;
+      const double w = 1.0 - SameProbability(selection[i], neighbour);
+      const double points =
+          patches[selection[i]].points + patches[neighbour].points;
+      EdgeSums sums{points * w, points};
+      edges[i][j->second] = sums;
+      edges[j->second][i] = sums;
+    }
+  }
+  // Edges in increasing weight; an entry is stale once either end's
+  // version changed.
+  std::set<std::tuple<double, int, int, int, int>> queue;
+  for (int i = 0; i < n; ++i) {
+    for (const auto& [j, sums] : edges[i]) {
+      if (i < j) queue.emplace(sums.Weight(), i, j, 0, 0);
+    }
+  }
+  double merged_p_sum = 0.0;
+  int merged = 0;
+  while (!queue.empty()) {
+    const auto [w, a, b, va, vb] = *queue.begin();
+    queue.erase(queue.begin());
+    if (find(a) != a || find(b) != b || version[a] != va || version[b] != vb) {
+      continue;
+    }
+    const double threshold = std::min(internal[a] + options_.k / members[a],
+                                      internal[b] + options_.k / members[b]);
+    if (w > threshold) continue;
+    // Merge b into a; its edges join a's, summed where both had one.
+    parent[b] = a;
+    members[a] += members[b];
+    internal[a] = std::max({internal[a], internal[b], w});
+    merged_p_sum += 1.0 - w;
+    ++merged;
+    edges[a].erase(b);
+    for (const auto& [c, sums] : edges[b]) {
+      if (c == a) continue;
+      EdgeSums& ac = edges[a][c];
+      ac.weighted += sums.weighted;
+      ac.weights += sums.weights;
+      edges[c].erase(b);
+      edges[c][a] = ac;
+    }
+    edges[b].clear();
+    // The order is kept right after the merge: a's edges re-enter with
+    // their new weights.
+    ++version[a];
+    for (const auto& [c, sums] : edges[a]) {
+      queue.emplace(sums.Weight(), std::min(a, c), std::max(a, c),
+                    version[std::min(a, c)], version[std::max(a, c)]);
+    }
+  }
+  const int root = find(index.at(seed));
+  std::vector<int> group;
+  for (int i = 0; i < n; ++i) {
+    if (find(i) == root) group.push_back(selection[i]);
+  }
+  std::sort(group.begin(), group.end());
+  if (score != nullptr) *score = merged > 0 ? merged_p_sum / merged : 1.0;
+  return group;
+}
+
+absl::StatusOr<std::optional<IncObject>> IncSegmenter::Next(
+    const InterruptCheck& interrupt) {
+  const std::vector<PlanarPatch>& patches = scene_.surfaces.patches.patches;
+  while (true) {
+    int seed = -1;
+    for (size_t s = 0; s < patches.size(); ++s) {
+      if (removed_[s]) continue;
+      if (seed < 0 || scene_.saliency[s] > scene_.saliency[seed] ||
+          (scene_.saliency[s] == scene_.saliency[seed] &&
+           patches[s].points > patches[seed].points)) {
+        seed = static_cast<int>(s);
+      }
+    }
+    if (seed < 0) return std::nullopt;
+
+    IncObject object;
+    object.seed_surface = seed;
+    object.saliency = scene_.saliency[seed];
+    std::vector<int> selection = {seed};
+    std::vector<int> group = {seed};
+    for (int step = 0; step < options_.max_growth_steps; ++step) {
+      if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
+      std::set<int> grown(selection.begin(), selection.end());
+      for (const int s : selection) {
+        for (const int t : scene_.surfaces.neighbours[s]) {
+          if (!removed_[t]) grown.insert(t);
+        }
+      }
+      if (grown.size() == selection.size()) break;  // nothing new around
+      selection.assign(grown.begin(), grown.end());
+      double score = 1.0;
+      std::vector<int> next = GroupOf(selection, seed, &score);
+      object.growth_steps = step + 1;
+      object.score = score;
+      const bool stable = next == group && step > 0;
+      group = std::move(next);
+      if (stable) break;
+    }
+    object.surfaces = group;
+    int points = 0;
+    for (const int s : group) {
+      removed_[s] = true;
+      points += patches[s].points;
+    }
+    removed_points_ += points;
+    if (points < options_.min_object_points) continue;  // noise: next
+    object.mask = PatchesMask(scene_.surfaces, group);
+    object.seed = CentralPixel(object.mask);
+    return object;
+  }
+}
+
+std::vector<SvmSample> IncTrainingSamples(const IncScene& scene,
+                                          const cv::Mat& labels, int group) {
+  const std::vector<int> object = PatchObjectIds(scene.surfaces, labels);
+  std::vector<SvmSample> samples;
+  for (const auto& [a, b] : scene.relations->adjacent_pairs()) {
+    if (scene.surfaces.support[a] || scene.surfaces.support[b]) continue;
+    if (object[a] == 0 && object[b] == 0) continue;
+    SvmSample sample;
+    sample.x = scene.relations->Relate(a, b);
+    sample.label = object[a] == object[b] ? 1 : -1;
+    sample.group = group;
+    samples.push_back(std::move(sample));
+  }
+  return samples;
+}
+
+}  // namespace fovea

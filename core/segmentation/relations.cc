@@ -1,0 +1,300 @@
+#include "core/segmentation/relations.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "absl/strings/str_cat.h"
+
+namespace fovea {
+namespace {
+
+constexpr int kOrientations = 4;
+constexpr int kFourierWindow = 16;
+constexpr int kFourierBands = 4;
+constexpr double kRadiansToDegrees = 180.0 / M_PI;
+
+double Clamp01(double v) { return std::min(1.0, std::max(0.0, v)); }
+
+// 1 - normalised L1 distance of two non-negative vectors: 1 for equal
+// ones, 0 for disjoint ones; 1 when both are empty.
+double ProfileSimilarity(const std::vector<double>& a,
+                         const std::vector<double>& b) {
+  double diff = 0.0, total = 0.0;
+  for (size_t i = 0; i < a.size() && i < b.size(); ++i) {
+    diff += std::abs(a[i] - b[i]);
+    total += a[i] + b[i];
+  }
+  return total > 0.0 ? 1.0 - diff / total : 1.0;
+}
+
+// Each vector scaled to sum 1 (left as is when it sums to 0).
+void Normalize(std::vector<double>& v) {
+  double sum = 0.0;
+  for (const double x : v) sum += x;
+  if (sum <= 0.0) return;
+  for (double& x : v) x /= sum;
+}
+
+// Per label, the mean absolute response of each filter of a Gabor bank on
+// the half-resolution grey image.
+std::vector<std::vector<double>> GaborEnergies(const cv::Mat& grey_half,
+                                               const cv::Mat& labels_half,
+                                               int count,
+                                               const RelationOptions& options) {
+  const int filters =
+      kOrientations * static_cast<int>(options.gabor_wavelengths_px.size());
+  std::vector<std::vector<double>> energy(count,
+                                          std::vector<double>(filters, 0.0));
+  std::vector<int> n(count, 0);
+  for (int v = 0; v < labels_half.rows; ++v) {
+    for (int u = 0; u < labels_half.cols; ++u) {
+      const int l = labels_half.at<int>(v, u);
+      if (l >= 0 && l < count) ++n[l];
+    }
+  }
+  int f = 0;
+  for (const float lambda : options.gabor_wavelengths_px) {
+    for (int o = 0; o < kOrientations; ++o, ++f) {
+      const int size = 2 * static_cast<int>(std::ceil(lambda)) + 1;
+      const cv::Mat kernel = cv::getGaborKernel(
+          cv::Size(size, size), 0.5 * lambda, o * M_PI / kOrientations, lambda,
+          1.0, 0.0, CV_32F);
+      cv::Mat response;
+      cv::filter2D(grey_half, response, CV_32F, kernel);
+      for (int v = 0; v < labels_half.rows; ++v) {
+        const int* label = labels_half.ptr<int>(v);
+        const float* r = response.ptr<float>(v);
+        for (int u = 0; u < labels_half.cols; ++u) {
+          if (label[u] >= 0 && label[u] < count) {
+            energy[label[u]][f] += std::abs(r[u]);
+          }
+        }
+      }
+    }
+  }
+  for (int l = 0; l < count; ++l) {
+    if (n[l] > 0) {
+      for (double& e : energy[l]) e /= n[l];
+    }
+    Normalize(energy[l]);
+  }
+  return energy;
+}
+
+// Per label, DFT magnitude energy in 4 radial bands (DC left out) of up to
+// options.fourier_windows 16x16 windows lying mostly on the label.
+std::vector<std::vector<double>> FourierEnergies(
+    const cv::Mat& grey_half, const cv::Mat& labels_half, int count,
+    const RelationOptions& options) {
+  std::vector<std::vector<double>> bands(
+      count, std::vector<double>(kFourierBands, 0.0));
+  std::vector<int> windows(count, 0);
+  const int step = kFourierWindow / 2;
+  for (int v = 0; v + kFourierWindow <= labels_half.rows; v += step) {
+    for (int u = 0; u + kFourierWindow <= labels_half.cols; u += step) {
+      const int l = labels_half.at<int>(v + step, u + step);
+      if (l < 0 || l >= count || windows[l] >= options.fourier_windows) {
+        continue;
+      }
+      const cv::Rect window(u, v, kFourierWindow, kFourierWindow);
+      if (cv::countNonZero(labels_half(window) == l) <
+          kFourierWindow * kFourierWindow * 3 / 4) {
+        continue;
+      }
+      cv::Mat patch;
+      grey_half(window).convertTo(patch, CV_32F);
+      patch -= cv::mean(patch)[0];
+      cv::Mat spectrum;
+      cv::dft(patch, spectrum, cv::DFT_COMPLEX_OUTPUT);
+      for (int y = 0; y < kFourierWindow; ++y) {
+        for (int x = 0; x < kFourierWindow; ++x) {
+          const int fy = std::min(y, kFourierWindow - y);
+          const int fx = std::min(x, kFourierWindow - x);
+          const double r = std::hypot(fx, fy);
+          if (r < 1.0) continue;
+          const int band = std::min(
+              kFourierBands - 1,
+              static_cast<int>(r * kFourierBands / (kFourierWindow / 2 + 1)));
+          const cv::Vec2f c = spectrum.at<cv::Vec2f>(y, x);
+          bands[l][band] += std::hypot(c[0], c[1]);
+        }
+      }
+      ++windows[l];
+    }
+  }
+  for (std::vector<double>& b : bands) Normalize(b);
+  return bands;
+}
+
+}  // namespace
+
+absl::Status Validate(const RelationOptions& options) {
+  if (absl::Status s = Validate(options.color); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("color.", s.message()));
+  }
+  if (options.gabor_wavelengths_px.empty()) {
+    return absl::InvalidArgumentError("gabor_wavelengths_px must not be empty");
+  }
+  for (const float w : options.gabor_wavelengths_px) {
+    if (!(w >= 2.0f && w <= 32.0f)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("gabor_wavelengths_px must be in [2, 32], got ", w));
+    }
+  }
+  if (options.fourier_windows < 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "fourier_windows must not be negative, got ", options.fourier_windows));
+  }
+  if (!(options.color_scale > 0) || !(options.depth_scale > 0) ||
+      !(options.angle_scale_deg > 0)) {
+    return absl::InvalidArgumentError(
+        "color_scale, depth_scale and angle_scale_deg must be positive");
+  }
+  if (!(options.touch_depth_fraction > 0)) {
+    return absl::InvalidArgumentError("touch_depth_fraction must be positive");
+  }
+  return absl::OkStatus();
+}
+
+const std::vector<std::string>& RelationFeatureNames() {
+  static const std::vector<std::string>* const names =
+      new std::vector<std::string>{
+          "color_similarity",   "gabor_similarity",
+          "fourier_similarity", "relative_size",
+          "border_color_mean",  "border_color_variation",
+          "border_depth_mean",  "border_depth_variation",
+          "border_angle_mean",  "border_angle_variation",
+          "border_3d_fraction", "curvature_similarity"};
+  return *names;
+}
+
+uint64_t RelationComputer::Key(int a, int b) {
+  return (static_cast<uint64_t>(std::min(a, b)) << 32) |
+         static_cast<uint32_t>(std::max(a, b));
+}
+
+RelationComputer::RelationComputer(const OrganizedCloud& cloud,
+                                   const cv::Mat& labels, int count,
+                                   const RelationOptions& options)
+    : options_(options), points_(count, 0), curvature_(count, 0.0) {
+  histograms_ = LabelColorHistograms(cloud.color, labels, count, options.color);
+  cv::Mat grey, grey_half, labels_half;
+  cv::cvtColor(cloud.color, grey, cv::COLOR_RGB2GRAY);
+  cv::resize(grey, grey_half, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+  cv::resize(labels, labels_half, grey_half.size(), 0, 0, cv::INTER_NEAREST);
+  cv::Mat grey_float;
+  grey_half.convertTo(grey_float, CV_32F, 1.0 / 255.0);
+  gabor_ = GaborEnergies(grey_float, labels_half, count, options);
+  fourier_ = FourierEnergies(grey_half, labels_half, count, options);
+
+  cv::Mat lab;
+  cv::Mat color_float;
+  cloud.color.convertTo(color_float, CV_32FC3, 1.0 / 255.0);
+  cv::cvtColor(color_float, lab, cv::COLOR_RGB2Lab);
+  // Mean normals, then each surface's mean deviation from it.
+  std::vector<Eigen::Vector3d> mean_normal(count, Eigen::Vector3d::Zero());
+  for (int v = 0; v < labels.rows; ++v) {
+    for (int u = 0; u < labels.cols; ++u) {
+      const int l = labels.at<int>(v, u);
+      if (l < 0 || l >= count) continue;
+      ++points_[l];
+      const cv::Vec3f& n = cloud.normals.at<cv::Vec3f>(v, u);
+      if (!std::isnan(n[2]))
+        mean_normal[l] += Eigen::Vector3d(n[0], n[1], n[2]);
+    }
+  }
+  std::vector<int> with_normal(count, 0);
+  for (int v = 0; v < labels.rows; ++v) {
+    for (int u = 0; u < labels.cols; ++u) {
+      const int l = labels.at<int>(v, u);
+      if (l < 0 || l >= count) continue;
+      const cv::Vec3f& n = cloud.normals.at<cv::Vec3f>(v, u);
+      if (std::isnan(n[2]) || mean_normal[l].norm() == 0.0) continue;
+      curvature_[l] += 1.0 - std::abs(Eigen::Vector3d(n[0], n[1], n[2])
+                                          .dot(mean_normal[l].normalized()));
+      ++with_normal[l];
+    }
+  }
+  for (int l = 0; l < count; ++l) {
+    if (with_normal[l] > 0) curvature_[l] /= with_normal[l];
+  }
+
+  // Borders: every 4-adjacent pixel pair of two surfaces.
+  for (int v = 0; v < labels.rows; ++v) {
+    for (int u = 0; u < labels.cols; ++u) {
+      const int a = labels.at<int>(v, u);
+      if (a < 0 || a >= count) continue;
+      for (const cv::Point d : {cv::Point(1, 0), cv::Point(0, 1)}) {
+        const int x = u + d.x;
+        const int y = v + d.y;
+        if (x >= labels.cols || y >= labels.rows) continue;
+        const int b = labels.at<int>(y, x);
+        if (b < 0 || b >= count || b == a) continue;
+        Border& border = borders_[Key(a, b)];
+        ++border.pixels;
+        const float za = cloud.xyz.at<cv::Vec3f>(v, u)[2];
+        const float zb = cloud.xyz.at<cv::Vec3f>(y, x)[2];
+        if (!std::isnan(za) && !std::isnan(zb)) {
+          const double step = std::abs(za - zb) / std::max(za, zb);
+          border.depth_sum += step;
+          border.depth_sq += step * step;
+          if (step <= options.touch_depth_fraction) ++border.touching;
+        }
+        const cv::Vec3f& la = lab.at<cv::Vec3f>(v, u);
+        const cv::Vec3f& lb = lab.at<cv::Vec3f>(y, x);
+        const double color = cv::norm(la - lb);
+        border.color_sum += color;
+        border.color_sq += color * color;
+        const cv::Vec3f& na = cloud.normals.at<cv::Vec3f>(v, u);
+        const cv::Vec3f& nb = cloud.normals.at<cv::Vec3f>(y, x);
+        if (!std::isnan(na[2]) && !std::isnan(nb[2])) {
+          const double angle =
+              std::acos(
+                  std::min(1.0, std::abs(static_cast<double>(na.dot(nb))))) *
+              kRadiansToDegrees;
+          border.angle_sum += angle;
+          border.angle_sq += angle * angle;
+        }
+      }
+    }
+  }
+  for (const auto& [key, border] : borders_) {
+    pairs_.emplace_back(static_cast<int>(key >> 32),
+                        static_cast<int>(key & 0xffffffffu));
+  }
+  std::sort(pairs_.begin(), pairs_.end());
+}
+
+std::vector<double> RelationComputer::Relate(int a, int b) const {
+  std::vector<double> f(RelationFeatureNames().size(), 0.0);
+  f[0] = 0.5 * (1.0 + HistogramCorrelation(histograms_[a], histograms_[b]));
+  f[1] = ProfileSimilarity(gabor_[a], gabor_[b]);
+  f[2] = ProfileSimilarity(fourier_[a], fourier_[b]);
+  f[3] = points_[a] > 0 && points_[b] > 0
+             ? static_cast<double>(std::min(points_[a], points_[b])) /
+                   std::max(points_[a], points_[b])
+             : 0.0;
+  const auto found = borders_.find(Key(a, b));
+  if (found != borders_.end() && found->second.pixels > 0) {
+    const Border& border = found->second;
+    const double n = border.pixels;
+    auto mean_std = [n](double sum, double sq, double scale) {
+      const double mean = sum / n;
+      const double var = std::max(0.0, sq / n - mean * mean);
+      return std::pair<double, double>(Clamp01(mean / scale),
+                                       Clamp01(std::sqrt(var) / scale));
+    };
+    std::tie(f[4], f[5]) =
+        mean_std(border.color_sum, border.color_sq, options_.color_scale);
+    std::tie(f[6], f[7]) =
+        mean_std(border.depth_sum, border.depth_sq, options_.depth_scale);
+    std::tie(f[8], f[9]) =
+        mean_std(border.angle_sum, border.angle_sq, options_.angle_scale_deg);
+    f[10] = border.touching / n;
+  }
+  f[11] = Clamp01(1.0 - std::abs(curvature_[a] - curvature_[b]) * 10.0);
+  return f;
+}
+
+}  // namespace fovea
