@@ -101,8 +101,7 @@ v1::Capabilities BuildCapabilities(
     model->set_name(name);
     model->set_version(version);
   }
-  // Incremental segmentation arrives with its issue.
-  out.set_segment_incremental(false);
+  out.set_segment_incremental(true);
   *out.mutable_default_detect_options() = ToProtoDetectOptions(DetectOptions{});
   return out;
 }

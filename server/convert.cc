@@ -8,9 +8,35 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/strings.h"
 
 namespace fovea::server {
 namespace {
+
+// Pixels of a request as cv::Points; INVALID_ARGUMENT naming `field` for
+// too many or for coordinates beyond any frame (core checks the frame's
+// own size).
+absl::StatusOr<std::vector<cv::Point>> ToPixels(
+    const google::protobuf::RepeatedPtrField<v1::AttentionPixel>& pixels,
+    std::string_view field) {
+  if (pixels.size() > kMaxAttentionPoints) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(AbslView(field), ": ", pixels.size(), " given, at most ",
+                     kMaxAttentionPoints, " allowed"));
+  }
+  constexpr uint32_t kMaxCoordinate = 1 << 16;
+  std::vector<cv::Point> points;
+  for (int i = 0; i < pixels.size(); ++i) {
+    const v1::AttentionPixel& p = pixels.Get(i);
+    if (p.u() >= kMaxCoordinate || p.v() >= kMaxCoordinate) {
+      return absl::InvalidArgumentError(absl::StrCat(AbslView(field), "[", i,
+                                                     "]: (", p.u(), ", ", p.v(),
+                                                     ") is beyond any frame"));
+    }
+    points.emplace_back(static_cast<int>(p.u()), static_cast<int>(p.v()));
+  }
+  return points;
+}
 
 // Largest value of one channel of `target_color_rgb`.
 constexpr uint32_t kMaxColorValue = 255;
@@ -553,24 +579,37 @@ absl::StatusOr<SegmentOptions> ToSegmentOptions(
       return absl::InvalidArgumentError(absl::StrCat(
           "method: unknown value ", static_cast<int>(request.method())));
   }
-  if (request.seeds_size() > kMaxAttentionPoints) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("seeds: ", request.seeds_size(), " given, at most ",
-                     kMaxAttentionPoints, " allowed"));
-  }
-  for (int i = 0; i < request.seeds_size(); ++i) {
-    const v1::AttentionPixel& p = request.seeds(i);
-    // Beyond any frame a server accepts; core checks the frame's size.
-    constexpr uint32_t kMaxCoordinate = 1 << 16;
-    if (p.u() >= kMaxCoordinate || p.v() >= kMaxCoordinate) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "seeds[", i, "]: (", p.u(), ", ", p.v(), ") is beyond any frame"));
-    }
-    options.seeds.emplace_back(static_cast<int>(p.u()),
-                               static_cast<int>(p.v()));
-  }
+  absl::StatusOr<std::vector<cv::Point>> seeds =
+      ToPixels(request.seeds(), "seeds");
+  if (!seeds.ok()) return seeds.status();
+  options.seeds = *std::move(seeds);
   options.max_objects =
       static_cast<int>(std::min<uint32_t>(request.max_objects(), 1u << 20));
+  return options;
+}
+
+absl::StatusOr<IncrementalOptions> ToIncrementalOptions(
+    const v1::SegmentIncrementalRequest& request) {
+  IncrementalOptions options;
+  absl::StatusOr<DetectOptions> detect =
+      ToDetectOptions(request.detect_options());
+  if (!detect.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("detect_options.", detect.status().message()));
+  }
+  options.detect = *std::move(detect);
+  absl::StatusOr<std::vector<cv::Point>> points =
+      ToPixels(request.attention_points(), "attention_points");
+  if (!points.ok()) return points.status();
+  options.attention_points = *std::move(points);
+  options.max_objects =
+      static_cast<int>(std::min<uint32_t>(request.max_objects(), 1u << 20));
+  const double budget = request.time_budget_seconds();
+  if (!std::isfinite(budget) || budget < 0.0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "time_budget_seconds: must be a finite number >= 0, got ", budget));
+  }
+  options.time_budget_seconds = budget;
   return options;
 }
 

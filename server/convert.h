@@ -7,6 +7,7 @@
 #include "absl/status/statusor.h"
 #include "core/frame/frame_decode.h"
 #include "core/pipeline/detect.h"
+#include "core/pipeline/incremental.h"
 #include "core/pipeline/segment.h"
 #include "fovea/v1/detect.pb.h"
 #include "fovea/v1/frame.pb.h"
@@ -83,6 +84,13 @@ absl::StatusOr<v1::DetectResponse> ToDetectResponse(
 // or a coordinate beyond any frame, method: unknown value).
 absl::StatusOr<SegmentOptions> ToSegmentOptions(
     const v1::SegmentRequest& request);
+
+// SegmentIncremental's options: attention_points as given (checked against
+// the frame by core), detect_options as ToDetectOptions, max_objects (0 =
+// no limit), time_budget_seconds (0 = none; negative or not finite is
+// INVALID_ARGUMENT naming it).
+absl::StatusOr<IncrementalOptions> ToIncrementalOptions(
+    const v1::SegmentIncrementalRequest& request);
 
 // COCO RLE (segment.proto RleMask) of a CV_8UC1 mask, non-zero = inside.
 v1::RleMask ToRleMask(const cv::Mat& mask);

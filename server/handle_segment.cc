@@ -6,46 +6,86 @@
 #include "server/metrics.h"
 
 namespace fovea::server {
+namespace {
 
-absl::Status HandleSegment(const v1::SegmentRequest& request,
-                           const SegmentOptions& options,
-                           const SegmentModels& models,
-                           const FrameLimits& limits,
-                           const InterruptCheck& interrupt,
-                           const SendMessage& send, Clock::time_point start,
-                           double queue_seconds) {
-  RecordStage("queue", queue_seconds);
+v1::StopReason ToStopReason(SegmentStop stop) {
+  switch (stop) {
+    case SegmentStop::kMaxObjects:
+      return v1::MAX_OBJECTS;
+    case SegmentStop::kTimeBudget:
+      return v1::TIME_BUDGET;
+    case SegmentStop::kDone:
+      break;
+  }
+  return v1::DONE;
+}
+
+// Decodes the frame, runs `run` with sinks that send each message, then
+// sends the summary; records the metrics of `method`.
+template <typename Run>
+absl::Status Stream(std::string_view method, const v1::Frame& wire_frame,
+                    const std::string& request_id,
+                    const SegmentHandlerContext& context, Run run) {
+  RecordStage("queue", context.queue_seconds);
   const Clock::time_point decode_start = Clock::now();
   absl::StatusOr<RgbdFrame> frame =
-      DecodeFrame(ToRawFrame(request.frame()), limits);
+      DecodeFrame(ToRawFrame(wire_frame), context.limits);
   if (!frame.ok()) return frame.status();
   RecordStage("decode", SecondsSince(decode_start));
-  if (absl::Status status = CheckInterrupt(interrupt); !status.ok()) {
+  if (absl::Status status = CheckInterrupt(context.interrupt); !status.ok()) {
     return status;
   }
-
-  const std::string& id = request.request_id();
   int objects = 0;
   SegmentSinks sinks;
   sinks.points = [&](const std::vector<AttentionPoint>& points) {
-    return send(ToPointsMessage(points, id));
+    return context.send(ToPointsMessage(points, request_id));
   };
   sinks.object = [&](SegmentedObject object) {
-    if (objects++ == 0) {
-      RecordFirstObject("Segment", object.seconds_since_start);
-    }
-    return send(ToObjectMessage(object, id));
+    if (objects++ == 0) RecordFirstObject(method, object.seconds_since_start);
+    return context.send(ToObjectMessage(object, request_id));
   };
-  absl::StatusOr<SegmentSummary> summary =
-      RunSegment(*frame, options, models, sinks, interrupt, start);
-  RecordObjectsPerRequest("Segment", objects);
-  if (!summary.ok()) return summary.status();
+  absl::StatusOr<SegmentSummary> summary = run(*frame, sinks);
+  RecordObjectsPerRequest(method, objects);
+  if (!summary.ok()) {
+    RecordStopReason(
+        method, summary.status().code() == absl::StatusCode::kDeadlineExceeded
+                    ? "deadline"
+                : summary.status().code() == absl::StatusCode::kCancelled
+                    ? "cancelled"
+                    : "error");
+    return summary.status();
+  }
   for (const StageTiming& timing : summary->timings) {
     RecordStage(timing.stage, timing.seconds);
   }
-  const v1::StopReason reason =
-      summary->stop == SegmentStop::kMaxObjects ? v1::MAX_OBJECTS : v1::DONE;
-  return send(ToSummaryMessage(*summary, reason, id));
+  const v1::StopReason reason = ToStopReason(summary->stop);
+  RecordStopReason(method, reason == v1::MAX_OBJECTS   ? "max_objects"
+                           : reason == v1::TIME_BUDGET ? "time_budget"
+                                                       : "done");
+  return context.send(ToSummaryMessage(*summary, reason, request_id));
+}
+
+}  // namespace
+
+absl::Status HandleSegment(const v1::SegmentRequest& request,
+                           const SegmentOptions& options,
+                           const SegmentHandlerContext& context) {
+  return Stream("Segment", request.frame(), request.request_id(), context,
+                [&](const RgbdFrame& frame, const SegmentSinks& sinks) {
+                  return RunSegment(frame, options, context.models, sinks,
+                                    context.interrupt, context.start);
+                });
+}
+
+absl::Status HandleSegmentIncremental(
+    const v1::SegmentIncrementalRequest& request,
+    const IncrementalOptions& options, const SegmentHandlerContext& context) {
+  return Stream(
+      "SegmentIncremental", request.frame(), request.request_id(), context,
+      [&](const RgbdFrame& frame, const SegmentSinks& sinks) {
+        return RunSegmentIncremental(frame, options, context.models.inc, sinks,
+                                     context.interrupt, context.start);
+      });
 }
 
 }  // namespace fovea::server

@@ -93,6 +93,11 @@ class Metrics {
                                *buckets);
   }
 
+  prometheus::Counter& Stops(std::string_view method, std::string_view reason) {
+    return stops_family_.Add({{"grpc_method", std::string(method)},
+                              {"reason", std::string(reason)}});
+  }
+
   prometheus::Gauge& inflight() { return inflight_; }
   prometheus::Histogram& queue_wait() { return queue_wait_; }
 
@@ -145,6 +150,11 @@ class Metrics {
                             .Name("fovea_objects_per_request")
                             .Help("Objects sent by one segmentation call.")
                             .Register(*registry_)),
+        stops_family_(prometheus::BuildCounter()
+                          .Name("fovea_segment_stops_total")
+                          .Help("Segmentation calls by the reason they "
+                                "stopped.")
+                          .Register(*registry_)),
         inflight_(prometheus::BuildGauge()
                       .Name("fovea_inflight_requests")
                       .Help("Calls started and not yet finished, queued "
@@ -174,6 +184,10 @@ class Metrics {
       if (kMethods[i].type == "server_stream") {
         FirstObject(kMethods[i].name);
         Objects(kMethods[i].name);
+        for (const char* reason : {"done", "max_objects", "time_budget",
+                                   "deadline", "cancelled", "error"}) {
+          Stops(kMethods[i].name, reason);
+        }
       }
       for (size_t c = 0; c < kAllStatusCodes.size(); ++c) {
         prometheus::Labels with_code = labels;
@@ -192,6 +206,7 @@ class Metrics {
   prometheus::Family<prometheus::Histogram>& stage_family_;
   prometheus::Family<prometheus::Histogram>& first_object_family_;
   prometheus::Family<prometheus::Histogram>& objects_family_;
+  prometheus::Family<prometheus::Counter>& stops_family_;
   prometheus::Gauge& inflight_;
   prometheus::Histogram& queue_wait_;
   prometheus::Family<prometheus::Gauge>& build_info_family_;
@@ -250,6 +265,10 @@ void RecordFirstObject(std::string_view method, double seconds) {
 
 void RecordObjectsPerRequest(std::string_view method, int objects) {
   Metrics::Get().Objects(method).Observe(objects);
+}
+
+void RecordStopReason(std::string_view method, std::string_view reason) {
+  Metrics::Get().Stops(method, reason).Increment();
 }
 
 void IncrementInflight() { Metrics::Get().inflight().Increment(); }

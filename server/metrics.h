@@ -38,6 +38,10 @@ namespace fovea::server {
 //                                        SegmentIncremental
 //   fovea_objects_per_request{grpc_method}  histogram: objects sent by one
 //                                        segmentation call
+//   fovea_segment_stops_total{grpc_method, reason}  counter: why each
+//                                        segmentation call stopped (done,
+//                                        max_objects, time_budget, deadline,
+//                                        cancelled, error)
 //   fovea_inflight_requests              gauge: calls started, not finished
 //   fovea_queue_wait_seconds             histogram: submit to start of work
 //   fovea_build_info{version}            gauge, always 1
@@ -68,6 +72,9 @@ void RecordQueueWait(double seconds);
 // Segmentation calls ("Segment", "SegmentIncremental").
 void RecordFirstObject(std::string_view method, double seconds);
 void RecordObjectsPerRequest(std::string_view method, int objects);
+// Why a segmentation call stopped: "done", "max_objects", "time_budget",
+// "deadline", "cancelled" or "error".
+void RecordStopReason(std::string_view method, std::string_view reason);
 void IncrementInflight();
 void DecrementInflight();
 

@@ -14,6 +14,7 @@
 #include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "core/base/strings.h"
 #include "server/capabilities.h"
 #include "server/clock.h"
 #include "server/convert.h"
@@ -178,18 +179,27 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
 // client cancels or a write fails. Finishes exactly once, after every
 // queued message was written; deletes itself in OnDone, which gRPC calls
 // only after Finish, and Finish only comes after the worker's last touch.
-class SegmentReactor final
+template <typename Request, typename Options>
+class StreamReactor final
     : public grpc::ServerWriteReactor<v1::SegmentResponse> {
  public:
-  SegmentReactor(const ServiceConfig& config, WorkQueue& work,
-                 grpc::CallbackServerContext* context,
-                 const v1::SegmentRequest* request)
-      : config_(config),
+  // Converts the request's options (a bad one fails the call at once).
+  using Convert = absl::StatusOr<Options> (*)(const Request&);
+  // The work of one call (HandleSegment, HandleSegmentIncremental).
+  using Handle = absl::Status (*)(const Request&, const Options&,
+                                  const SegmentHandlerContext&);
+
+  StreamReactor(std::string_view method, Convert convert, Handle handle,
+                const ServiceConfig& config, WorkQueue& work,
+                grpc::CallbackServerContext* context, const Request* request)
+      : method_(method),
+        handle_(handle),
+        config_(config),
         context_(context),
         request_(request),
-        call_("Segment", request->request_id()),
+        call_(method, request->request_id()),
         start_(Clock::now()) {
-    absl::StatusOr<SegmentOptions> options = ToSegmentOptions(*request);
+    absl::StatusOr<Options> options = convert(*request);
     if (!options.ok()) {
       FinishOnce(options.status());
       return;
@@ -211,7 +221,7 @@ class SegmentReactor final
         broken_ = true;
         pending_.clear();
       } else {
-        RecordMessageSent("Segment");
+        RecordMessageSent(method_);
       }
       if (!pending_.empty()) {
         StartNextWriteLocked();
@@ -244,13 +254,14 @@ class SegmentReactor final
     try {
       status = Compute();
     } catch (const std::bad_alloc&) {
-      status = absl::ResourceExhaustedError("Segment: out of memory");
+      status = absl::ResourceExhaustedError(
+          absl::StrCat(AbslView(method_), ": out of memory"));
     } catch (const std::exception& e) {
-      status = absl::InternalError(
-          absl::StrCat("Segment: unexpected exception: ", e.what()));
+      status = absl::InternalError(absl::StrCat(
+          AbslView(method_), ": unexpected exception: ", e.what()));
     } catch (...) {
-      status = absl::InternalError(
-          "Segment: unexpected exception of a non-standard type");
+      status = absl::InternalError(absl::StrCat(
+          AbslView(method_), ": unexpected exception of a non-standard type"));
     }
     FinishOnce(status);
   }
@@ -261,16 +272,19 @@ class SegmentReactor final
     if (absl::Status status = CheckInterrupt(*context_); !status.ok()) {
       return status;
     }
-    return HandleSegment(
-        *request_, options_, config_.segment_models, config_.limits,
-        [this] {
-          if (config_.at_stage_boundary) config_.at_stage_boundary();
-          return CheckInterrupt(*context_);
-        },
-        [this](v1::SegmentResponse message) {
-          return Send(std::move(message));
-        },
-        start_, queue_seconds);
+    SegmentHandlerContext handler;
+    handler.models = config_.segment_models;
+    handler.limits = config_.limits;
+    handler.interrupt = [this] {
+      if (config_.at_stage_boundary) config_.at_stage_boundary();
+      return CheckInterrupt(*context_);
+    };
+    handler.send = [this](v1::SegmentResponse message) {
+      return Send(std::move(message));
+    };
+    handler.start = start_;
+    handler.queue_seconds = queue_seconds;
+    return handle_(*request_, options_, handler);
   }
 
   // Queues one message; blocks while kMaxPendingMessages wait. CANCELLED
@@ -310,12 +324,14 @@ class SegmentReactor final
     if (now) Finish(call_.EndStream(status));
   }
 
+  const std::string_view method_;  // a string literal
+  const Handle handle_;
   const ServiceConfig& config_;
   grpc::CallbackServerContext* const context_;  // gRPC's, valid until OnDone
-  const v1::SegmentRequest* const request_;     // gRPC's, valid until OnDone
+  const Request* const request_;                // gRPC's, valid until OnDone
   CallRecord call_;
   const Clock::time_point start_;
-  SegmentOptions options_;
+  Options options_;
 
   std::mutex mutex_;
   std::condition_variable changed_;
@@ -325,22 +341,6 @@ class SegmentReactor final
   bool broken_ = false;          // guarded by mutex_
   bool finished_ = false;        // guarded by mutex_
   std::optional<absl::Status> final_status_;  // guarded by mutex_
-};
-
-// A server-streaming call refused with `status` before any message.
-class RefusedStream final
-    : public grpc::ServerWriteReactor<v1::SegmentResponse> {
- public:
-  RefusedStream(std::string_view method, std::string_view request_id,
-                const absl::Status& status)
-      : call_(method, request_id) {
-    Finish(call_.EndStream(status));
-  }
-
-  void OnDone() override { delete this; }
-
- private:
-  CallRecord call_;
 };
 
 }  // namespace
@@ -359,19 +359,18 @@ grpc::ServerUnaryReactor* PerceptionService::Detect(
 
 grpc::ServerWriteReactor<v1::SegmentResponse>* PerceptionService::Segment(
     grpc::CallbackServerContext* context, const v1::SegmentRequest* request) {
-  return new SegmentReactor(config_, *work_, context, request);
+  return new StreamReactor<v1::SegmentRequest, SegmentOptions>(
+      "Segment", &ToSegmentOptions, &HandleSegment, config_, *work_, context,
+      request);
 }
 
 grpc::ServerWriteReactor<v1::SegmentResponse>*
 PerceptionService::SegmentIncremental(
     grpc::CallbackServerContext* context,
     const v1::SegmentIncrementalRequest* request) {
-  return new RefusedStream(
-      "SegmentIncremental", request->request_id(),
-      absl::UnimplementedError(
-          "SegmentIncremental is not built yet: incremental segmentation "
-          "arrives in a later issue (see "
-          "GetCapabilities.segment_incremental)"));
+  return new StreamReactor<v1::SegmentIncrementalRequest, IncrementalOptions>(
+      "SegmentIncremental", &ToIncrementalOptions, &HandleSegmentIncremental,
+      config_, *work_, context, request);
 }
 
 grpc::ServerUnaryReactor* PerceptionService::GetCapabilities(

@@ -54,7 +54,8 @@ struct ServiceConfig {
 // objects and inside the methods' loops, and a failed write stops the
 // work. What was made before a deadline has been sent; the call then ends
 // DEADLINE_EXCEEDED.
-// SegmentIncremental: UNIMPLEMENTED until its issue lands.
+// SegmentIncremental: the same streaming, with INC's objects in order of
+// saliency; also stops on the request's time budget.
 // GetCapabilities: BuildCapabilities, computed once.
 class PerceptionService final : public v1::Perception::CallbackService {
  public:

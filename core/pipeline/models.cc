@@ -6,6 +6,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/strings.h"
+#include "core/segmentation/relations.h"
 
 namespace fovea {
 namespace {
@@ -44,6 +45,7 @@ SegmentModels LoadedModels::View() const {
   SegmentModels models;
   models.cos = cos ? &*cos : nullptr;
   models.ebs = ebs ? &*ebs : nullptr;
+  models.inc = inc ? &*inc : nullptr;
   return models;
 }
 
@@ -87,6 +89,26 @@ absl::StatusOr<LoadedModels> LoadModels(const std::string& dir) {
   }
   models.versions.emplace_back("ebs_edges", ebs->Version());
   models.ebs = *std::move(ebs);
+
+  const std::filesystem::path inc_path =
+      std::filesystem::path(dir) / kIncModelFile;
+  absl::StatusOr<std::string> inc_text = ReadModelFile(
+      inc_path, "fovea-train inc --data DIR --out models/inc_relations.txt");
+  if (!inc_text.ok()) return inc_text.status();
+  absl::StatusOr<RbfSvm> inc = RbfSvm::Parse(*inc_text, "inc");
+  if (!inc.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "model file ", inc_path.string(),
+        " is not an INC relation model: ", inc.status().message()));
+  }
+  if (inc->feature_names() != RelationFeatureNames()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "model file ", inc_path.string(),
+        " was trained on other relations than this build computes; retrain "
+        "it with fovea-train inc"));
+  }
+  models.versions.emplace_back("inc_relations", inc->Version());
+  models.inc = *std::move(inc);
   return models;
 }
 

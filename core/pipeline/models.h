@@ -10,6 +10,7 @@
 #include "core/pipeline/segment.h"
 #include "core/segmentation/ebs.h"
 #include "core/segmentation/linear_svm.h"
+#include "core/segmentation/rbf_svm.h"
 
 namespace fovea {
 
@@ -17,10 +18,12 @@ namespace fovea {
 // its README for how each was made).
 inline constexpr char kCosModelFile[] = "cos_svm.txt";
 inline constexpr char kEbsModelFile[] = "ebs_edges.txt";
+inline constexpr char kIncModelFile[] = "inc_relations.txt";
 
 struct LoadedModels {
   std::optional<LinearSvm> cos;
   std::optional<EbsModel> ebs;
+  std::optional<RbfSvm> inc;
   // (name, version) of each model, as GetCapabilities reports them.
   std::vector<std::pair<std::string, std::string>> versions;
 

@@ -17,6 +17,7 @@
 #include "core/segmentation/cos.h"
 #include "core/segmentation/ebs.h"
 #include "core/segmentation/linear_svm.h"
+#include "core/segmentation/rbf_svm.h"
 
 namespace fovea {
 
@@ -52,6 +53,7 @@ absl::Status Validate(const SegmentOptions& options);
 struct SegmentModels {
   const LinearSvm* cos = nullptr;
   const EbsModel* ebs = nullptr;
+  const RbfSvm* inc = nullptr;  // INC's relation SVM (incremental.h)
 };
 
 struct SegmentedObject {

@@ -98,6 +98,7 @@ absl::StatusOr<IncScene> BuildIncScene(const OrganizedCloud& cloud,
     }
   }
   scene.saliency.assign(n, 0.0);
+  scene.pixels = count;
   for (int l = 0; l < n; ++l) {
     if (count[l] > 0) scene.saliency[l] = sum[l] / count[l];
     if (!scene.surfaces.support[l]) scene.object_points += count[l];
@@ -261,7 +262,7 @@ absl::StatusOr<std::optional<IncObject>> IncSegmenter::Next(
     int points = 0;
     for (const int s : group) {
       removed_[s] = true;
-      points += patches[s].points;
+      points += scene_.pixels[s];
     }
     removed_points_ += points;
     if (points < options_.min_object_points) continue;  // noise: next

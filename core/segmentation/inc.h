@@ -57,6 +57,7 @@ struct IncScene {
   CosScene surfaces;
   std::unique_ptr<RelationComputer> relations;
   std::vector<double> saliency;  // per surface, eq. 3.6: mean of the map
+  std::vector<int> pixels;       // per surface, in the labels image
   int object_points = 0;         // pixels of non-support surfaces
 };
 

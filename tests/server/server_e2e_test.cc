@@ -400,15 +400,62 @@ TEST_F(ServerTest,
   call = CallSegment(*stub_, request);
   EXPECT_EQ(call.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(call.status.error_message(), HasSubstr("intrinsics"));
+}
 
+TEST_F(ServerTest, SegmentIncrementalStreamsObjectsInOrderAndStops) {
+  StartServer();
+  v1::SegmentIncrementalRequest request;
+  request.set_request_id("inc-1");
+  *request.mutable_frame() = MakeSyntheticRequest(3, false).request.frame();
   grpc::ClientContext context;
-  v1::SegmentIncrementalRequest incremental;
-  auto reader = stub_->SegmentIncremental(&context, incremental);
+  context.set_deadline(std::chrono::system_clock::now() +
+                       std::chrono::seconds(60));
+  auto reader = stub_->SegmentIncremental(&context, request);
+  std::vector<v1::SegmentResponse> messages;
   v1::SegmentResponse response;
-  EXPECT_FALSE(reader->Read(&response));
+  while (reader->Read(&response)) messages.push_back(response);
   const grpc::Status status = reader->Finish();
-  EXPECT_EQ(status.error_code(), grpc::StatusCode::UNIMPLEMENTED);
-  EXPECT_THAT(status.error_message(), HasSubstr("not built yet"));
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_GE(messages.size(), 3u);  // points, an object at least, summary
+  EXPECT_GT(messages.front().attention_points_size(), 0);
+  const v1::SegmentSummary& summary = messages.back().summary();
+  EXPECT_TRUE(messages.back().last());
+  EXPECT_EQ(summary.stop_reason(), v1::DONE);
+  EXPECT_GT(summary.scene_coverage(), 0.9);  // run to the end
+  for (size_t i = 1; i + 1 < messages.size(); ++i) {
+    EXPECT_EQ(messages[i].object().index(), i - 1);
+  }
+  // The same with a budget of one object, and with a time budget of
+  // nothing: each stops and says why.
+  request.set_max_objects(1);
+  grpc::ClientContext one;
+  auto one_reader = stub_->SegmentIncremental(&one, request);
+  messages.clear();
+  while (one_reader->Read(&response)) messages.push_back(response);
+  ASSERT_TRUE(one_reader->Finish().ok());
+  EXPECT_EQ(messages.back().summary().stop_reason(), v1::MAX_OBJECTS);
+  EXPECT_EQ(messages.back().summary().object_count(), 1u);
+  request.set_max_objects(0);
+  request.set_time_budget_seconds(1e-9);
+  grpc::ClientContext budget;
+  auto budget_reader = stub_->SegmentIncremental(&budget, request);
+  messages.clear();
+  while (budget_reader->Read(&response)) messages.push_back(response);
+  ASSERT_TRUE(budget_reader->Finish().ok());
+  EXPECT_EQ(messages.back().summary().stop_reason(), v1::TIME_BUDGET);
+  const std::string text = Scrape();
+  EXPECT_EQ(MetricValue(text, "fovea_segment_stops_total",
+                        {"grpc_method=\"SegmentIncremental\"",
+                         "reason=\"time_budget\""}),
+            1);
+  // A negative budget is refused naming the field.
+  request.set_time_budget_seconds(-1.0);
+  grpc::ClientContext bad;
+  auto bad_reader = stub_->SegmentIncremental(&bad, request);
+  EXPECT_FALSE(bad_reader->Read(&response));
+  const grpc::Status refused = bad_reader->Finish();
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(refused.error_message(), HasSubstr("time_budget_seconds"));
 }
 
 TEST_F(ServerTest, SegmentDeadlineMidStreamKeepsWhatWasSentAndEndsDeadline) {
@@ -507,13 +554,14 @@ TEST_F(ServerTest, CapabilitiesReportWhatCoreImplements) {
             static_cast<uint64_t>(kDefaultMaxMessageBytes));
   EXPECT_THAT(capabilities.segmentation_methods(),
               ::testing::ElementsAre(v1::COS, v1::EBS));
-  ASSERT_EQ(capabilities.models_size(), 2);
+  ASSERT_EQ(capabilities.models_size(), 3);
   EXPECT_EQ(capabilities.models(0).name(), "cos_svm");
   EXPECT_THAT(capabilities.models(0).version(), ::testing::StartsWith("cos-"));
   EXPECT_EQ(capabilities.models(1).name(), "ebs_edges");
   EXPECT_THAT(capabilities.models(1).version(),
               ::testing::StartsWith("ebs-v1-"));
-  EXPECT_FALSE(capabilities.segment_incremental());
+  EXPECT_EQ(capabilities.models(2).name(), "inc_relations");
+  EXPECT_TRUE(capabilities.segment_incremental());
   EXPECT_EQ(capabilities.default_detect_options().max_points(), 10u);
 }
 

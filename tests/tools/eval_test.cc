@@ -168,7 +168,8 @@ TEST(FoveaTrainTest, WritesModelsTheServerLoads) {
   std::filesystem::create_directories(models);
   for (const auto& [command, file] :
        {std::pair<std::string, std::string>{"cos", kCosModelFile},
-        {"ebs", kEbsModelFile}}) {
+        {"ebs", kEbsModelFile},
+        {"inc", kIncModelFile}}) {
     const ::fovea::testing::CommandRun run = ::fovea::testing::RunCommand(
         std::string(FOVEA_TRAIN_BIN) + " " + command + " --data " +
         dir.string() + " --folds 3 --out " + (models / file).string());
@@ -177,7 +178,7 @@ TEST(FoveaTrainTest, WritesModelsTheServerLoads) {
   }
   const absl::StatusOr<LoadedModels> loaded = LoadModels(models.string());
   ASSERT_TRUE(loaded.ok()) << loaded.status();
-  EXPECT_EQ(loaded->versions.size(), 2u);
+  EXPECT_EQ(loaded->versions.size(), 3u);
   const ::fovea::testing::CommandRun usage = ::fovea::testing::RunCommand(
       std::string(FOVEA_TRAIN_BIN) + " cos --data " + dir.string());
   EXPECT_EQ(usage.exit_code, 64);
