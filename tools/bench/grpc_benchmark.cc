@@ -152,6 +152,41 @@ void BenchmarkGrpcSegment(benchmark::State& state, const SceneList& scenes,
   });
 }
 
+// One SegmentIncremental call per scene with the server's defaults;
+// max_objects 1: the time to the first object; 0: the whole scene.
+void BenchmarkGrpcIncremental(benchmark::State& state, const SceneList& scenes,
+                              const std::string& set_name, int max_objects) {
+  absl::StatusOr<Loopback*> loopback = StartLoopback();
+  if (!loopback.ok()) {
+    state.SkipWithError(loopback.status().ToString().c_str());
+    return;
+  }
+  std::unordered_map<const BenchScene*, v1::SegmentIncrementalRequest> requests;
+  for (const auto& scene : scenes) {
+    v1::SegmentIncrementalRequest request;
+    request.set_request_id(scene->name);
+    *request.mutable_frame() = server::ToProtoFrame(
+        scene->frame, server::DepthEncoding::k16UC1, kWireDepthScale);
+    request.set_max_objects(static_cast<uint32_t>(max_objects));
+    requests.emplace(scene.get(), std::move(request));
+  }
+  SweepScenes(state, scenes, set_name, [&](const BenchScene& scene) {
+    grpc::ClientContext context;
+    auto reader =
+        (*loopback)->stub->SegmentIncremental(&context, requests.at(&scene));
+    v1::SegmentResponse response;
+    int messages = 0;
+    while (reader->Read(&response)) ++messages;
+    const grpc::Status status = reader->Finish();
+    if (!status.ok()) {
+      return absl::Status(static_cast<absl::StatusCode>(status.error_code()),
+                          status.error_message());
+    }
+    benchmark::DoNotOptimize(messages);
+    return absl::OkStatus();
+  });
+}
+
 }  // namespace
 
 void RegisterGrpcBenchmarks(const SceneList* scenes,
@@ -191,6 +226,18 @@ void RegisterGrpcBenchmarks(const SceneList* scenes,
                                        2 * kGrpcDetectMs))
           ->Unit(benchmark::kMillisecond);
     }
+  }
+  for (const int max_objects : {1, 0}) {
+    benchmark::RegisterBenchmark(
+        absl::StrCat("BM_SegmentIncrementalGrpc/",
+                     max_objects == 1 ? "first" : "all", suffix)
+            .c_str(),
+        [scenes, set_name, max_objects](benchmark::State& state) {
+          BenchmarkGrpcIncremental(state, *scenes, set_name, max_objects);
+        })
+        ->Iterations(SweepIterations(sweep, static_cast<int>(scenes->size()),
+                                     2 * kGrpcDetectMs))
+        ->Unit(benchmark::kMillisecond);
   }
 }
 
