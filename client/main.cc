@@ -98,7 +98,9 @@ ABSL_FLAG(std::string, method, "", "segment: cos | ebs");
 ABSL_FLAG(int32_t, max_objects, 0, "segment: most objects, 0 = no limit");
 ABSL_FLAG(std::string, seeds, "",
           "segment: seed pixels 'u,v;u,v;...' used in this order instead of "
-          "the server's attention points (e.g. where a person pointed)");
+          "the server's attention points (e.g. where a person pointed); "
+          "segment-incremental: attention points, a Gaussian of saliency at "
+          "each, the first the most salient");
 ABSL_FLAG(double, time_budget_ms, 0.0,
           "segment-incremental: time budget, milliseconds, 0 = none");
 
@@ -384,6 +386,11 @@ int RunSegment(bool incremental) {
     *request.mutable_detect_options() = *std::move(options);
     request.set_max_objects(static_cast<uint32_t>(max_objects));
     request.set_time_budget_seconds(time_budget_ms / 1e3);
+    for (const auto& [u, v] : *seeds) {
+      fovea::v1::AttentionPixel* point = request.add_attention_points();
+      point->set_u(u);
+      point->set_v(v);
+    }
     start = absl::Now();
     status = (*client)->SegmentIncremental(request, Deadline(), on_message);
   } else {

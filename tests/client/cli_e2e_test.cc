@@ -128,6 +128,20 @@ TEST_F(FoveaClientCliE2eTest, SegmentStreamsObjectsAndWritesEachMask) {
   std::filesystem::remove_all(out);
 }
 
+TEST_F(FoveaClientCliE2eTest,
+       SegmentIncrementalStreamsObjectsAndStopsOnBudget) {
+  const std::string out =
+      ::testing::TempDir() + "/segment_inc_cli_" + std::to_string(::getpid());
+  const CliRun run = RunCli(absl::StrCat(
+      "--server ", address_,
+      " segment-incremental --synthetic 3 --max_objects 2 --out ", out));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_THAT(run.out, HasSubstr("object 1:"));
+  EXPECT_THAT(run.out, HasSubstr("last: MAX_OBJECTS, 2 objects"));
+  EXPECT_TRUE(std::filesystem::exists(out + "/mask_1.png"));
+  std::filesystem::remove_all(out);
+}
+
 TEST_F(FoveaClientCliE2eTest, SegmentSeedsAreSentAndBadOnesAreUsageErrors) {
   // A seed in the corner sees no object: the stream ends with none.
   const CliRun corner = RunCli(absl::StrCat(
