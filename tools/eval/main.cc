@@ -385,10 +385,11 @@ int RunSegmentEval() {
         "{\"scenes\": %zu, \"f_all\": %.4f, \"f_best\": %.4f, "
         "\"f_first\": %.4f, \"object_recall\": %.4f, \"false_masks\": "
         "%.4f, \"first_mask_ms_median\": %.1f, \"all_masks_ms_median\": "
-        "%.1f}\n",
+        "%.1f, \"whole_scene_f\": %.4f}\n",
         summary->scenes.size(), summary->f_all, summary->f_best,
         summary->f_first, summary->object_recall, summary->false_masks,
-        summary->first_mask_ms_median, summary->all_masks_ms_median);
+        summary->first_mask_ms_median, summary->all_masks_ms_median,
+        summary->whole_scene_f);
   }
   return 0;
 }

@@ -75,6 +75,7 @@ SegmentEvalSummary SummarizeSegment(
     masks += r.score.masks;
     false_masks += r.score.false_masks;
     all_ms.push_back(r.all_masks_ms);
+    s.whole_scene_f += r.whole_scene_f;
     if (r.score.masks > 0) first_ms.push_back(r.first_mask_ms);
     if (r.score.objects_with_mask == 0) continue;
     ++scored;
@@ -87,6 +88,8 @@ SegmentEvalSummary SummarizeSegment(
     s.f_best /= scored;
     s.f_first /= scored;
   }
+  if (!s.scenes.empty())
+    s.whole_scene_f /= static_cast<double>(s.scenes.size());
   s.object_recall = objects > 0 ? static_cast<double>(with_mask) / objects : 0;
   s.false_masks = masks > 0 ? static_cast<double>(false_masks) / masks : 0;
   s.first_mask_ms_median = Median(first_ms);
@@ -170,6 +173,11 @@ absl::StatusOr<SegmentEvalSummary> EvaluateSegment(
       r.name = scene.name;
       r.kind = SceneKind(scene.name);
       r.score = ScoreSegmentation(scene.labels, masks, kMinObjectPixels);
+      cv::Mat segments(scene.labels.size(), CV_32SC1, cv::Scalar(-1));
+      for (size_t m = 0; m < masks.size(); ++m) {
+        segments.setTo(static_cast<int>(m), masks[m].mask & (segments < 0));
+      }
+      r.whole_scene_f = WholeSceneF(scene.labels, segments, kMinObjectPixels);
       r.first_mask_ms = first_seconds.value_or(0.0) * 1e3;
       r.all_masks_ms = run->total_seconds * 1e3;
       if (options.verbose) {

@@ -28,6 +28,7 @@ struct SceneSegmentResult {
   std::string name;
   std::string kind;  // SceneKind(name)
   SegmentationScore score;
+  double whole_scene_f = 0.0;  // WholeSceneF of the masks (earlier first)
   double first_mask_ms = 0.0;  // request start to first object; 0 if none
   double all_masks_ms = 0.0;   // the whole RunSegment
 };
@@ -43,6 +44,7 @@ struct SegmentEvalSummary {
   // masks seeded on the table or nothing / masks.
   double object_recall = 0.0;
   double false_masks = 0.0;
+  double whole_scene_f = 0.0;  // mean over scenes
   double first_mask_ms_median = 0.0;
   double all_masks_ms_median = 0.0;
 };
