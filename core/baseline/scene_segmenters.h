@@ -99,7 +99,7 @@ struct LccpSceneOptions {
   // Give the supervoxels the cloud's normals (zero where it has none), as
   // the example does when its input has normals; false (the example's
   // -nonormals): PCL estimates each voxel's normal from its neighbours,
-  // which scored higher on the OSD learning scenes (F 0.926 against 0.918).
+  // which scored higher on the OSD learning scenes (F 0.925 against 0.918).
   bool use_cloud_normals = false;
   // Voxelize in PCL's depth-dependent "single camera" space (the example's
   // -tvoxel switch, off by default).
@@ -113,8 +113,9 @@ struct LccpSceneOptions {
   float smoothness_threshold = 0.1f;
   // k of the extended convexity test: an edge stays convex only with k
   // common neighbours convexly connected to both (0: off, 1: the example's
-  // -ec, which Stein et al. 2014 use on noisy data; OSD learning scenes:
-  // F 0.926 with 1 against 0.901 with 0).
+  // -ec). OSD learning scenes: F 0.925 with 1 against 0.901 with 0; it is
+  // also what cuts touching boxes apart at a concave junction (see
+  // tests/core/baseline/scene_segmenters_test.cc).
   uint32_t k_factor = 1;
   // Sanity criterion: invalidate singular connections (example: off).
   bool use_sanity_criterion = false;
