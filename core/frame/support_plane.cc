@@ -333,9 +333,32 @@ absl::StatusOr<SupportPlane> FindSupportPlane(
   for (int round = 0; round < 2; ++round) {
     RefinePlane(cloud, options.inlier_distance, min_cos, plane.normal, plane.d);
   }
-  plane.inliers = LargestInlierComponent(cloud, plane.normal, plane.d,
-                                         options.inlier_distance, min_cos,
-                                         plane.inlier_count);
+  int inlier_count = 0;
+  const cv::Mat inliers =
+      LargestInlierComponent(cloud, plane.normal, plane.d,
+                             options.inlier_distance, min_cos, inlier_count);
+  return SupportPlaneFromInliers(cloud, plane.normal, plane.d, inliers);
+}
+
+absl::StatusOr<SupportPlane> SupportPlaneFromInliers(
+    const OrganizedCloud& cloud, const Eigen::Vector3f& normal, float d,
+    const cv::Mat& inliers) {
+  const float norm = normal.norm();
+  if (!(norm > 0.0f) || !std::isfinite(norm) || !std::isfinite(d)) {
+    return absl::InvalidArgumentError(
+        "support plane: the normal must be finite and non-zero");
+  }
+  if (inliers.type() != CV_8UC1 || inliers.rows != cloud.height() ||
+      inliers.cols != cloud.width()) {
+    return absl::InvalidArgumentError(
+        "support plane: inliers must be CV_8UC1 of the cloud's size");
+  }
+  SupportPlane plane;
+  plane.normal = normal / norm;
+  plane.d = d / norm;
+  OrientTowardsCamera(plane.normal, plane.d);
+  plane.inliers = inliers;
+  plane.inlier_count = cv::countNonZero(inliers);
   // Axes: u along the camera x projected into the plane.
   Eigen::Vector3f u =
       Eigen::Vector3f::UnitX() - plane.normal * plane.normal.x();

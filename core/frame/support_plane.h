@@ -68,6 +68,17 @@ absl::Status Validate(const SupportPlaneOptions& options);
 absl::StatusOr<SupportPlane> FindSupportPlane(
     const OrganizedCloud& cloud, const SupportPlaneOptions& options);
 
+// A support plane found by other means (e.g. PCL's organized multi-plane
+// segmentation, core/baseline/scene_segmenters.h) made whole: `normal`
+// (need not be unit length) and `d` are normalised and turned towards the
+// camera, the axes set as FindSupportPlane sets them, and the convex hull
+// taken of `inliers` (CV_8UC1 of the cloud's size, non-zero = on the plane;
+// kept as the plane's `inliers`). INVALID_ARGUMENT for a zero normal or a
+// mask of another size; NOT_FOUND when the inliers have no 2D extent.
+absl::StatusOr<SupportPlane> SupportPlaneFromInliers(
+    const OrganizedCloud& cloud, const Eigen::Vector3f& normal, float d,
+    const cv::Mat& inliers);
+
 }  // namespace fovea
 
 #endif  // FOVEA_CORE_FRAME_SUPPORT_PLANE_H_

@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/strings.h"
+#include "core/baseline/scene_segmenters.h"
 #include "core/frame/frame_decode.h"
 #include "core/frame/organized_cloud.h"
 #include "core/frame/support_plane.h"
@@ -42,6 +43,8 @@ constexpr double kEbsEdgeProbabilityMs = 12.0;
 constexpr double kEbsContourMs = 4.0;
 constexpr double kDetectMs = 30.0;
 constexpr double kSegmentMs = 60.0;
+constexpr double kPeerEuclideanMs = 40.0;
+constexpr double kPeerLccpMs = 40.0;
 
 using SceneBody = std::function<absl::Status(const BenchScene&)>;
 
@@ -245,6 +248,28 @@ void RegisterSegmentCases(const SceneList* scenes, const std::string& set,
   }
 }
 
+// The whole-scene PCL peers of core/baseline/scene_segmenters.h, from the
+// organized cloud with normals (what our own segmentation starts from too):
+// support plane by organized multi-plane segmentation, then Euclidean
+// clustering or supervoxels + LCCP.
+void RegisterPeerCases(const SceneList* scenes, const std::string& set,
+                       const std::string& suffix, const SweepOptions& sweep) {
+  Register("BM_PeerEuclidean" + suffix, scenes, set, sweep, kPeerEuclideanMs,
+           [](const BenchScene& scene) {
+             absl::StatusOr<SceneSegmentation> segmentation =
+                 SegmentSceneEuclidean(scene.cloud, EuclideanSceneOptions{});
+             benchmark::DoNotOptimize(segmentation);
+             return segmentation.status();
+           });
+  Register("BM_PeerLccp" + suffix, scenes, set, sweep, kPeerLccpMs,
+           [](const BenchScene& scene) {
+             absl::StatusOr<SceneSegmentation> segmentation =
+                 SegmentSceneLccp(scene.cloud, LccpSceneOptions{});
+             benchmark::DoNotOptimize(segmentation);
+             return segmentation.status();
+           });
+}
+
 void RegisterDetectCases(const SceneList* scenes, const std::string& set,
                          const std::string& suffix, const SweepOptions& sweep) {
   // What a request without options gets.
@@ -364,6 +389,7 @@ void RegisterStageBenchmarks(const SceneList* scenes,
   RegisterSaliencyCases(scenes, set_name, suffix, sweep);
   RegisterDetectCases(scenes, set_name, suffix, sweep);
   RegisterSegmentCases(scenes, set_name, suffix, sweep);
+  RegisterPeerCases(scenes, set_name, suffix, sweep);
   RegisterAttentionCases(scenes, set_name, suffix, sweep);
 }
 

@@ -59,9 +59,15 @@ inline synth::SynthScene BoxOnTable(const Eigen::Vector3f& half_extents,
 // Camera as in BoxOnTable; no noise. The blue top lies below the red top, so
 // the two together are not convex.
 // With `gap` > 0 the blue box stands that many metres further right.
-inline synth::SynthScene TwoBoxesOnTable(float gap = 0.0f) {
+// `camera` moves the camera (world frame, looking at the origin): the default
+// lies in the boxes' contact plane x = 0, which it sees edge-on, so the
+// visible surfaces of touching boxes are 2 cm apart (their fronts); from
+// x > 0 it sees the red box's right face rise above the blue top.
+inline synth::SynthScene TwoBoxesOnTable(
+    float gap = 0.0f,
+    const Eigen::Vector3f& camera = Eigen::Vector3f(0.0f, -0.75f, 0.75f)) {
   synth::SceneSpec spec;
-  spec.camera_pose = synth::LookAt({0.0f, -0.75f, 0.75f}, {0.0f, 0.0f, 0.0f});
+  spec.camera_pose = synth::LookAt(camera, {0.0f, 0.0f, 0.0f});
   for (const float side : {-1.0f, 1.0f}) {
     synth::Primitive box;
     box.shape = synth::Shape::kBox;
