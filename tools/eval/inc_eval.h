@@ -54,6 +54,14 @@ struct IncEvalSummary {
 absl::StatusOr<IncEvalSummary> EvaluateInc(
     const std::vector<LabelledFrame>& scenes, const IncEvalOptions& options);
 
+// The PCL peers on the same scenes and metric (no training): "pcl-euclidean"
+// or "pcl-lccp". Each segment is an object, largest first, its seed at its
+// central pixel; both times are the frame's (back-projection, normals and
+// the peer).
+absl::StatusOr<IncEvalSummary> EvaluatePeer(
+    const std::vector<LabelledFrame>& scenes, const std::string& peer,
+    bool verbose);
+
 // Means and medians over the scenes of one kind ("" = all).
 IncEvalSummary SummarizeInc(const std::vector<IncSceneResult>& scenes,
                             const std::string& kind);

@@ -76,7 +76,8 @@ ABSL_FLAG(std::string, out, "",
           "Write <scene>.png (colour with object outlines | saliency map, "
           "points numbered) into this folder.");
 ABSL_FLAG(bool, verbose, false, "One line per scene on stderr.");
-ABSL_FLAG(std::string, method, "cos", "segment: cos, ebs or inc.");
+ABSL_FLAG(std::string, method, "cos",
+          "segment: cos, ebs, inc, or a peer: pcl-euclidean, pcl-lccp.");
 ABSL_FLAG(std::string, inc_saliency, "sym3d",
           "segment --method inc: sym3d (Detect's map, F from one run) or "
           "random-points (per object 5 sequences of 5 points, section 3.3.3).");
@@ -269,6 +270,19 @@ void PrintIncTable(const std::vector<IncSceneResult>& scenes) {
   }
 }
 
+void PrintIncJson(const IncEvalSummary& summary) {
+  if (!absl::GetFlag(FLAGS_json)) return;
+  std::printf(
+      "{\"scenes\": %zu, \"f_all\": %.4f, \"f_best\": %.4f, "
+      "\"f_first\": %.4f, \"object_recall\": %.4f, \"false_masks\": "
+      "%.4f, \"whole_scene_f\": %.4f, \"first_object_ms_median\": %.1f, "
+      "\"whole_scene_ms_median\": %.1f, \"first_object_slope\": %.4f}\n",
+      summary.scenes.size(), summary.f_all, summary.f_best, summary.f_first,
+      summary.object_recall, summary.false_masks, summary.whole_scene_f,
+      summary.first_object_ms_median, summary.whole_scene_ms_median,
+      summary.first_object_slope);
+}
+
 int RunIncEval(std::optional<DetectOptions> detect,
                const std::vector<LabelledFrame>& scenes) {
   IncEvalOptions options;
@@ -297,17 +311,7 @@ int RunIncEval(std::optional<DetectOptions> detect,
       saliency.c_str(), summary->scenes.size(), options.folds,
       summary->first_object_slope);
   PrintIncTable(summary->scenes);
-  if (absl::GetFlag(FLAGS_json)) {
-    std::printf(
-        "{\"scenes\": %zu, \"f_all\": %.4f, \"f_best\": %.4f, "
-        "\"f_first\": %.4f, \"object_recall\": %.4f, \"false_masks\": "
-        "%.4f, \"whole_scene_f\": %.4f, \"first_object_ms_median\": %.1f, "
-        "\"whole_scene_ms_median\": %.1f, \"first_object_slope\": %.4f}\n",
-        summary->scenes.size(), summary->f_all, summary->f_best,
-        summary->f_first, summary->object_recall, summary->false_masks,
-        summary->whole_scene_f, summary->first_object_ms_median,
-        summary->whole_scene_ms_median, summary->first_object_slope);
-  }
+  PrintIncJson(*summary);
   return 0;
 }
 
@@ -334,6 +338,27 @@ int RunSegmentEval() {
       return kUsageError;
     }
     options.segment.detect.extraction = *kind;
+  }
+  const std::string method_name = absl::GetFlag(FLAGS_method);
+  if (method_name == "pcl-euclidean" || method_name == "pcl-lccp") {
+    absl::StatusOr<std::vector<LabelledFrame>> scenes = LoadScenes(data);
+    if (!scenes.ok()) {
+      std::fprintf(stderr, "fovea-eval: %s\n",
+                   scenes.status().ToString().c_str());
+      return kRunError;
+    }
+    absl::StatusOr<IncEvalSummary> summary = EvaluatePeer(
+        *scenes, method_name, absl::GetFlag(FLAGS_verbose));
+    if (!summary.ok()) {
+      std::fprintf(stderr, "fovea-eval: %s\n",
+                   summary.status().ToString().c_str());
+      return kRunError;
+    }
+    std::printf("segment %s (peer, whole scene), %zu scenes\n",
+                method_name.c_str(), summary->scenes.size());
+    PrintIncTable(summary->scenes);
+    PrintIncJson(*summary);
+    return 0;
   }
   if (absl::GetFlag(FLAGS_method) == "inc") {
     absl::StatusOr<std::vector<LabelledFrame>> scenes = LoadScenes(data);
