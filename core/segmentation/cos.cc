@@ -250,8 +250,10 @@ absl::StatusOr<CosScene> BuildCosScene(const OrganizedCloud& cloud,
   }
   scene.support.assign(n, false);
   for (int p = 0; p < n; ++p) {
+    const float height = plane.Height(scene.patches.patches[p].centroid);
     scene.support[p] =
-        size[p] > 0 && on_plane[p] > options.max_support_fraction * size[p];
+        size[p] > 0 && (on_plane[p] > options.max_support_fraction * size[p] ||
+                        (have_inliers && height < options.min_patch_height));
   }
   return scene;
 }

@@ -46,6 +46,11 @@ struct CosOptions {
   // Removing the support surface first is how the thesis's table-top
   // pipeline starts; the SVM then decides between objects.
   float max_support_fraction = 0.5f;
+  // ... and so is a patch whose points lie on average less than this above
+  // the support plane, metres (the table remnants along objects' feet that
+  // the plane fit's normal test left out; TableSceneOptions'
+  // min_object_height).
+  float min_patch_height = 0.01f;
   // Pixels with depth but no normal (object rims, occluding edges) join a
   // 4-neighbouring patch at nearly the same depth, one pixel ring per pass,
   // this many passes: 8 is NormalOptions::max_half_window, the farthest a
