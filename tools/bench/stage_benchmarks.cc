@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <unordered_map>
 #include <utility>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "core/base/strings.h"
@@ -22,6 +24,7 @@
 #include "core/saliency/sym3d.h"
 #include "core/segmentation/ebs.h"
 #include "core/segmentation/planar_patches.h"
+#include "core/segmentation/surface_model.h"
 
 namespace fovea::bench {
 namespace {
@@ -38,6 +41,7 @@ constexpr double kSaliencyMs = 3.0;
 constexpr double kMsrMs = 2.0;
 constexpr double kSurfaceEdgesMs = 3.0;
 constexpr double kPlanarPatchesMs = 15.0;
+constexpr double kSurfaceModelMs = 2.0;
 constexpr double kSym3dLevel0Ms = 40.0;
 constexpr double kEbsEdgeProbabilityMs = 12.0;
 constexpr double kEbsContourMs = 4.0;
@@ -210,6 +214,86 @@ void RegisterSaliencyCases(const SceneList* scenes, const std::string& set,
                benchmark::DoNotOptimize(points);
                return points.status();
              });
+  }
+}
+
+// The points of each planar patch of `cloud`, in raster order, as
+// incremental segmentation would hand them to FitSurface.
+absl::StatusOr<std::vector<std::vector<Eigen::Vector3f>>> PatchPoints(
+    const OrganizedCloud& cloud, const PlanarPatchOptions& options) {
+  absl::StatusOr<PlanarPatches> patches = FindPlanarPatches(cloud, {}, options);
+  if (!patches.ok()) return patches.status();
+  std::vector<std::vector<Eigen::Vector3f>> points(patches->patches.size());
+  for (int v = 0; v < cloud.height(); ++v) {
+    for (int u = 0; u < cloud.width(); ++u) {
+      const int id = patches->labels.at<int>(v, u);
+      if (id < 0) continue;
+      const cv::Vec3f& p = cloud.xyz.at<cv::Vec3f>(v, u);
+      points[id].emplace_back(p[0], p[1], p[2]);
+    }
+  }
+  return points;
+}
+
+// Surface models (thesis section 3.3): FitSurface (plane and B-spline by
+// MDL) on every planar patch of the frame. The patches are found and their
+// points gathered before the timed loop; counters give the mean patches
+// per frame and the share that came out as B-splines. "BM_SurfaceModel"
+// takes the default patches (about 30 per OSD frame); "BM_SurfaceModel/
+// fine" patches grown with tighter thresholds (half the distance, 10
+// degrees, 15-point minimum): about 200 per OSD frame, the many small
+// patches of a cluttered one (on the synthetic frames most points fail the
+// tight thresholds and are left out, so there are fewer).
+void RegisterSurfaceModelCases(const SceneList* scenes, const std::string& set,
+                               const std::string& suffix,
+                               const SweepOptions& sweep) {
+  PlanarPatchOptions fine;
+  fine.max_plane_distance = 0.002f;
+  fine.distance_per_m2 = 0.00075f;
+  fine.max_normal_angle_deg = 10.0f;
+  fine.min_points = 15;
+  for (const auto& [name, patch_options] :
+       {std::pair<std::string, PlanarPatchOptions>{"", PlanarPatchOptions{}},
+        {"/fine", fine}}) {
+    benchmark::RegisterBenchmark(
+        ("BM_SurfaceModel" + name + suffix).c_str(),
+        [scenes, set, patch_options = patch_options](benchmark::State& state) {
+          const SurfaceModelOptions options;
+          std::unordered_map<const BenchScene*,
+                             std::vector<std::vector<Eigen::Vector3f>>>
+              patches;
+          double patch_count = 0.0, splines = 0.0;
+          for (const auto& scene : *scenes) {
+            absl::StatusOr<std::vector<std::vector<Eigen::Vector3f>>> points =
+                PatchPoints(scene->cloud, patch_options);
+            if (!points.ok()) {
+              state.SkipWithError(points.status().ToString().c_str());
+              return;
+            }
+            for (const auto& patch : *points) {
+              absl::StatusOr<SurfaceModel> model = FitSurface(patch, options);
+              if (model.ok() && model->kind == SurfaceKind::kBSpline) {
+                ++splines;
+              }
+            }
+            patch_count += static_cast<double>(points->size());
+            patches.emplace(scene.get(), *std::move(points));
+          }
+          SweepScenes(state, *scenes, set, [&](const BenchScene& scene) {
+            for (const auto& points : patches.at(&scene)) {
+              absl::StatusOr<SurfaceModel> model = FitSurface(points, options);
+              if (!model.ok()) return model.status();
+              benchmark::DoNotOptimize(model->description_length);
+            }
+            return absl::OkStatus();
+          });
+          state.counters["patches"] = patch_count / scenes->size();
+          state.counters["bspline_share"] =
+              patch_count > 0.0 ? splines / patch_count : 0.0;
+        })
+        ->Iterations(SweepIterations(sweep, static_cast<int>(scenes->size()),
+                                     kSurfaceModelMs))
+        ->Unit(benchmark::kMillisecond);
   }
 }
 
@@ -387,6 +471,7 @@ void RegisterStageBenchmarks(const SceneList* scenes,
   if (scenes->empty()) return;
   RegisterFrameCases(scenes, set_name, suffix, sweep);
   RegisterSaliencyCases(scenes, set_name, suffix, sweep);
+  RegisterSurfaceModelCases(scenes, set_name, suffix, sweep);
   RegisterDetectCases(scenes, set_name, suffix, sweep);
   RegisterSegmentCases(scenes, set_name, suffix, sweep);
   RegisterPeerCases(scenes, set_name, suffix, sweep);
