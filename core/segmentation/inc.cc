@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <set>
 #include <tuple>
 #include <utility>
@@ -58,6 +59,10 @@ absl::Status Validate(const IncOptions& options) {
         absl::StrCat("min_object_points must not be negative, got ",
                      options.min_object_points));
   }
+  if (absl::Status s = Validate(options.surface_models); !s.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("surface_models.", s.message()));
+  }
   if (options.max_growth_steps < 1) {
     return absl::InvalidArgumentError(absl::StrCat(
         "max_growth_steps must be positive, got ", options.max_growth_steps));
@@ -95,6 +100,40 @@ absl::StatusOr<IncScene> BuildIncScene(const OrganizedCloud& cloud,
       if (l < 0) continue;
       sum[l] += std::isnan(s[u]) ? 0.0 : s[u];
       ++count[l];
+    }
+  }
+  // Surface models and fusions of neighbours into one B-spline.
+  scene.kinds.assign(n, SurfaceKind::kPlane);
+  if (options.fuse_surfaces) {
+    std::vector<std::vector<Eigen::Vector3f>> points(n);
+    for (int v = 0; v < labels.rows; ++v) {
+      const int* label = labels.ptr<int>(v);
+      const cv::Vec3f* xyz = cloud.xyz.ptr<cv::Vec3f>(v);
+      for (int u = 0; u < labels.cols; ++u) {
+        const int l = label[u];
+        if (l < 0 || scene.surfaces.support[l] || std::isnan(xyz[u][2])) {
+          continue;
+        }
+        points[l].emplace_back(xyz[u][0], xyz[u][1], xyz[u][2]);
+      }
+    }
+    std::vector<std::optional<SurfaceModel>> models(n);
+    for (int l = 0; l < n; ++l) {
+      if (scene.surfaces.support[l] || points[l].size() < 3) continue;
+      absl::StatusOr<SurfaceModel> model =
+          FitSurface(points[l], options.surface_models);
+      if (!model.ok()) continue;  // degenerate: no model, no fusion
+      scene.kinds[l] = model->kind;
+      models[l] = *std::move(model);
+    }
+    for (const auto& [a, b] : scene.relations->adjacent_pairs()) {
+      if (!models[a] || !models[b]) continue;
+      absl::StatusOr<FusionVerdict> verdict = ShouldFuse(
+          points[a], *models[a], points[b], *models[b], options.surface_models);
+      if (verdict.ok() && verdict->fuse &&
+          verdict->fused.kind == SurfaceKind::kBSpline) {
+        scene.fused.insert(PairKey(a, b));
+      }
     }
   }
   scene.saliency.assign(n, 0.0);
@@ -159,7 +198,9 @@ std::vector<int> IncSegmenter::GroupOf(const std::vector<int>& selection,
     for (const int neighbour : scene_.surfaces.neighbours[selection[i]]) {
       const auto j = index.find(neighbour);
       if (j == index.end() || j->second <= i) continue;
-      const double w = 1.0 - SameProbability(selection[i], neighbour);
+      const double w = scene_.fused.count(PairKey(selection[i], neighbour)) > 0
+                           ? 0.0
+                           : 1.0 - SameProbability(selection[i], neighbour);
       const double points =
           patches[selection[i]].points + patches[neighbour].points;
       EdgeSums sums{points * w, points};

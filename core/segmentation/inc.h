@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -15,6 +16,7 @@
 #include "core/segmentation/cos.h"
 #include "core/segmentation/rbf_svm.h"
 #include "core/segmentation/relations.h"
+#include "core/segmentation/surface_model.h"
 
 namespace fovea {
 
@@ -42,6 +44,11 @@ struct IncOptions {
   // whole-scene F 0.889 / 0.914 / 0.917 / 0.919 / 0.859 for k = 0.5 / 0.75
   // / 1 / 1.25 / 2.
   double k = 1.0;
+  // Surface models (plane or B-spline by MDL); two neighbouring surfaces
+  // whose union is better explained by one B-spline are one surface for
+  // the grouping (their edge weighs 0).
+  bool fuse_surfaces = true;
+  SurfaceModelOptions surface_models;
   // Objects of fewer points leave the scene without being emitted (noise
   // surfaces), pixels.
   int min_object_points = 150;
@@ -56,9 +63,13 @@ absl::Status Validate(const IncOptions& options);
 struct IncScene {
   CosScene surfaces;
   std::unique_ptr<RelationComputer> relations;
-  std::vector<double> saliency;  // per surface, eq. 3.6: mean of the map
-  std::vector<int> pixels;       // per surface, in the labels image
-  int object_points = 0;         // pixels of non-support surfaces
+  std::vector<double> saliency;    // per surface, eq. 3.6: mean of the map
+  std::vector<int> pixels;         // per surface, in the labels image
+  std::vector<SurfaceKind> kinds;  // per surface (support ones: kPlane)
+  // Neighbouring pairs (PairKey: smaller << 32 | larger) fused into one
+  // B-spline.
+  std::unordered_set<uint64_t> fused;
+  int object_points = 0;  // pixels of non-support surfaces
 };
 
 // Surfaces, their relations' statistics and saliency from `saliency_map`
