@@ -62,5 +62,24 @@ TEST(ScoreSegmentationTest, SmallObjectsAreNotCountedAndNoMasksScoreZero) {
   EXPECT_EQ(ScoreSegmentation(Labels(), {}, 41).objects, 0);
 }
 
+TEST(WholeSceneFTest, BestSegmentPerObjectAndTableSegmentsIgnored) {
+  // Object 2 (columns 0-3): segment 0 covers columns 0-5 (P 4/6, R 1, F
+  // 0.8). Object 3 (columns 6-9): segments 1 (6-7) and 2 (8-9) split it;
+  // the best is either (P 1, R 0.5, F 2/3).
+  cv::Mat segments(10, 10, CV_32SC1, cv::Scalar(-1));
+  segments.colRange(0, 6).setTo(0);
+  segments.colRange(6, 8).setTo(1);
+  segments.colRange(8, 10).setTo(2);
+  EXPECT_NEAR(WholeSceneF(Labels(), segments), (0.8 + 2.0 / 3.0) / 2.0,
+              1e-9);
+  // An object no segment touches scores 0.
+  cv::Mat only_first(10, 10, CV_32SC1, cv::Scalar(-1));
+  only_first.colRange(0, 4).setTo(0);
+  EXPECT_NEAR(WholeSceneF(Labels(), only_first), 0.5, 1e-9);
+  // A pure table segment changes nothing.
+  only_first.colRange(4, 6).setTo(7);
+  EXPECT_NEAR(WholeSceneF(Labels(), only_first), 0.5, 1e-9);
+}
+
 }  // namespace
 }  // namespace fovea
