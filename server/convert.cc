@@ -557,15 +557,27 @@ absl::StatusOr<v1::DetectResponse> ToDetectResponse(
   return response;
 }
 
-absl::StatusOr<SegmentOptions> ToSegmentOptions(
-    const v1::SegmentRequest& request) {
-  SegmentOptions options;
-  absl::StatusOr<DetectOptions> detect =
-      ToDetectOptions(request.detect_options());
+namespace {
+
+// A segmentation request's detect_options, errors prefixed with the field.
+absl::StatusOr<DetectOptions> ToNestedDetectOptions(
+    const v1::DetectOptions& options) {
+  absl::StatusOr<DetectOptions> detect = ToDetectOptions(options);
   if (!detect.ok()) {
     return absl::InvalidArgumentError(
         absl::StrCat("detect_options.", detect.status().message()));
   }
+  return detect;
+}
+
+}  // namespace
+
+absl::StatusOr<SegmentOptions> ToSegmentOptions(
+    const v1::SegmentRequest& request) {
+  SegmentOptions options;
+  absl::StatusOr<DetectOptions> detect =
+      ToNestedDetectOptions(request.detect_options());
+  if (!detect.ok()) return detect.status();
   options.detect = *std::move(detect);
   switch (request.method()) {
     case v1::SEGMENTATION_METHOD_UNSPECIFIED:
@@ -592,11 +604,8 @@ absl::StatusOr<IncrementalOptions> ToIncrementalOptions(
     const v1::SegmentIncrementalRequest& request) {
   IncrementalOptions options;
   absl::StatusOr<DetectOptions> detect =
-      ToDetectOptions(request.detect_options());
-  if (!detect.ok()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("detect_options.", detect.status().message()));
-  }
+      ToNestedDetectOptions(request.detect_options());
+  if (!detect.ok()) return detect.status();
   options.detect = *std::move(detect);
   absl::StatusOr<std::vector<cv::Point>> points =
       ToPixels(request.attention_points(), "attention_points");

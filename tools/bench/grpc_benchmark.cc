@@ -115,6 +115,20 @@ void BenchmarkGrpcDetect(benchmark::State& state, const SceneList& scenes,
   });
 }
 
+// Reads a segmentation stream to its end; its status.
+absl::Status ReadStream(
+    std::unique_ptr<grpc::ClientReader<v1::SegmentResponse>> reader) {
+  v1::SegmentResponse response;
+  int messages = 0;
+  while (reader->Read(&response)) ++messages;
+  const grpc::Status status = reader->Finish();
+  benchmark::DoNotOptimize(messages);
+  return status.ok()
+             ? absl::OkStatus()
+             : absl::Status(static_cast<absl::StatusCode>(status.error_code()),
+                            status.error_message());
+}
+
 // One Segment call per scene with the server's default options and
 // `method`; max_objects 1 ends the stream after the first object (the time
 // to the first mask), 0 cuts them all.
@@ -138,17 +152,8 @@ void BenchmarkGrpcSegment(benchmark::State& state, const SceneList& scenes,
   }
   SweepScenes(state, scenes, set_name, [&](const BenchScene& scene) {
     grpc::ClientContext context;
-    auto reader = (*loopback)->stub->Segment(&context, requests.at(&scene));
-    v1::SegmentResponse response;
-    int messages = 0;
-    while (reader->Read(&response)) ++messages;
-    const grpc::Status status = reader->Finish();
-    if (!status.ok()) {
-      return absl::Status(static_cast<absl::StatusCode>(status.error_code()),
-                          status.error_message());
-    }
-    benchmark::DoNotOptimize(messages);
-    return absl::OkStatus();
+    return ReadStream(
+        (*loopback)->stub->Segment(&context, requests.at(&scene)));
   });
 }
 
@@ -172,18 +177,8 @@ void BenchmarkGrpcIncremental(benchmark::State& state, const SceneList& scenes,
   }
   SweepScenes(state, scenes, set_name, [&](const BenchScene& scene) {
     grpc::ClientContext context;
-    auto reader =
-        (*loopback)->stub->SegmentIncremental(&context, requests.at(&scene));
-    v1::SegmentResponse response;
-    int messages = 0;
-    while (reader->Read(&response)) ++messages;
-    const grpc::Status status = reader->Finish();
-    if (!status.ok()) {
-      return absl::Status(static_cast<absl::StatusCode>(status.error_code()),
-                          status.error_message());
-    }
-    benchmark::DoNotOptimize(messages);
-    return absl::OkStatus();
+    return ReadStream(
+        (*loopback)->stub->SegmentIncremental(&context, requests.at(&scene)));
   });
 }
 

@@ -46,7 +46,8 @@ std::map<int, std::vector<cv::Point>> ObjectPixels(const LabelledFrame& scene) {
 // The mask's pixel nearest its centroid.
 cv::Point CentralPixelOf(const cv::Mat& mask) {
   const cv::Moments m = cv::moments(mask, true);
-  const cv::Point2d c(m.m10 / std::max(m.m00, 1.0), m.m01 / std::max(m.m00, 1.0));
+  const cv::Point2d c(m.m10 / std::max(m.m00, 1.0),
+                      m.m01 / std::max(m.m00, 1.0));
   std::vector<cv::Point> pixels;
   cv::findNonZero(mask, pixels);
   cv::Point best = pixels.empty() ? cv::Point() : pixels[0];
@@ -275,9 +276,7 @@ absl::StatusOr<IncEvalSummary> EvaluateInc(
     absl::StatusOr<std::vector<SvmSample>> s =
         CollectIncSamples(scenes[i], static_cast<int>(i), run.detect, run.inc);
     if (!s.ok()) {
-      return absl::Status(
-          s.status().code(),
-          absl::StrCat(scenes[i].name, ": ", s.status().message()));
+      return InScene(scenes[i].name, s.status());
     }
     samples[i] = *std::move(s);
   }
@@ -298,9 +297,7 @@ absl::StatusOr<IncEvalSummary> EvaluateInc(
       const LabelledFrame& scene = scenes[i];
       absl::StatusOr<WholeRun> whole = RunToTheEnd(scene, run, *svm);
       if (!whole.ok()) {
-        return absl::Status(
-            whole.status().code(),
-            absl::StrCat(scene.name, ": ", whole.status().message()));
+        return InScene(scene.name, whole.status());
       }
       IncSceneResult r;
       r.name = scene.name;
@@ -361,9 +358,7 @@ absl::StatusOr<IncEvalSummary> EvaluatePeer(
             ? SegmentSceneEuclidean(*cloud, EuclideanSceneOptions{})
             : SegmentSceneLccp(*cloud, LccpSceneOptions{});
     if (!segmentation.ok()) {
-      return absl::Status(segmentation.status().code(),
-                          absl::StrCat(scene.name, ": ",
-                                       segmentation.status().message()));
+      return InScene(scene.name, segmentation.status());
     }
     const double ms = std::chrono::duration<double, std::milli>(
                           std::chrono::steady_clock::now() - start)

@@ -347,8 +347,8 @@ int RunSegmentEval() {
                    scenes.status().ToString().c_str());
       return kRunError;
     }
-    absl::StatusOr<IncEvalSummary> summary = EvaluatePeer(
-        *scenes, method_name, absl::GetFlag(FLAGS_verbose));
+    absl::StatusOr<IncEvalSummary> summary =
+        EvaluatePeer(*scenes, method_name, absl::GetFlag(FLAGS_verbose));
     if (!summary.ok()) {
       std::fprintf(stderr, "fovea-eval: %s\n",
                    summary.status().ToString().c_str());

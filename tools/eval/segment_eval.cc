@@ -119,9 +119,7 @@ absl::StatusOr<SegmentEvalSummary> EvaluateSegment(
     absl::StatusOr<std::vector<SvmSample>> s = CollectCosSamples(
         scenes[i], static_cast<int>(i), segment.detect, segment.cos);
     if (!s.ok()) {
-      return absl::Status(
-          s.status().code(),
-          absl::StrCat(scenes[i].name, ": ", s.status().message()));
+      return InScene(scenes[i].name, s.status());
     }
     samples[i] = *std::move(s);
   }
@@ -165,9 +163,7 @@ absl::StatusOr<SegmentEvalSummary> EvaluateSegment(
       absl::StatusOr<SegmentSummary> run =
           RunSegment(scene.frame, segment, models, sinks);
       if (!run.ok()) {
-        return absl::Status(
-            run.status().code(),
-            absl::StrCat(scene.name, ": ", run.status().message()));
+        return InScene(scene.name, run.status());
       }
       SceneSegmentResult r;
       r.name = scene.name;

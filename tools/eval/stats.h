@@ -2,7 +2,11 @@
 #define FOVEA_TOOLS_EVAL_STATS_H_
 
 #include <algorithm>
+#include <string>
 #include <vector>
+
+#include "absl/status/status.h"
+#include "absl/strings/str_cat.h"
 
 namespace fovea::eval {
 
@@ -17,6 +21,13 @@ inline double Median(std::vector<double> values) {
     m = (m + *std::max_element(values.begin(), values.begin() + mid)) / 2.0;
   }
   return m;
+}
+
+// `status` with the scene's name in front of its message.
+inline absl::Status InScene(const std::string& scene,
+                            const absl::Status& status) {
+  return absl::Status(status.code(),
+                      absl::StrCat(scene, ": ", status.message()));
 }
 
 }  // namespace fovea::eval

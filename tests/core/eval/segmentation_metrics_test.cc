@@ -70,8 +70,7 @@ TEST(WholeSceneFTest, BestSegmentPerObjectAndTableSegmentsIgnored) {
   segments.colRange(0, 6).setTo(0);
   segments.colRange(6, 8).setTo(1);
   segments.colRange(8, 10).setTo(2);
-  EXPECT_NEAR(WholeSceneF(Labels(), segments), (0.8 + 2.0 / 3.0) / 2.0,
-              1e-9);
+  EXPECT_NEAR(WholeSceneF(Labels(), segments), (0.8 + 2.0 / 3.0) / 2.0, 1e-9);
   // An object no segment touches scores 0.
   cv::Mat only_first(10, 10, CV_32SC1, cv::Scalar(-1));
   only_first.colRange(0, 4).setTo(0);
