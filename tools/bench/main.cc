@@ -2,6 +2,11 @@
 // frames, one core.
 //
 //   fovea-bench [--passes=N] [--osd_scenes=N] [--benchmark_* flags]
+//   fovea-bench load --server 127.0.0.1:PORT --clients C --requests N
+//                    [--seconds S] [--rpc detect|segment|segment-incremental]
+//                    (closed-loop load on a running server, loopback only:
+//                    throughput, p50/p99 latency, time to first object,
+//                    calls per status code)
 //
 // Inputs: synthetic scenes (core/synth, seeds kSynthSeeds) and, when
 // FOVEA_OSD_DIR names the OSD data (learn/learn*.pcd), the same cases on
@@ -33,6 +38,7 @@
 #include "tools/bench/stage_benchmarks.h"
 #ifdef FOVEA_BENCH_GRPC
 #include "tools/bench/grpc_benchmark.h"
+#include "tools/bench/load.h"
 #endif
 
 namespace {
@@ -101,7 +107,65 @@ BenchFlags ParseFlags(int argc, char** argv, std::vector<char*>& args) {
 
 }  // namespace
 
+#ifdef FOVEA_BENCH_GRPC
+// `fovea-bench load --server ADDR --clients C --requests N --seconds S
+// --rpc detect|segment|segment-incremental [--deadline_s D]`.
+int RunLoadCommand(int argc, char** argv) {
+  fovea::bench::LoadOptions options;
+  for (int i = 2; i + 1 < argc; i += 2) {
+    const std::string flag = argv[i];
+    const std::string value = argv[i + 1];
+    int n = 0;
+    double x = 0;
+    if (flag == "--server") {
+      options.server = value;
+    } else if (flag == "--rpc") {
+      options.rpc = value;
+    } else if (flag == "--clients" && absl::SimpleAtoi(value, &n)) {
+      options.clients = n;
+    } else if (flag == "--requests" && absl::SimpleAtoi(value, &n)) {
+      options.requests = n;
+    } else if (flag == "--seconds" && absl::SimpleAtod(value, &x)) {
+      options.max_seconds = x;
+    } else if (flag == "--deadline_s" && absl::SimpleAtod(value, &x)) {
+      options.deadline_seconds = x;
+    } else {
+      std::fprintf(stderr, "fovea-bench load: bad flag %s %s\n", flag.c_str(),
+                   value.c_str());
+      return 2;
+    }
+  }
+  const absl::StatusOr<fovea::bench::LoadReport> report =
+      fovea::bench::RunLoad(options);
+  if (!report.ok()) {
+    std::fprintf(stderr, "fovea-bench load: %s\n",
+                 report.status().ToString().c_str());
+    return 2;
+  }
+  std::printf(
+      "load %s on %s: %d clients, %d calls in %.2f s: %.1f calls/s, p50 %.1f "
+      "ms, p99 %.1f ms",
+      options.rpc.c_str(), options.server.c_str(), options.clients,
+      report->calls, report->seconds, report->throughput, report->p50_ms,
+      report->p99_ms);
+  if (report->first_object_p50_ms > 0) {
+    std::printf(", first object p50 %.1f ms", report->first_object_p50_ms);
+  }
+  std::printf("\ncodes:");
+  for (const auto& [code, count] : report->codes) {
+    std::printf(" %s %d", code.c_str(), count);
+  }
+  std::printf("\n");
+  return 0;
+}
+#endif
+
 int main(int argc, char** argv) {
+#ifdef FOVEA_BENCH_GRPC
+  if (argc > 1 && std::string_view(argv[1]) == "load") {
+    return RunLoadCommand(argc, argv);
+  }
+#endif
   std::vector<char*> args;
   const BenchFlags flags = ParseFlags(argc, argv, args);
   int bench_argc = static_cast<int>(args.size()) - 1;
