@@ -1,0 +1,87 @@
+#include "tools/bench/load.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
+
+#include "server/log.h"
+#include "server/server.h"
+
+namespace fovea::bench {
+namespace {
+
+// An in-process server on a free loopback port, warmed up.
+std::unique_ptr<server::FoveaServer> Start(server::ServerConfig config) {
+  server::SetLogLevel(server::LogLevel::kWarn);
+  config.listen = "127.0.0.1:0";
+  absl::StatusOr<std::unique_ptr<server::FoveaServer>> started =
+      server::FoveaServer::Start(std::move(config));
+  EXPECT_TRUE(started.ok()) << started.status();
+  if (!started.ok()) return nullptr;
+  for (int i = 0; i < 6000 && !(*started)->warmed_up(); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return *std::move(started);
+}
+
+TEST(LoadTest, EveryCallIsCountedByCodeWithLatencies) {
+  server::ServerConfig config;
+  config.concurrency = 2;
+  config.queue = 8;
+  std::unique_ptr<server::FoveaServer> s = Start(config);
+  ASSERT_NE(s, nullptr);
+  LoadOptions options;
+  options.server = "127.0.0.1:" + std::to_string(s->port());
+  options.clients = 2;
+  options.requests = 6;
+  options.rpc = "segment";
+  absl::StatusOr<LoadReport> report = RunLoad(options);
+  ASSERT_TRUE(report.ok()) << report.status();
+  EXPECT_EQ(report->calls, 6);
+  EXPECT_EQ(report->codes["OK"], 6);
+  EXPECT_GT(report->p50_ms, 0.0);
+  EXPECT_GE(report->p99_ms, report->p50_ms);
+  EXPECT_GT(report->first_object_p50_ms, 0.0);
+  EXPECT_GT(report->throughput, 0.0);
+}
+
+TEST(LoadTest, AFullQueueAnswersResourceExhaustedNotACollapse) {
+  server::ServerConfig config;
+  config.concurrency = 1;
+  config.queue = 0;
+  // Keep the one worker busy long enough for the other clients to arrive.
+  config.before_detect_job = [] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  };
+  std::unique_ptr<server::FoveaServer> s = Start(config);
+  ASSERT_NE(s, nullptr);
+  LoadOptions options;
+  options.server = "127.0.0.1:" + std::to_string(s->port());
+  options.clients = 6;
+  options.requests = 6;
+  absl::StatusOr<LoadReport> report = RunLoad(options);
+  ASSERT_TRUE(report.ok()) << report.status();
+  EXPECT_EQ(report->calls, 6);
+  EXPECT_GE(report->codes["OK"], 1);
+  EXPECT_GE(report->codes["ResourceExhausted"], 1);
+  EXPECT_EQ(report->codes["OK"] + report->codes["ResourceExhausted"], 6);
+}
+
+TEST(LoadTest, OnlyLoopbackAndSaneNumbers) {
+  LoadOptions options;
+  options.server = "10.1.2.3:50051";
+  EXPECT_EQ(RunLoad(options).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  options.server = "127.0.0.1:1";
+  options.clients = 0;
+  EXPECT_EQ(RunLoad(options).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  options.clients = 1;
+  options.rpc = "nope";
+  EXPECT_EQ(RunLoad(options).status().code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace fovea::bench
