@@ -19,7 +19,7 @@ import unittest
 
 try:
     import grpc
-    import numpy  # noqa: F401 (needed by the example)
+    import numpy
     from fovea_client import FoveaClient
 except ImportError as e:
     print(f"skipped: {e}")
