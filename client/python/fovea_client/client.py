@@ -1,0 +1,130 @@
+"""A small blocking client for fovea.v1.Perception (perception.proto)."""
+
+import grpc
+
+from fovea.health.v1 import health_pb2
+from fovea.v1 import detect_pb2, perception_pb2, perception_pb2_grpc, segment_pb2
+
+from fovea_client.frame import frame_from_numpy
+
+_HEALTH_CHECK = "/grpc.health.v1.Health/Check"
+# The gRPC default is 4 MiB; a 640x480 frame with float depth is ~2.2 MB,
+# larger frames need more. The server's own limit is in GetCapabilities.
+_MAX_MESSAGE_BYTES = 64 * 1024 * 1024
+
+
+def detect_options(**options):
+    """DetectOptions (detect.proto) from keyword arguments.
+
+    Fields are named as in the proto: max_points=5, extraction="MSR",
+    pyramid="SIMPLE", split_at_surface_edges=False, ... Enum values may be
+    given by name. `saliency` may be a list of operator names ("rso", "ph")
+    or of (name, weight) pairs. Raises ValueError for an unknown field.
+    """
+    saliency = options.pop("saliency", None)
+    message = detect_pb2.DetectOptions(**options)
+    for entry in saliency or ():
+        name, weight = (entry, 0.0) if isinstance(entry, str) else entry
+        message.saliency.add(op=name.upper(), weight=weight)
+    return message
+
+
+class FoveaClient:
+    """One channel to a Fovea server, e.g. FoveaClient("127.0.0.1:50051").
+
+    Calls raise grpc.RpcError on failure (e.code(), e.details()); the
+    server names the offending field in INVALID_ARGUMENT details. `timeout`
+    arguments are seconds (None = no deadline).
+    """
+
+    def __init__(self, target, channel=None):
+        self._channel = channel or grpc.insecure_channel(
+            target,
+            options=[("grpc.max_receive_message_length", _MAX_MESSAGE_BYTES),
+                     ("grpc.max_send_message_length", _MAX_MESSAGE_BYTES)])
+        self._stub = perception_pb2_grpc.PerceptionStub(self._channel)
+        self._health = self._channel.unary_unary(
+            _HEALTH_CHECK,
+            request_serializer=health_pb2.HealthCheckRequest.SerializeToString,
+            response_deserializer=health_pb2.HealthCheckResponse.FromString)
+
+    def close(self):
+        self._channel.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def health(self, service="fovea.v1.Perception", timeout=5.0):
+        """The grpc.health.v1 status name, e.g. "SERVING"."""
+        response = self._health(
+            health_pb2.HealthCheckRequest(service=service), timeout=timeout)
+        return health_pb2.HealthCheckResponse.ServingStatus.Name(response.status)
+
+    def capabilities(self, timeout=None):
+        """The server's Capabilities (perception.proto)."""
+        return self._stub.GetCapabilities(
+            perception_pb2.GetCapabilitiesRequest(), timeout=timeout)
+
+    def detect(self, color_rgb, depth_m, fx, fy, cx, cy, timeout=None,
+               request_id="", **options):
+        """Attention points for one frame: a DetectResponse (detect.proto).
+
+        color_rgb: (H, W, 3) uint8 RGB; depth_m: (H, W) float32 metres
+        (NaN or 0 = no data) or uint16 millimetres; see frame_from_numpy.
+        `options` are DetectOptions fields (see detect_options).
+        """
+        request = detect_pb2.DetectRequest(
+            request_id=request_id,
+            frame=frame_from_numpy(color_rgb, depth_m, fx, fy, cx, cy),
+            options=detect_options(**options))
+        return self.detect_request(request, timeout=timeout)
+
+    def detect_request(self, request, timeout=None):
+        """Detect with a ready DetectRequest (e.g. a frame_from_files one)."""
+        return self._stub.Detect(request, timeout=timeout)
+
+    def segment(self, color_rgb, depth_m, fx, fy, cx, cy, method="COS",
+                max_objects=0, seeds=(), timeout=None, request_id="",
+                **options):
+        """Object masks for one frame, as a generator of SegmentResponse.
+
+        Messages are yielded as they arrive: first the attention points,
+        then one per object (`response.object`, mask as COCO RLE; see
+        decode_rle), then one with `last` set and a summary. method: "COS"
+        or "EBS". seeds: (u, v) pixels to use instead of attention points.
+        `options` are DetectOptions fields for the attention points.
+        Breaking out of the loop early cancels the call.
+        """
+        request = segment_pb2.SegmentRequest(
+            request_id=request_id,
+            frame=frame_from_numpy(color_rgb, depth_m, fx, fy, cx, cy),
+            method=method, max_objects=max_objects,
+            seeds=[detect_pb2.AttentionPixel(u=u, v=v) for u, v in seeds],
+            detect_options=detect_options(**options))
+        return self.segment_request(request, timeout=timeout)
+
+    def segment_request(self, request, timeout=None):
+        """Segment with a ready SegmentRequest; a generator as segment()."""
+        return self._stream(self._stub.Segment(request, timeout=timeout))
+
+    def segment_incremental(self, color_rgb, depth_m, fx, fy, cx, cy,
+                            max_objects=0, time_budget_seconds=0.0,
+                            timeout=None, request_id="", **options):
+        """Anytime incremental segmentation (INC); a generator as segment()."""
+        request = segment_pb2.SegmentIncrementalRequest(
+            request_id=request_id,
+            frame=frame_from_numpy(color_rgb, depth_m, fx, fy, cx, cy),
+            max_objects=max_objects, time_budget_seconds=time_budget_seconds,
+            detect_options=detect_options(**options))
+        return self._stream(
+            self._stub.SegmentIncremental(request, timeout=timeout))
+
+    @staticmethod
+    def _stream(call):
+        try:
+            yield from call
+        finally:
+            call.cancel()  # a no-op when the stream has ended

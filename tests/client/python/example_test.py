@@ -1,0 +1,108 @@
+"""client/python/example.py against a live fovea-server: starts the server
+on a free loopback port, waits for health SERVING, runs the example on its
+synthetic NumPy scene and expects exit 0 with every decoded mask matching
+its object's area. Exits 77 (ctest SKIP_RETURN_CODE) when the Python
+modules are missing.
+
+    example_test.py --server_binary build/bin/fovea-server \\
+        --models_dir models --example client/python/example.py
+"""
+
+import argparse
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+import unittest
+
+try:
+    import grpc
+    import numpy
+    from fovea_client import FoveaClient
+except ImportError as e:
+    print(f"skipped: {e}")
+    sys.exit(77)
+
+ARGS = None  # set in __main__
+
+
+def free_port():
+    """A TCP port on 127.0.0.1 that was free a moment ago."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class ExampleTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.target = f"127.0.0.1:{free_port()}"
+        cls.server = subprocess.Popen(
+            [ARGS.server_binary, f"--listen={cls.target}", "--metrics_listen=",
+             f"--models_dir={ARGS.models_dir}", "--concurrency=1"])
+        deadline = time.monotonic() + 60
+        status = None
+        while time.monotonic() < deadline and cls.server.poll() is None:
+            # A fresh channel per attempt: one that tried before the server
+            # listened may wait out gRPC's reconnect backoff.
+            with FoveaClient(cls.target) as client:
+                try:
+                    status = client.health(timeout=1.0)
+                except grpc.RpcError:
+                    status = None
+            if status == "SERVING":
+                return
+            time.sleep(0.1)
+        cls.tearDownClass()
+        raise AssertionError(f"fovea-server not SERVING within 60 s "
+                             f"(exit code {cls.server.returncode})")
+
+    @classmethod
+    def tearDownClass(cls):
+        if cls.server.poll() is None:
+            cls.server.send_signal(signal.SIGTERM)
+            try:
+                cls.server.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                cls.server.kill()
+                cls.server.wait()
+
+    def test_capabilities_list_cos(self):
+        with FoveaClient(self.target) as client:
+            capabilities = client.capabilities(timeout=10)
+        self.assertIn("32FC1", capabilities.depth_encodings)
+        self.assertIn(1, capabilities.segmentation_methods)  # COS
+
+    def test_example_prints_objects_whose_masks_match_their_area(self):
+        run = subprocess.run(
+            [sys.executable, ARGS.example, "--server", self.target],
+            capture_output=True, text=True, timeout=300, env=os.environ)
+        sys.stdout.write(run.stdout)
+        sys.stderr.write(run.stderr)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        objects = [line for line in run.stdout.splitlines()
+                   if line.startswith("object ")]
+        self.assertGreaterEqual(len(objects), 1, run.stdout)
+        self.assertNotIn("MISMATCH", run.stdout)
+        self.assertIn("support plane", run.stdout)
+
+    def test_bad_frame_is_invalid_argument(self):
+        rgb = numpy.zeros((4, 4, 3), numpy.uint8)
+        depth = numpy.zeros((4, 4), numpy.float32)
+        with FoveaClient(self.target) as client:
+            with self.assertRaises(grpc.RpcError) as caught:
+                client.detect(rgb, depth, fx=-1, fy=525, cx=2, cy=2, timeout=10)
+        self.assertEqual(caught.exception.code(),
+                         grpc.StatusCode.INVALID_ARGUMENT)
+        self.assertIn("fx", caught.exception.details())
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--server_binary", required=True)
+    parser.add_argument("--models_dir", required=True)
+    parser.add_argument("--example", required=True)
+    ARGS, rest = parser.parse_known_args()
+    unittest.main(argv=[sys.argv[0]] + rest)
