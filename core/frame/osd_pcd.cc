@@ -212,9 +212,53 @@ bool ParseCounts(const std::vector<absl::string_view>& tokens, uint64_t max,
   return true;
 }
 
+// PCL's PCDReader::readHeader goes on reading header lines after DATA:
+// empty lines and comments are skipped and a line whose first word starts
+// with a keyword ("FIELDSx" counts) is taken as header, until any other
+// line. So a body starting e.g. "FIELDS a" re-declares the cloud behind
+// CheckPcdFile's back, and PCL's ASCII reader then reads freed memory.
+// Refuses such a body; `pos` is where the line after DATA starts in `head`,
+// the first `head.size()` bytes of a file of `file_size` bytes.
+absl::Status CheckNoHeaderAfterData(const std::string& path,
+                                    absl::string_view head, size_t pos,
+                                    uint64_t file_size) {
+  static constexpr absl::string_view kKeywords[] = {
+      "VERSION", "FIELDS", "COLUMNS",   "SIZE",   "TYPE", "COUNT",
+      "WIDTH",   "HEIGHT", "VIEWPOINT", "POINTS", "DATA"};
+  const bool whole_file = head.size() == file_size;
+  while (pos < head.size()) {
+    size_t end = head.find('\n', pos);
+    const bool cut = end == absl::string_view::npos;
+    if (cut) end = head.size();
+    const absl::string_view line = head.substr(pos, end - pos);
+    pos = end + 1;
+    // PCL's first word: `stream >> word`, i.e. after leading white space.
+    const absl::string_view rest = absl::StripLeadingAsciiWhitespace(line);
+    const absl::string_view word =
+        rest.substr(0, rest.find_first_of(" \t\n\v\f\r"));
+    const bool skipped = line.empty() || absl::StartsWith(word, "#");
+    if (cut && !whole_file && (skipped || word.size() == rest.size())) {
+      return PcdError(path, "header comments run past the header size limit");
+    }
+    if (skipped) continue;
+    for (const absl::string_view keyword : kKeywords) {
+      if (absl::StartsWith(word, keyword)) {
+        return PcdError(path,
+                        absl::StrCat("header line '", keyword, "' after DATA"));
+      }
+    }
+    return absl::OkStatus();
+  }
+  if (!whole_file) {
+    return PcdError(path, "header comments run past the header size limit");
+  }
+  return absl::OkStatus();
+}
+
 // Checks what PCL's PCDReader assumes without checking (it reads past its
 // buffers on some malformed files): a complete v0.7 header whose field
-// sizes, types and counts agree, WIDTH x HEIGHT = POINTS, and enough bytes
+// sizes, types and counts agree, WIDTH x HEIGHT = POINTS, no header line
+// after DATA (CheckNoHeaderAfterData), and enough bytes
 // after DATA for a binary or binary_compressed body.
 absl::Status CheckPcdFile(const std::string& path, uint64_t file_size) {
   std::ifstream in(path, std::ios::binary);
@@ -291,6 +335,8 @@ absl::Status CheckPcdFile(const std::string& path, uint64_t file_size) {
                                    absl::CHexEscape(key.substr(0, 16)), "'"));
     }
   }
+  absl::Status after_data = CheckNoHeaderAfterData(path, head, pos, file_size);
+  if (!after_data.ok()) return after_data;
   if (fields == 0 || sizes.size() != fields || types.size() != fields) {
     return PcdError(path, "FIELDS, SIZE or TYPE missing");
   }

@@ -260,6 +260,33 @@ TEST(OsdPcdTest, GarbageFilesAreRefusedNotCrashedOn) {
             absl::StatusCode::kInvalidArgument);
 }
 
+// PCL's reader takes keyword lines after DATA as more header; a body that
+// re-declared FIELDS made its ASCII reader read freed memory (found by
+// tests/fuzz/fuzz_pcd_load). Comments and empty lines there stay harmless.
+TEST(OsdPcdTest, HeaderLinesAfterDataAreRefused) {
+  const std::filesystem::path dir = TestDir();
+  const std::string header =
+      PcdHeader("x y z rgb", "F F F F", 4, 2, 1, "ascii");
+  const std::vector<std::pair<std::string, std::string>> bodies = {
+      {"fields.pcd", "\nFIELDS label 11 0\n1 2 3 4\n"},
+      {"comment_then_count.pcd", "# note\n\nCOUNT 1 1 1 1\n1 2 3 4\n"},
+      {"prefix.pcd", "  DATAx ascii\n1 2 3 4\n"},
+  };
+  for (const auto& [name, body] : bodies) {
+    const absl::StatusOr<LabelledFrame> loaded =
+        LoadOsdPcd(WriteFile(dir / name, header + body));
+    ASSERT_FALSE(loaded.ok()) << name;
+    EXPECT_EQ(loaded.status().code(), absl::StatusCode::kInvalidArgument)
+        << name;
+    EXPECT_THAT(std::string(loaded.status().message()), HasSubstr("after DATA"))
+        << name;
+  }
+  const absl::StatusOr<LabelledFrame> commented = LoadOsdPcd(WriteFile(
+      dir / "commented.pcd", header + "# a comment\n\n0 0 1 4\n0.01 0 1 4\n"));
+  ASSERT_TRUE(commented.ok()) << commented.status();
+  EXPECT_EQ(commented->frame.depth.type(), CV_32FC1);
+}
+
 TEST(OsdPcdTest, ListPcdFilesSortsByTheNumberInTheName) {
   const std::filesystem::path dir = TestDir();
   for (const char* name :
