@@ -281,7 +281,13 @@ absl::Status CheckPcdFile(const std::string& path, uint64_t file_size) {
     pos = end + 1;
     const std::vector<absl::string_view> tokens =
         absl::StrSplit(line, absl::ByAnyChar(" \t\r"), absl::SkipEmpty());
-    if (tokens.empty() || absl::StartsWith(tokens[0], "#")) continue;
+    if (line.empty()) continue;
+    if (tokens.empty()) {
+      // PCL's readHeader stops at such a line and reads on with what it
+      // has (no POINTS: it dereferences a null pointer).
+      return PcdError(path, "a header line of only white space");
+    }
+    if (absl::StartsWith(tokens[0], "#")) continue;
     const absl::string_view key = tokens[0];
     const size_t values = tokens.size() - 1;
     if (key == "VERSION" || key == "VIEWPOINT") continue;

@@ -287,6 +287,19 @@ TEST(OsdPcdTest, HeaderLinesAfterDataAreRefused) {
   EXPECT_EQ(commented->frame.depth.type(), CV_32FC1);
 }
 
+// PCL's reader ends its header at a line of only white space and then
+// dereferenced a null pointer (found by tests/fuzz/fuzz_pcd_load).
+TEST(OsdPcdTest, WhiteSpaceLineInTheHeaderIsRefused) {
+  const std::string pcd =
+      " \n" + PcdHeader("x y z rgb", "F F F F", 4, 1, 1, "ascii") + "0 0 1 4\n";
+  const absl::StatusOr<LabelledFrame> loaded =
+      LoadOsdPcd(WriteFile(TestDir() / "blank.pcd", pcd));
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_EQ(loaded.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(loaded.status().message()),
+              HasSubstr("only white space"));
+}
+
 TEST(OsdPcdTest, ListPcdFilesSortsByTheNumberInTheName) {
   const std::filesystem::path dir = TestDir();
   for (const char* name :
