@@ -10,6 +10,7 @@
 // contract; a breach aborts, which libFuzzer reports as a crash. With
 // FOVEA_FUZZ_VERBOSE set, each input's outcome is printed.
 
+#include <pcl/console/print.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -46,6 +47,13 @@ const std::string& TempPath() {
 }
 
 }  // namespace
+
+// PCL warns on stderr about every malformed file it reads; that is
+// expected here and would fill the log.
+extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
+  pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
+  return 0;
+}
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size > kMaxInputBytes) return -1;
