@@ -11,6 +11,7 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <istream>
 #include <limits>
 #include <new>
 #include <opencv2/core.hpp>
@@ -217,30 +218,23 @@ bool ParseCounts(const std::vector<absl::string_view>& tokens, uint64_t max,
 // with a keyword ("FIELDSx" counts) is taken as header, until any other
 // line. So a body starting e.g. "FIELDS a" re-declares the cloud behind
 // CheckPcdFile's back, and PCL's ASCII reader then reads freed memory.
-// Refuses such a body; `pos` is where the line after DATA starts in `head`,
-// the first `head.size()` bytes of a file of `file_size` bytes.
-absl::Status CheckNoHeaderAfterData(const std::string& path,
-                                    absl::string_view head, size_t pos,
-                                    uint64_t file_size) {
+// Refuses such a body, reading `in` line by line from `pos`, where the line
+// after DATA starts, as PCL does.
+absl::Status CheckNoHeaderAfterData(const std::string& path, std::istream& in,
+                                    size_t pos) {
   static constexpr absl::string_view kKeywords[] = {
       "VERSION", "FIELDS", "COLUMNS",   "SIZE",   "TYPE", "COUNT",
       "WIDTH",   "HEIGHT", "VIEWPOINT", "POINTS", "DATA"};
-  const bool whole_file = head.size() == file_size;
-  while (pos < head.size()) {
-    size_t end = head.find('\n', pos);
-    const bool cut = end == absl::string_view::npos;
-    if (cut) end = head.size();
-    const absl::string_view line = head.substr(pos, end - pos);
-    pos = end + 1;
+  in.clear();
+  in.seekg(static_cast<std::streamoff>(pos));
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
     // PCL's first word: `stream >> word`, i.e. after leading white space.
     const absl::string_view rest = absl::StripLeadingAsciiWhitespace(line);
     const absl::string_view word =
         rest.substr(0, rest.find_first_of(" \t\n\v\f\r"));
-    const bool skipped = line.empty() || absl::StartsWith(word, "#");
-    if (cut && !whole_file && (skipped || word.size() == rest.size())) {
-      return PcdError(path, "header comments run past the header size limit");
-    }
-    if (skipped) continue;
+    if (absl::StartsWith(word, "#")) continue;
     for (const absl::string_view keyword : kKeywords) {
       if (absl::StartsWith(word, keyword)) {
         return PcdError(path,
@@ -248,9 +242,6 @@ absl::Status CheckNoHeaderAfterData(const std::string& path,
       }
     }
     return absl::OkStatus();
-  }
-  if (!whole_file) {
-    return PcdError(path, "header comments run past the header size limit");
   }
   return absl::OkStatus();
 }
@@ -341,7 +332,7 @@ absl::Status CheckPcdFile(const std::string& path, uint64_t file_size) {
                                    absl::CHexEscape(key.substr(0, 16)), "'"));
     }
   }
-  absl::Status after_data = CheckNoHeaderAfterData(path, head, pos, file_size);
+  absl::Status after_data = CheckNoHeaderAfterData(path, in, pos);
   if (!after_data.ok()) return after_data;
   if (fields == 0 || sizes.size() != fields || types.size() != fields) {
     return PcdError(path, "FIELDS, SIZE or TYPE missing");

@@ -285,6 +285,16 @@ TEST(OsdPcdTest, HeaderLinesAfterDataAreRefused) {
       dir / "commented.pcd", header + "# a comment\n\n0 0 1 4\n0.01 0 1 4\n"));
   ASSERT_TRUE(commented.ok()) << commented.status();
   EXPECT_EQ(commented->frame.depth.type(), CV_32FC1);
+  // A binary body that happens to start with '#' (label 35) is data.
+  std::string hash = PcdHeader("label x y z", "U F F F", 4, 1, 1, "binary");
+  Append<uint32_t>(hash, 35);
+  Append<float>(hash, 0.0f);
+  Append<float>(hash, 0.0f);
+  Append<float>(hash, 1.0f);
+  const absl::StatusOr<LabelledFrame> binary =
+      LoadOsdPcd(WriteFile(dir / "hash.pcd", hash));
+  ASSERT_TRUE(binary.ok()) << binary.status();
+  EXPECT_EQ(cv::countNonZero(binary->labels == 35), 1);
 }
 
 // PCL's reader ends its header at a line of only white space and then
