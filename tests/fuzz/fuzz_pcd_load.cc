@@ -52,6 +52,9 @@ const std::string& TempPath() {
 // expected here and would fill the log.
 extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
   pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
+  // The temporary file goes at a normal exit (not after a crash: it is the
+  // crashing input, which libFuzzer also saves).
+  std::atexit([] { std::remove(TempPath().c_str()); });
   return 0;
 }
 
