@@ -350,6 +350,15 @@ absl::Status CheckPcdFile(const std::string& path, uint64_t file_size) {
   }
   const uint64_t data_bytes = points * point_step;
   const uint64_t body = file_size - std::min<uint64_t>(pos, file_size);
+  // PCL allocates POINTS x point step before reading an ASCII body; each
+  // value there takes at least one character and a separator.
+  uint64_t values = 0;
+  for (size_t i = 0; i < fields; ++i) values += counts[i];
+  if (data_kind == "ascii" && body + 1 < 2 * values * points) {
+    return PcdError(path,
+                    absl::StrCat(body, " bytes of ASCII data for ", points,
+                                 " points of ", values, " values"));
+  }
   if (data_kind == "binary" && body < data_bytes) {
     return PcdError(path, absl::StrCat(body, " bytes of binary data, ",
                                        data_bytes, " expected"));

@@ -310,6 +310,25 @@ TEST(OsdPcdTest, WhiteSpaceLineInTheHeaderIsRefused) {
               HasSubstr("only white space"));
 }
 
+// PCL allocates POINTS x point step before reading an ASCII body: a
+// 100-byte file claiming 50 million points cost it 800 MB.
+TEST(OsdPcdTest, AsciiBodyTooShortForItsPointsIsRefused) {
+  const std::string pcd =
+      PcdHeader("x y z rgb", "F F F F", 4, 50000000, 1, "ascii") + "0 0 1 4\n";
+  const absl::StatusOr<LabelledFrame> loaded =
+      LoadOsdPcd(WriteFile(TestDir() / "huge_ascii.pcd", pcd));
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_EQ(loaded.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(loaded.status().message()),
+              HasSubstr("bytes of ASCII data for 50000000 points"));
+  // The shortest body that can hold its points (no final newline) loads.
+  const absl::StatusOr<LabelledFrame> shortest =
+      LoadOsdPcd(WriteFile(TestDir() / "short_ascii.pcd",
+                           PcdHeader("x y z rgb", "F F F F", 4, 2, 1, "ascii") +
+                               "0 0 1 4\n0 0 2 4"));
+  EXPECT_TRUE(shortest.ok()) << shortest.status();
+}
+
 TEST(OsdPcdTest, ListPcdFilesSortsByTheNumberInTheName) {
   const std::filesystem::path dir = TestDir();
   for (const char* name :
