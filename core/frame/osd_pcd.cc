@@ -11,6 +11,7 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <istream>
 #include <limits>
 #include <new>
 #include <opencv2/core.hpp>
@@ -212,9 +213,43 @@ bool ParseCounts(const std::vector<absl::string_view>& tokens, uint64_t max,
   return true;
 }
 
+// PCL's PCDReader::readHeader goes on reading header lines after DATA:
+// empty lines and comments are skipped and a line whose first word starts
+// with a keyword ("FIELDSx" counts) is taken as header, until any other
+// line. So a body starting e.g. "FIELDS a" re-declares the cloud behind
+// CheckPcdFile's back, and PCL's ASCII reader then reads freed memory.
+// Refuses such a body, reading `in` line by line from `pos`, where the line
+// after DATA starts, as PCL does.
+absl::Status CheckNoHeaderAfterData(const std::string& path, std::istream& in,
+                                    size_t pos) {
+  static constexpr absl::string_view kKeywords[] = {
+      "VERSION", "FIELDS", "COLUMNS",   "SIZE",   "TYPE", "COUNT",
+      "WIDTH",   "HEIGHT", "VIEWPOINT", "POINTS", "DATA"};
+  in.clear();
+  in.seekg(static_cast<std::streamoff>(pos));
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    // PCL's first word: `stream >> word`, i.e. after leading white space.
+    const absl::string_view rest = absl::StripLeadingAsciiWhitespace(line);
+    const absl::string_view word =
+        rest.substr(0, rest.find_first_of(" \t\n\v\f\r"));
+    if (absl::StartsWith(word, "#")) continue;
+    for (const absl::string_view keyword : kKeywords) {
+      if (absl::StartsWith(word, keyword)) {
+        return PcdError(path,
+                        absl::StrCat("header line '", keyword, "' after DATA"));
+      }
+    }
+    return absl::OkStatus();
+  }
+  return absl::OkStatus();
+}
+
 // Checks what PCL's PCDReader assumes without checking (it reads past its
 // buffers on some malformed files): a complete v0.7 header whose field
-// sizes, types and counts agree, WIDTH x HEIGHT = POINTS, and enough bytes
+// sizes, types and counts agree, WIDTH x HEIGHT = POINTS, no header line
+// after DATA (CheckNoHeaderAfterData), and enough bytes
 // after DATA for a binary or binary_compressed body.
 absl::Status CheckPcdFile(const std::string& path, uint64_t file_size) {
   std::ifstream in(path, std::ios::binary);
@@ -237,7 +272,13 @@ absl::Status CheckPcdFile(const std::string& path, uint64_t file_size) {
     pos = end + 1;
     const std::vector<absl::string_view> tokens =
         absl::StrSplit(line, absl::ByAnyChar(" \t\r"), absl::SkipEmpty());
-    if (tokens.empty() || absl::StartsWith(tokens[0], "#")) continue;
+    if (line.empty()) continue;
+    if (tokens.empty()) {
+      // PCL's readHeader stops at such a line and reads on with what it
+      // has (no POINTS: it dereferences a null pointer).
+      return PcdError(path, "a header line of only white space");
+    }
+    if (absl::StartsWith(tokens[0], "#")) continue;
     const absl::string_view key = tokens[0];
     const size_t values = tokens.size() - 1;
     if (key == "VERSION" || key == "VIEWPOINT") continue;
@@ -291,6 +332,8 @@ absl::Status CheckPcdFile(const std::string& path, uint64_t file_size) {
                                    absl::CHexEscape(key.substr(0, 16)), "'"));
     }
   }
+  absl::Status after_data = CheckNoHeaderAfterData(path, in, pos);
+  if (!after_data.ok()) return after_data;
   if (fields == 0 || sizes.size() != fields || types.size() != fields) {
     return PcdError(path, "FIELDS, SIZE or TYPE missing");
   }
@@ -307,6 +350,15 @@ absl::Status CheckPcdFile(const std::string& path, uint64_t file_size) {
   }
   const uint64_t data_bytes = points * point_step;
   const uint64_t body = file_size - std::min<uint64_t>(pos, file_size);
+  // PCL allocates POINTS x point step before reading an ASCII body; each
+  // value there takes at least one character and a separator.
+  uint64_t values = 0;
+  for (size_t i = 0; i < fields; ++i) values += counts[i];
+  if (data_kind == "ascii" && body + 1 < 2 * values * points) {
+    return PcdError(path,
+                    absl::StrCat(body, " bytes of ASCII data for ", points,
+                                 " points of ", values, " values"));
+  }
   if (data_kind == "binary" && body < data_bytes) {
     return PcdError(path, absl::StrCat(body, " bytes of binary data, ",
                                        data_bytes, " expected"));

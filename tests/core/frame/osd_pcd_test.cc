@@ -260,6 +260,75 @@ TEST(OsdPcdTest, GarbageFilesAreRefusedNotCrashedOn) {
             absl::StatusCode::kInvalidArgument);
 }
 
+// PCL's reader takes keyword lines after DATA as more header; a body that
+// re-declared FIELDS made its ASCII reader read freed memory (found by
+// tests/fuzz/fuzz_pcd_load). Comments and empty lines there stay harmless.
+TEST(OsdPcdTest, HeaderLinesAfterDataAreRefused) {
+  const std::filesystem::path dir = TestDir();
+  const std::string header =
+      PcdHeader("x y z rgb", "F F F F", 4, 2, 1, "ascii");
+  const std::vector<std::pair<std::string, std::string>> bodies = {
+      {"fields.pcd", "\nFIELDS label 11 0\n1 2 3 4\n"},
+      {"comment_then_count.pcd", "# note\n\nCOUNT 1 1 1 1\n1 2 3 4\n"},
+      {"prefix.pcd", "  DATAx ascii\n1 2 3 4\n"},
+  };
+  for (const auto& [name, body] : bodies) {
+    const absl::StatusOr<LabelledFrame> loaded =
+        LoadOsdPcd(WriteFile(dir / name, header + body));
+    ASSERT_FALSE(loaded.ok()) << name;
+    EXPECT_EQ(loaded.status().code(), absl::StatusCode::kInvalidArgument)
+        << name;
+    EXPECT_THAT(std::string(loaded.status().message()), HasSubstr("after DATA"))
+        << name;
+  }
+  const absl::StatusOr<LabelledFrame> commented = LoadOsdPcd(WriteFile(
+      dir / "commented.pcd", header + "# a comment\n\n0 0 1 4\n0.01 0 1 4\n"));
+  ASSERT_TRUE(commented.ok()) << commented.status();
+  EXPECT_EQ(commented->frame.depth.type(), CV_32FC1);
+  // A binary body that happens to start with '#' (label 35) is data.
+  std::string hash = PcdHeader("label x y z", "U F F F", 4, 1, 1, "binary");
+  Append<uint32_t>(hash, 35);
+  Append<float>(hash, 0.0f);
+  Append<float>(hash, 0.0f);
+  Append<float>(hash, 1.0f);
+  const absl::StatusOr<LabelledFrame> binary =
+      LoadOsdPcd(WriteFile(dir / "hash.pcd", hash));
+  ASSERT_TRUE(binary.ok()) << binary.status();
+  EXPECT_EQ(cv::countNonZero(binary->labels == 35), 1);
+}
+
+// PCL's reader ends its header at a line of only white space and then
+// dereferenced a null pointer (found by tests/fuzz/fuzz_pcd_load).
+TEST(OsdPcdTest, WhiteSpaceLineInTheHeaderIsRefused) {
+  const std::string pcd =
+      " \n" + PcdHeader("x y z rgb", "F F F F", 4, 1, 1, "ascii") + "0 0 1 4\n";
+  const absl::StatusOr<LabelledFrame> loaded =
+      LoadOsdPcd(WriteFile(TestDir() / "blank.pcd", pcd));
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_EQ(loaded.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(loaded.status().message()),
+              HasSubstr("only white space"));
+}
+
+// PCL allocates POINTS x point step before reading an ASCII body: a
+// 100-byte file claiming 50 million points cost it 800 MB.
+TEST(OsdPcdTest, AsciiBodyTooShortForItsPointsIsRefused) {
+  const std::string pcd =
+      PcdHeader("x y z rgb", "F F F F", 4, 50000000, 1, "ascii") + "0 0 1 4\n";
+  const absl::StatusOr<LabelledFrame> loaded =
+      LoadOsdPcd(WriteFile(TestDir() / "huge_ascii.pcd", pcd));
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_EQ(loaded.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(loaded.status().message()),
+              HasSubstr("bytes of ASCII data for 50000000 points"));
+  // The shortest body that can hold its points (no final newline) loads.
+  const absl::StatusOr<LabelledFrame> shortest =
+      LoadOsdPcd(WriteFile(TestDir() / "short_ascii.pcd",
+                           PcdHeader("x y z rgb", "F F F F", 4, 2, 1, "ascii") +
+                               "0 0 1 4\n0 0 2 4"));
+  EXPECT_TRUE(shortest.ok()) << shortest.status();
+}
+
 TEST(OsdPcdTest, ListPcdFilesSortsByTheNumberInTheName) {
   const std::filesystem::path dir = TestDir();
   for (const char* name :
