@@ -4,15 +4,16 @@
 fuzz_frame_decode inputs are a mode byte (0 = protobuf, 1 = raw) and then
 a fovea.v1.Frame, encoded here by hand from proto/fovea/v1/frame.proto's
 field numbers, or FuzzedDataProvider bytes. fuzz_pcd_load inputs are PCD
-files with the OSD fields label x y z rgba. Run from anywhere; rerun after
-changing it and commit the output.
+files with the OSD fields label x y z rgba. Usage: make_corpus.py OUT_DIR
+(writes OUT_DIR/<target>/...); scripts/fuzz runs it into build-fuzz/seeds,
+so no seed file is kept in the repository.
 """
 
 import os
 import struct
+import sys
 import zlib
 
-HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 def varint(n):
@@ -102,7 +103,7 @@ JPEG_4X4 = bytes.fromhex(
 
 
 def write(target, name, data):
-    folder = os.path.join(HERE, "corpus", target)
+    folder = os.path.join(OUT, target)
     os.makedirs(folder, exist_ok=True)
     with open(os.path.join(folder, name), "wb") as f:
         f.write(data)
@@ -196,5 +197,8 @@ def pcd_corpus():
 
 
 if __name__ == "__main__":
+    if len(sys.argv) != 2:
+        sys.exit("usage: make_corpus.py OUT_DIR")
+    OUT = sys.argv[1]
     frame_corpus()
     pcd_corpus()
