@@ -4,6 +4,7 @@
 #include <signal.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <thread>
@@ -16,6 +17,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/time/time.h"
 #include "server/capabilities.h"
+#include "server/env_flags.h"
 #include "server/log.h"
 #include "server/server.h"
 
@@ -61,11 +63,15 @@ ABSL_FLAG(std::string, log_level, "info", "debug, info, warn or error.");
 
 int main(int argc, char** argv) {
   absl::SetProgramUsageMessage(
-      "Fovea perception service: attention points (Detect) and, later, "
-      "object masks from RGB-D frames over gRPC (fovea.v1.Perception; "
-      "health: grpc.health.v1; server reflection on).\n"
+      "Fovea perception service: attention points (Detect) and object "
+      "masks (Segment, SegmentIncremental) from RGB-D frames over gRPC "
+      "(fovea.v1.Perception; health: grpc.health.v1; server reflection "
+      "on).\n"
       "Usage: fovea-server [--listen=HOST:PORT] "
       "[--metrics_listen=HOST:PORT] [--concurrency=N] [--queue=N] ...\n"
+      "Every flag can also come from the environment: FOVEA_LISTEN, "
+      "FOVEA_METRICS_LISTEN, FOVEA_MODELS_DIR, ... (the flag's name in "
+      "upper case); the command line wins.\n"
       "SIGTERM or SIGINT: health NOT_SERVING, stop accepting, let calls "
       "finish within --grace_period_s, exit 0.");
   // List this program's flags in --help, not those of linked libraries.
@@ -75,10 +81,20 @@ int main(int argc, char** argv) {
   };
   usage.contains_helpshort_flags = usage.contains_help_flags;
   absl::SetFlagsUsageConfig(usage);
-  absl::ParseCommandLine(argc, argv);
 
   using fovea::server::LogError;
   using fovea::server::LogInfo;
+  // Before the command line, so that it wins.
+  const absl::Status from_env = fovea::server::ApplyFlagsFromEnv(
+      {"listen", "metrics_listen", "concurrency", "queue", "max_message_bytes",
+       "max_width", "max_height", "grace_period_s", "models_dir", "log_level"},
+      [](const char* name) { return std::getenv(name); });
+  if (!from_env.ok()) {
+    LogError(from_env.ToString());
+    return 2;
+  }
+  absl::ParseCommandLine(argc, argv);
+
   absl::StatusOr<fovea::server::LogLevel> level =
       fovea::server::ParseLogLevel(absl::GetFlag(FLAGS_log_level));
   if (!level.ok()) {

@@ -59,10 +59,12 @@ int WaitExit(pid_t pid, std::chrono::milliseconds timeout) {
   return exited ? status : -1;
 }
 
-// Output and wait status of fovea-server run with `args` to completion.
-std::pair<std::string, int> RunToCompletion(const std::string& args) {
+// Output and wait status of fovea-server run with `args` to completion;
+// `env` ("NAME=value ", shell syntax) goes before the command.
+std::pair<std::string, int> RunToCompletion(const std::string& args,
+                                            const std::string& env = "") {
   const std::string command =
-      std::string(FOVEA_SERVER_BINARY) + " " + args + " 2>&1";
+      env + std::string(FOVEA_SERVER_BINARY) + " " + args + " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
   std::string output;
   char buffer[4096];
@@ -92,6 +94,41 @@ TEST(ServerBinaryTest, BadFlagValueExitsNonZeroNamingIt) {
   EXPECT_TRUE(WIFEXITED(status));
   EXPECT_NE(WEXITSTATUS(status), 0);
   EXPECT_THAT(output, HasSubstr("--concurrency"));
+}
+
+TEST(ServerBinaryTest, FlagsComeFromTheEnvironmentAndTheCommandLineWins) {
+  // FOVEA_MODELS_DIR points at a folder without models: start-up fails
+  // naming it, which proves the variable was read.
+  const std::string dir =
+      ::testing::TempDir() + "/fovea_env_models_" + std::to_string(getpid());
+  std::filesystem::create_directories(dir);
+  {
+    const auto [output, status] =
+        RunToCompletion("--metrics_listen=", "FOVEA_MODELS_DIR=" + dir + " ");
+    EXPECT_TRUE(WIFEXITED(status));
+    EXPECT_NE(WEXITSTATUS(status), 0);
+    EXPECT_THAT(output, HasSubstr(dir));
+  }
+  {
+    // A bad value names the variable, not a flag the user never typed.
+    const auto [output, status] =
+        RunToCompletion("--metrics_listen=", "FOVEA_CONCURRENCY=many ");
+    EXPECT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 2);
+    EXPECT_THAT(output, HasSubstr("FOVEA_CONCURRENCY"));
+  }
+  {
+    // The command line overrides the environment: a good log level from
+    // the environment, a bad one on the command line, and the bad one is
+    // what start-up rejects.
+    const auto [output, status] =
+        RunToCompletion("--log_level=bogus --metrics_listen=",
+                        "FOVEA_LOG_LEVEL=info FOVEA_MODELS_DIR=" + dir + " ");
+    EXPECT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 2);
+    EXPECT_THAT(output, HasSubstr("bogus"));
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(ServerBinaryTest, MissingOrCorruptModelsStopStartUpNamingTheFile) {
