@@ -55,6 +55,12 @@ ABSL_FLAG(uint32_t, max_height, fovea::FrameLimits{}.max_height,
 ABSL_FLAG(double, grace_period_s, 10.0,
           "On SIGTERM/SIGINT: seconds in-flight calls get to finish before "
           "they are cancelled.");
+ABSL_FLAG(double, max_connection_age_s, 300.0,
+          "Seconds after which a client connection is asked to reconnect "
+          "(gRPC GOAWAY, +-10 % jitter), so clients re-resolve DNS and "
+          "spread over replicas added since; 0 keeps connections forever.");
+ABSL_FLAG(double, max_connection_age_grace_s, 30.0,
+          "Seconds calls in flight on such a connection get to finish.");
 ABSL_FLAG(
     std::string, models_dir, fovea::server::ServerConfig{}.models_dir,
     "Folder of the trained models (cos_svm.txt, ...; see models/README.md). "
@@ -87,7 +93,8 @@ int main(int argc, char** argv) {
   // Before the command line, so that it wins.
   const absl::Status from_env = fovea::server::ApplyFlagsFromEnv(
       {"listen", "metrics_listen", "concurrency", "queue", "max_message_bytes",
-       "max_width", "max_height", "grace_period_s", "models_dir", "log_level"},
+       "max_width", "max_height", "grace_period_s", "max_connection_age_s",
+       "max_connection_age_grace_s", "models_dir", "log_level"},
       [](const char* name) { return std::getenv(name); });
   if (!from_env.ok()) {
     LogError(from_env.ToString());
@@ -125,6 +132,9 @@ int main(int argc, char** argv) {
   config.max_message_bytes = absl::GetFlag(FLAGS_max_message_bytes);
   config.limits.max_width = absl::GetFlag(FLAGS_max_width);
   config.limits.max_height = absl::GetFlag(FLAGS_max_height);
+  config.max_connection_age_s = absl::GetFlag(FLAGS_max_connection_age_s);
+  config.max_connection_age_grace_s =
+      absl::GetFlag(FLAGS_max_connection_age_grace_s);
   config.models_dir = absl::GetFlag(FLAGS_models_dir);
 
   absl::StatusOr<std::unique_ptr<fovea::server::FoveaServer>> server =

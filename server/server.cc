@@ -3,6 +3,7 @@
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/health_check_service_interface.h>
 
+#include <cmath>
 #include <utility>
 #include <vector>
 
@@ -25,6 +26,10 @@ constexpr const char* kHealthNames[] = {"", "fovea.v1.Perception"};
 // 1 / kWarmUpDownscale of the Kinect's 640x480 (320x240: small, yet large
 // enough for core's pixel-sized defaults, e.g. MSR's smallest region, to
 // yield points, so every stage runs).
+// Largest --max_connection_age_s and grace: gRPC takes milliseconds as an
+// int; a day is plenty.
+constexpr double kMaxConnectionAgeS = 86400.0;
+
 constexpr uint64_t kWarmUpSeed = 1;
 constexpr int kWarmUpDownscale = 2;
 
@@ -76,6 +81,18 @@ absl::Status Validate(const ServerConfig& config) {
     return absl::InvalidArgumentError(absl::StrCat(
         "--max_message_bytes: ", config.max_message_bytes, " is below 1"));
   }
+  if (!(config.max_connection_age_s >= 0.0) ||
+      config.max_connection_age_s > kMaxConnectionAgeS) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--max_connection_age_s: ", config.max_connection_age_s,
+                     " is not in [0, ", kMaxConnectionAgeS, "]"));
+  }
+  if (!(config.max_connection_age_grace_s >= 0.0) ||
+      config.max_connection_age_grace_s > kMaxConnectionAgeS) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--max_connection_age_grace_s: ", config.max_connection_age_grace_s,
+        " is not in [0, ", kMaxConnectionAgeS, "]"));
+  }
   if (absl::Status status = Validate(config.limits); !status.ok()) {
     return absl::Status(
         status.code(),
@@ -119,6 +136,15 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
   // share it silently with SO_REUSEPORT).
   builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
   builder.SetMaxReceiveMessageSize(config.max_message_bytes);
+  if (config.max_connection_age_s > 0.0) {
+    builder.AddChannelArgument(
+        GRPC_ARG_MAX_CONNECTION_AGE_MS,
+        static_cast<int>(std::lround(config.max_connection_age_s * 1000.0)));
+    builder.AddChannelArgument(
+        GRPC_ARG_MAX_CONNECTION_AGE_GRACE_MS,
+        static_cast<int>(
+            std::lround(config.max_connection_age_grace_s * 1000.0)));
+  }
   builder.AddListeningPort(config.listen, grpc::InsecureServerCredentials(),
                            &server->port_);
   builder.RegisterService(server->service_.get());

@@ -32,6 +32,12 @@ struct ServerConfig {
   int max_message_bytes = kDefaultMaxMessageBytes;  // largest request, > 0
   FrameLimits limits;                               // largest frame
   bool warm_up = true;  // run one Detect before reporting SERVING
+  // Seconds after which the server asks a client connection to go away
+  // (GOAWAY; gRPC adds +-10 % jitter), so that clients re-resolve DNS and
+  // spread over replicas added since they connected; calls in flight get
+  // max_connection_age_grace_s more to finish. 0: connections live forever.
+  double max_connection_age_s = 0.0;
+  double max_connection_age_grace_s = 30.0;  // >= 0
   // Folder of the trained models (LoadModels); start-up fails when a model
   // is missing or corrupt.
   std::string models_dir = FOVEA_DEFAULT_MODELS_DIR;

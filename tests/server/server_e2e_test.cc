@@ -3,6 +3,7 @@
 #include <grpcpp/grpcpp.h>
 
 #include <chrono>
+#include <cmath>
 #include <future>
 #include <memory>
 #include <string>
@@ -576,6 +577,39 @@ TEST_F(ServerTest, HealthServingAfterWarmUpThenNotServingOnDrain) {
   // Draining still serves calls until Shutdown.
   v1::DetectResponse response;
   EXPECT_TRUE(Detect(MakeSyntheticRequest(1, false).request, &response).ok());
+}
+
+// With --max_connection_age_s the server sends GOAWAY to old connections,
+// so a client's channel leaves READY by itself (and re-resolves its target
+// when it reconnects); without it the channel would stay READY for good.
+TEST_F(ServerTest, MaxConnectionAgeMakesClientsReconnect) {
+  ServerConfig config = DefaultConfig();
+  config.max_connection_age_s = 0.5;
+  config.max_connection_age_grace_s = 1.0;
+  StartServer(config);
+  ASSERT_EQ(HealthStatus(channel_, ""), "SERVING");
+  ASSERT_EQ(channel_->GetState(false), GRPC_CHANNEL_READY);
+  EXPECT_TRUE(channel_->WaitForStateChange(
+      GRPC_CHANNEL_READY,
+      std::chrono::system_clock::now() + std::chrono::seconds(30)));
+  // And the next call simply reconnects.
+  EXPECT_EQ(HealthStatus(channel_, ""), "SERVING");
+}
+
+TEST(ServerConfigTest, NegativeOrHugeConnectionAgeNamesTheFlag) {
+  ServerConfig config;
+  config.max_connection_age_s = -1.0;
+  EXPECT_THAT(Validate(config).message(),
+              ::testing::HasSubstr("--max_connection_age_s"));
+  config.max_connection_age_s = 1e9;
+  EXPECT_THAT(Validate(config).message(),
+              ::testing::HasSubstr("--max_connection_age_s"));
+  config.max_connection_age_s = 300.0;
+  config.max_connection_age_grace_s = std::nan("");
+  EXPECT_THAT(Validate(config).message(),
+              ::testing::HasSubstr("--max_connection_age_grace_s"));
+  config.max_connection_age_grace_s = 30.0;
+  EXPECT_TRUE(Validate(config).ok());
 }
 
 TEST_F(ServerTest, MetricsScrapeShowsCountersWithGrpcLabels) {
