@@ -112,6 +112,17 @@ BenchFlags ParseFlags(int argc, char** argv, std::vector<char*>& args) {
 // --rpc detect|segment|segment-incremental [--deadline_s D]`.
 int RunLoadCommand(int argc, char** argv) {
   fovea::bench::LoadOptions options;
+  if (argc % 2 != 0) {  // "fovea-bench load" and flag-value pairs
+    std::fprintf(stderr,
+                 "usage: fovea-bench load --server 127.0.0.1:PORT --clients C "
+                 "--requests N [--seconds S] "
+                 "[--rpc detect|segment|segment-incremental] "
+                 "[--deadline_s D]\n");
+    return argc == 3 && (std::string_view(argv[2]) == "--help" ||
+                         std::string_view(argv[2]) == "-h")
+               ? 0
+               : 2;
+  }
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string flag = argv[i];
     const std::string value = argv[i + 1];
