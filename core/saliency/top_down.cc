@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/lab.h"
 #include "core/saliency/saliency_map.h"
 
 namespace fovea {
@@ -26,12 +27,12 @@ absl::StatusOr<cv::Mat> ComputeTargetColorSaliency(
   // OpenCV's float Lab: L in [0, 100], a and b in about [-127, 127].
   cv::Mat rgb_f, lab;
   color.convertTo(rgb_f, CV_32FC3, 1.0 / 255.0);
-  cv::cvtColor(rgb_f, lab, cv::COLOR_RGB2Lab);
+  RgbToLab(rgb_f, &lab);
   cv::Mat target_rgb(1, 1, CV_32FC3,
                      cv::Scalar(options.rgb[0] / 255.0, options.rgb[1] / 255.0,
                                 options.rgb[2] / 255.0));
   cv::Mat target_lab;
-  cv::cvtColor(target_rgb, target_lab, cv::COLOR_RGB2Lab);
+  RgbToLab(target_rgb, &target_lab);
   const cv::Vec3f t = target_lab.at<cv::Vec3f>(0, 0);
   const float inv = 0.5f / (options.sigma_delta_e * options.sigma_delta_e);
   cv::Mat map(color.size(), CV_32FC1);

@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
+#include "core/base/lab.h"
 
 namespace fovea {
 namespace {
@@ -36,7 +37,7 @@ absl::Status RadiusError(const char* field, int value) {
 cv::Mat ColorEdges(const cv::Mat& rgb, double fx,
                    const EdgeMapOptions& options) {
   cv::Mat lab;
-  cv::cvtColor(rgb, lab, cv::COLOR_RGB2Lab);
+  RgbToLab(rgb, &lab);
   if (options.color_blur_sigma_px > 0.0f) {
     const double sigma = options.color_blur_sigma_px * fx / kReferenceFocalPx;
     cv::GaussianBlur(lab, lab, cv::Size(0, 0), sigma, sigma,

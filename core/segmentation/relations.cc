@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/lab.h"
 
 namespace fovea {
 namespace {
@@ -191,7 +192,7 @@ RelationComputer::RelationComputer(const OrganizedCloud& cloud,
   cv::Mat lab;
   cv::Mat color_float;
   cloud.color.convertTo(color_float, CV_32FC3, 1.0 / 255.0);
-  cv::cvtColor(color_float, lab, cv::COLOR_RGB2Lab);
+  RgbToLab(color_float, &lab);
   // Mean normals, then each surface's mean deviation from it.
   std::vector<Eigen::Vector3d> mean_normal(count, Eigen::Vector3d::Zero());
   for (int v = 0; v < labels.rows; ++v) {
