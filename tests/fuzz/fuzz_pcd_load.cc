@@ -1,8 +1,9 @@
 // libFuzzer target: LoadOsdPcd on hostile PCD files.
 //
 // The input is written to a per-process file in the temporary folder and
-// loaded with LoadOsdPcd (PCL's reader has no in-memory entry point for
-// PCD). Inputs above 1 MiB are refused by the target: LoadOsdPcd's header
+// loaded with LoadOsdPcd, which reads it with ReadPcd (core/frame/
+// pcd_reader: header, ASCII, binary and LZF-compressed bodies). Inputs
+// above 1 MiB are refused by the target: LoadOsdPcd's header
 // check, not the input size, must keep memory bounded, and a small body with
 // a header claiming billions of points is the case that matters. Unorganized
 // clouds are re-organized into 64 x 48 (Kinect intrinsics scaled by 1/10) to
@@ -10,7 +11,6 @@
 // contract; a breach aborts, which libFuzzer reports as a crash. With
 // FOVEA_FUZZ_VERBOSE set, each input's outcome is printed.
 
-#include <pcl/console/print.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -48,10 +48,7 @@ const std::string& TempPath() {
 
 }  // namespace
 
-// PCL warns on stderr about every malformed file it reads; that is
-// expected here and would fill the log.
 extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
-  pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
   // The temporary file goes at a normal exit (not after a crash: it is the
   // crashing input, which libFuzzer also saves).
   std::atexit([] { std::remove(TempPath().c_str()); });

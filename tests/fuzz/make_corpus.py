@@ -4,9 +4,10 @@
 fuzz_frame_decode inputs are a mode byte (0 = protobuf, 1 = raw) and then
 a fovea.v1.Frame, encoded here by hand from proto/fovea/v1/frame.proto's
 field numbers, or FuzzedDataProvider bytes. fuzz_pcd_load inputs are PCD
-files with the OSD fields label x y z rgba. Usage: make_corpus.py OUT_DIR
-(writes OUT_DIR/<target>/...); scripts/fuzz runs it into build-fuzz/seeds,
-so no seed file is kept in the repository.
+files, mostly with the OSD fields label x y z rgba, in all three encodings
+(binary_compressed with a small LZF compressor here). Usage:
+make_corpus.py OUT_DIR (writes OUT_DIR/<target>/...); scripts/fuzz runs it
+into build-fuzz/seeds, so no seed file is kept in the repository.
 """
 
 import os
@@ -152,6 +153,46 @@ DATA {kind}
 """
 
 
+def lzf_compress(data):
+    """Greedy LZF (liblzf's format): a back-reference to the last place each
+    3-byte prefix was seen, when it is in reach, else literal runs."""
+    out = bytearray()
+    literal = bytearray()
+
+    def flush():
+        for start in range(0, len(literal), 32):
+            chunk = literal[start:start + 32]
+            out.append(len(chunk) - 1)
+            out.extend(chunk)
+        literal.clear()
+
+    last = {}
+    i = 0
+    while i < len(data):
+        key = data[i:i + 3]
+        ref = last.get(key) if len(key) == 3 else None
+        if len(key) == 3:
+            last[key] = i
+        if ref is None or i - ref > 8192:
+            literal.append(data[i])
+            i += 1
+            continue
+        length = 3
+        while (length < min(264, len(data) - i) and
+               data[ref + length] == data[i + length]):
+            length += 1
+        flush()
+        distance, field = i - ref - 1, length - 2
+        if field < 7:
+            out.append(field << 5 | distance >> 8)
+        else:
+            out += bytes([7 << 5 | distance >> 8, field - 7])
+        out.append(distance & 0xFF)
+        i += length
+    flush()
+    return bytes(out)
+
+
 def pcd_points():
     # A 3 x 2 organized patch 1 m away; one point has no data (NaN).
     points = []
@@ -190,6 +231,28 @@ def pcd_corpus():
                                kind="binary_compressed").encode()
     write(target, "organized_compressed.pcd", header +
           struct.pack("<II", len(lzf), len(soa)) + bytes(lzf))
+    # A larger organized cloud, LZF with back-references (runs of equal
+    # labels, colours and NaN rows).
+    big = []
+    for v in range(6):
+        for u in range(8):
+            z = float("nan") if v == 5 else 1.0 + 0.25 * (u // 4)
+            big.append((0 if v == 5 else 21, 0.125 * (u - 4), 0.125 * (v - 3),
+                        z, 0x404040))
+    soa = b"".join(
+        b"".join(struct.pack("<" + fmt, p[i]) for p in big)
+        for i, fmt in enumerate("IfffI"))
+    lzf = lzf_compress(soa)
+    header = PCD_HEADER.format(width=8, height=6, points=len(big),
+                               kind="binary_compressed").encode()
+    write(target, "organized_compressed_backrefs.pcd", header +
+          struct.pack("<II", len(lzf), len(soa)) + lzf)
+    # COUNT > 1 and 1, 2 and 8-byte fields beside x y z; CRLF line ends.
+    mixed = ("VERSION 0.7\r\nFIELDS x y z normal label intensity\r\n"
+             "SIZE 4 4 4 8 2 1\r\nTYPE F F F F I U\r\nCOUNT 1 1 1 3 1 1\r\n"
+             "WIDTH 2\r\nHEIGHT 1\r\nPOINTS 2\r\nDATA ascii\r\n"
+             "0 0 1 0 0 1 -3 200\r\n0.01 0 1.5 nan nan nan 4 0\r\n")
+    write(target, "mixed_types_crlf_ascii.pcd", mixed.encode())
     # Only x y z, float64, no label or colour.
     xyz = ("VERSION 0.7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\n"
            "WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n0 0 1\n0.1 0 1.5\n")
