@@ -28,9 +28,9 @@ struct ClientOptions {
   // Also the most a call buffers to replay on a retry, so a frame of any
   // accepted size can be retried.
   int max_message_bytes = 64 * 1024 * 1024;
-  // Wait for a replica to become ready (reachable and SERVING) instead of
-  // failing at once with UNAVAILABLE while none is. The call deadline
-  // still bounds the wait.
+  // Wait for a replica to become ready (reachable and, for Perception
+  // calls, SERVING) instead of failing at once with UNAVAILABLE while none
+  // is. The call deadline still bounds the wait.
   bool wait_for_ready = false;
   // Attempts per call, 1..5 (gRPC's most), 1 = no retries. A call is
   // retried only when it failed with UNAVAILABLE (no replica reachable,
