@@ -2,11 +2,8 @@
 
 #include <utility>
 
-#include "absl/strings/str_cat.h"
+#include "absl/memory/memory.h"
 #include "grpcpp/client_context.h"
-#include "grpcpp/create_channel.h"
-#include "grpcpp/security/credentials.h"
-#include "grpcpp/support/channel_arguments.h"
 
 namespace fovea::client {
 namespace {
@@ -40,27 +37,28 @@ absl::Status DrainStream(Reader& reader, const SegmentCallback& on_message) {
 
 absl::StatusOr<std::unique_ptr<FoveaClient>> FoveaClient::Connect(
     const std::string& target, const ClientOptions& options) {
-  if (target.empty()) {
-    return absl::InvalidArgumentError("server: empty target (want HOST:PORT)");
-  }
-  grpc::ChannelArguments arguments;
-  arguments.SetMaxReceiveMessageSize(options.max_message_bytes);
-  arguments.SetMaxSendMessageSize(options.max_message_bytes);
-  std::shared_ptr<grpc::Channel> channel = grpc::CreateCustomChannel(
-      target, grpc::InsecureChannelCredentials(), arguments);
-  if (channel == nullptr) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("server: cannot create a channel to \"", target, "\""));
-  }
-  return std::make_unique<FoveaClient>(std::move(channel), options);
+  absl::StatusOr<std::shared_ptr<grpc::Channel>> channel =
+      CreateBalancedChannel(target, options);
+  if (!channel.ok()) return channel.status();
+  absl::StatusOr<std::shared_ptr<grpc::Channel>> health_channel =
+      CreateProbeChannel(target, options);
+  if (!health_channel.ok()) return health_channel.status();
+  return absl::WrapUnique(new FoveaClient(*std::move(channel),
+                                          *std::move(health_channel), options));
 }
 
 FoveaClient::FoveaClient(std::shared_ptr<grpc::Channel> channel,
                          const ClientOptions& options)
+    : FoveaClient(channel, channel, options) {}
+
+FoveaClient::FoveaClient(std::shared_ptr<grpc::Channel> channel,
+                         std::shared_ptr<grpc::Channel> health_channel,
+                         const ClientOptions& options)
     : options_(options),
       channel_(std::move(channel)),
+      health_channel_(std::move(health_channel)),
       perception_(fovea::v1::Perception::NewStub(channel_)),
-      health_(grpc::health::v1::Health::NewStub(channel_)) {}
+      health_(grpc::health::v1::Health::NewStub(health_channel_)) {}
 
 absl::StatusOr<grpc::health::v1::HealthCheckResponse::ServingStatus>
 FoveaClient::Health(const std::string& service, absl::Duration deadline) {

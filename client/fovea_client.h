@@ -9,46 +9,45 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
+#include "client/channel.h"
 #include "fovea/v1/perception.grpc.pb.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "grpcpp/channel.h"
 
-// A small synchronous client for fovea.v1.Perception and grpc.health.v1.
-// The pieces to build requests live beside it: client/frame_builder.h
-// (frames from raw buffers or PNG/JPEG bytes), client/option_names.h (enum
-// names as typed on a command line), client/rle.h (object masks).
+// A small synchronous client for fovea.v1.Perception and grpc.health.v1,
+// to one server or several replicas (client/channel.h: ClientOptions, the
+// targets Connect takes, how calls are spread and retried). The pieces to
+// build requests live beside it: client/frame_builder.h (frames from raw
+// buffers or PNG/JPEG bytes), client/option_names.h (enum names as typed
+// on a command line), client/rle.h (object masks).
 
 namespace fovea::client {
-
-struct ClientOptions {
-  // Largest message sent or received, bytes. The server's default maximum
-  // receive size is 64 MiB (a 1280x720 raw frame is about 6 MiB).
-  int max_message_bytes = 64 * 1024 * 1024;
-  // Wait for the channel to become ready instead of failing at once with
-  // UNAVAILABLE while the server is not (yet) listening. The call deadline
-  // still bounds the wait.
-  bool wait_for_ready = false;
-};
 
 // Gets a fovea.v1.SegmentResponse as soon as it has been read off a
 // stream, on the calling thread.
 using SegmentCallback = std::function<void(const fovea::v1::SegmentResponse&)>;
 
-// One insecure channel to a server. Thread-safe: calls may run
-// concurrently. Every call takes a deadline measured from the moment it
+// Insecure channels to a server or its replicas. Thread-safe: calls may
+// run concurrently. Every call takes a deadline measured from the moment it
 // starts; a failed call returns the server's (or gRPC's) status with the
 // same code (absl and gRPC share the canonical codes, so
 // absl::StatusCodeToString gives the gRPC name, e.g. "INVALID_ARGUMENT")
 // and its message.
 class FoveaClient {
  public:
-  // Creates a channel to `target` ("HOST:PORT", or any gRPC target URI).
-  // Connecting is lazy: an unreachable server shows up as UNAVAILABLE on
-  // the first call. INVALID_ARGUMENT for an empty target.
+  // Creates the channels to `target`: "HOST:PORT", a comma-separated list
+  // of IP:PORT replicas, or any gRPC target URI such as dns:///NAME:PORT
+  // (ChannelTarget). Perception calls go round robin to the replicas that
+  // report SERVING and are retried on UNAVAILABLE (CreateBalancedChannel);
+  // with none SERVING they fail at once with UNAVAILABLE, or wait with
+  // `options.wait_for_ready`. Connecting is lazy: an unreachable server
+  // shows up as UNAVAILABLE on the first call. INVALID_ARGUMENT from
+  // ChannelTarget and Validate(options).
   static absl::StatusOr<std::unique_ptr<FoveaClient>> Connect(
       const std::string& target, const ClientOptions& options = {});
 
-  // A client over an existing channel (e.g. an in-process one in tests).
+  // A client over an existing channel (e.g. an in-process one in tests),
+  // used for every call as it is.
   FoveaClient(std::shared_ptr<grpc::Channel> channel,
               const ClientOptions& options);
 
@@ -58,7 +57,9 @@ class FoveaClient {
   // grpc.health.v1.Health/Check for `service` ("" = the whole server,
   // "fovea.v1.Perception" = the perception service). The serving status
   // (SERVING, NOT_SERVING, ...) when the call succeeds; NOT_FOUND when the
-  // server does not know `service`.
+  // server does not know `service`. Asks one replica, NOT_SERVING ones
+  // included: with several, each call asks the next reachable one in turn
+  // (CreateProbeChannel).
   absl::StatusOr<grpc::health::v1::HealthCheckResponse::ServingStatus> Health(
       const std::string& service, absl::Duration deadline);
 
@@ -81,8 +82,13 @@ class FoveaClient {
       absl::Duration deadline, const SegmentCallback& on_message);
 
  private:
+  FoveaClient(std::shared_ptr<grpc::Channel> channel,
+              std::shared_ptr<grpc::Channel> health_channel,
+              const ClientOptions& options);
+
   ClientOptions options_;
-  std::shared_ptr<grpc::Channel> channel_;
+  std::shared_ptr<grpc::Channel> channel_;         // Perception calls
+  std::shared_ptr<grpc::Channel> health_channel_;  // Health calls
   std::unique_ptr<fovea::v1::Perception::Stub> perception_;
   std::unique_ptr<grpc::health::v1::Health::Stub> health_;
 };

@@ -5,7 +5,9 @@
 //   fovea-client --server HOST:PORT detect FRAME [options] [--json] [--out DIR]
 //   fovea-client --server HOST:PORT segment FRAME [--method cos|ebs] ...
 //   fovea-client --server HOST:PORT segment-incremental FRAME ...
-// where FRAME is --color C.png --depth D.png [--fx .. --fy .. --cx .. --cy ..]
+// where --server may also list replicas, IP:PORT,IP:PORT,..., or name them
+// all with one DNS name, dns:///NAME:PORT (client/channel.h), and
+// FRAME is --color C.png --depth D.png [--fx .. --fy .. --cx .. --cy ..]
 // or --pcd scene.pcd or --synthetic SEED.
 //
 // Exit codes: 0 success (health: SERVING), 1 health not SERVING or a local
@@ -37,7 +39,11 @@
 #include "client/fovea_client.h"
 #include "client/option_names.h"
 
-ABSL_FLAG(std::string, server, "127.0.0.1:50051", "gRPC server, HOST:PORT");
+ABSL_FLAG(std::string, server, "127.0.0.1:50051",
+          "gRPC server: HOST:PORT, replicas as IP:PORT,IP:PORT,... or one "
+          "DNS name for all of them, dns:///NAME:PORT; calls go round robin "
+          "to the replicas whose health is SERVING and are retried on "
+          "UNAVAILABLE");
 ABSL_FLAG(int64_t, deadline_ms, 30000,
           "deadline of the call, milliseconds from its start");
 ABSL_FLAG(bool, wait_for_ready, false,
@@ -115,7 +121,13 @@ constexpr int kExitUsage = 64;  // EX_USAGE
 constexpr char kUsage[] =
     R"(calls a Fovea perception server.
 
-usage: fovea-client [--server HOST:PORT] COMMAND [flags]
+usage: fovea-client [--server SERVERS] COMMAND [flags]
+
+SERVERS is HOST:PORT (default 127.0.0.1:50051), a list of replicas
+IP:PORT,IP:PORT,... or one DNS name resolving to all of them,
+dns:///NAME:PORT. Calls go round robin to the replicas that report
+SERVING; one that fails with UNAVAILABLE before replying is retried on the
+next. health asks one replica (the next reachable one).
 
 commands:
   health                 print the serving status; exit 0 when SERVING
@@ -133,6 +145,7 @@ FRAME is one of
 examples:
   fovea-client --server 127.0.0.1:50051 detect --synthetic 1 --out out/demo
   fovea-client detect --pcd learn6.pcd --saliency ph+sh+rso --extract msr --json
+  fovea-client --server 10.0.0.5:50051,10.0.0.6:50051 detect --synthetic 1
 
 exit codes: 0 ok, 1 not SERVING or a local failure, 2 the call failed (gRPC
 code and message on stderr), 64 usage error. The flags: fovea-client --help)";

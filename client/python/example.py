@@ -68,7 +68,9 @@ def render_table_scene(width=640, height=480, camera_height_m=0.8,
 
 def main(argv):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--server", default="127.0.0.1:50051")
+    parser.add_argument("--server", default="127.0.0.1:50051",
+                        help="HOST:PORT, replicas IP:PORT,IP:PORT,... or "
+                        "dns:///NAME:PORT")
     parser.add_argument("--color", help="PNG/JPEG colour image")
     parser.add_argument("--depth", help="16-bit PNG depth, millimetres")
     parser.add_argument("--method", default="COS", choices=["COS", "EBS"])

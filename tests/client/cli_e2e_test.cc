@@ -75,6 +75,20 @@ TEST_F(FoveaClientCliE2eTest, HealthPrintsServing) {
   EXPECT_EQ(run.out, "SERVING\n");
 }
 
+// Port 1 on loopback has no listener: round robin skips that replica.
+TEST_F(FoveaClientCliE2eTest, ReplicaListSkipsOneThatIsDown) {
+  const std::string servers = absl::StrCat("127.0.0.1:1,", address_);
+  CliRun run = RunCli(absl::StrCat("--server ", servers, " health"));
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.out, "SERVING\n");
+  run = RunCli(
+      absl::StrCat("--server ", servers, " detect --synthetic 3 --json"));
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  run = RunCli(absl::StrCat("--server ", servers,
+                            " segment --synthetic 3 --max_objects 1 --json"));
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+}
+
 TEST_F(FoveaClientCliE2eTest, DetectSyntheticJsonHasPoints) {
   const CliRun run = RunCli(
       absl::StrCat("--server ", address_, " detect --synthetic 3 --json"));

@@ -26,6 +26,17 @@ TEST(FoveaClientCliUsageTest, HelpListsTheFlags) {
                            "--synthetic", "--method", "--time_budget_ms"}) {
     EXPECT_THAT(text, HasSubstr(flag));
   }
+  EXPECT_THAT(text, HasSubstr("dns:///NAME:PORT"));
+}
+
+TEST(FoveaClientCliUsageTest, BadServerListIsAUsageErrorNamingTheEntry) {
+  CliRun run = RunCli("--server 127.0.0.1:1,,127.0.0.1:2 health");
+  EXPECT_EQ(run.exit_code, 64);
+  EXPECT_THAT(run.err, HasSubstr("entry 2"));
+  EXPECT_THAT(run.err, HasSubstr("is empty"));
+  run = RunCli("--server 127.0.0.1:1,fovea-b:2 detect --synthetic 1");
+  EXPECT_EQ(run.exit_code, 64);
+  EXPECT_THAT(run.err, HasSubstr("dns:///fovea-b:2"));
 }
 
 TEST(FoveaClientCliUsageTest, UnknownCommandExits64) {
@@ -59,6 +70,13 @@ TEST(FoveaClientCliUsageTest, MissingFileExits1) {
 
 TEST(FoveaClientCliUsageTest, NoServerIsACallFailureWithItsCode) {
   const CliRun run = RunCli("--server 127.0.0.1:1 health");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.err, HasSubstr("UNAVAILABLE"));
+}
+
+TEST(FoveaClientCliUsageTest, NoReplicaUpIsUnavailable) {
+  const CliRun run =
+      RunCli("--server 127.0.0.1:1,127.0.0.1:2 detect --synthetic 1");
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_THAT(run.err, HasSubstr("UNAVAILABLE"));
 }

@@ -2,9 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
+#include <memory>
+#include <string>
 #include <thread>
 
+#include "absl/strings/str_cat.h"
 #include "server/log.h"
 #include "server/server.h"
 
@@ -46,6 +50,29 @@ TEST(LoadTest, EveryCallIsCountedByCodeWithLatencies) {
   EXPECT_GT(report->throughput, 0.0);
 }
 
+TEST(LoadTest, AListOfReplicasSpreadsTheCalls) {
+  std::atomic<int> jobs[2] = {0, 0};
+  std::unique_ptr<server::FoveaServer> servers[2];
+  std::string list;
+  for (int i = 0; i < 2; ++i) {
+    server::ServerConfig config;
+    config.before_detect_job = [&jobs, i] { jobs[i].fetch_add(1); };
+    servers[i] = Start(config);
+    ASSERT_NE(servers[i], nullptr);
+    absl::StrAppend(&list, i == 0 ? "" : ",", "127.0.0.1:", servers[i]->port());
+  }
+  LoadOptions options;
+  options.server = list;
+  options.clients = 2;
+  options.requests = 20;
+  absl::StatusOr<LoadReport> report = RunLoad(options);
+  ASSERT_TRUE(report.ok()) << report.status();
+  EXPECT_EQ(report->codes["OK"], 20);
+  EXPECT_GT(jobs[0].load(), 0);
+  EXPECT_GT(jobs[1].load(), 0);
+  EXPECT_EQ(jobs[0].load() + jobs[1].load(), 20);
+}
+
 TEST(LoadTest, AFullQueueAnswersResourceExhaustedNotACollapse) {
   server::ServerConfig config;
   config.concurrency = 1;
@@ -71,6 +98,12 @@ TEST(LoadTest, AFullQueueAnswersResourceExhaustedNotACollapse) {
 TEST(LoadTest, OnlyLoopbackAndSaneNumbers) {
   LoadOptions options;
   options.server = "10.1.2.3:50051";
+  EXPECT_EQ(RunLoad(options).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  options.server = "127.0.0.1:1,10.1.2.3:50051";
+  EXPECT_EQ(RunLoad(options).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  options.server = "127.0.0.1:1,,127.0.0.1:2";
   EXPECT_EQ(RunLoad(options).status().code(),
             absl::StatusCode::kInvalidArgument);
   options.server = "127.0.0.1:1";

@@ -5,12 +5,17 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <memory>
 #include <mutex>
 #include <thread>
 #include <vector>
 
+#include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "absl/strings/string_view.h"
+#include "client/channel.h"
 #include "core/synth/synth_scene.h"
 #include "fovea/v1/perception.grpc.pb.h"
 #include "server/convert.h"
@@ -29,10 +34,18 @@ double Percentile(std::vector<double> values, double q) {
   return values[i];
 }
 
-bool IsLoopback(const std::string& target) {
-  return absl::StartsWith(target, "127.") ||
-         absl::StartsWith(target, "localhost:") ||
-         absl::StartsWith(target, "[::1]:");
+// True when every address of `servers` (one, or a comma-separated list)
+// is on loopback.
+bool IsLoopback(const std::string& servers) {
+  for (absl::string_view address : absl::StrSplit(servers, ',')) {
+    address = absl::StripAsciiWhitespace(address);
+    if (!absl::StartsWith(address, "127.") &&
+        !absl::StartsWith(address, "localhost:") &&
+        !absl::StartsWith(address, "[::1]:")) {
+      return false;
+    }
+  }
+  return true;
 }
 
 struct CallResult {
@@ -69,8 +82,13 @@ CallResult Stream(const Request& request, double deadline_s, Call call) {
 absl::StatusOr<LoadReport> RunLoad(const LoadOptions& options) {
   if (!IsLoopback(options.server)) {
     return absl::InvalidArgumentError(absl::StrCat(
-        "--server must be a loopback address (127.x, localhost, [::1]), got ",
+        "--server must be loopback addresses (127.x, localhost, [::1]), got ",
         options.server));
+  }
+  if (absl::StatusOr<std::string> target =
+          client::ChannelTarget(options.server);
+      !target.ok()) {
+    return target.status();
   }
   if (options.clients < 1 || options.requests < 1 ||
       !(options.max_seconds > 0) || !(options.deadline_seconds > 0)) {
@@ -93,13 +111,17 @@ absl::StatusOr<LoadReport> RunLoad(const LoadOptions& options) {
   const Clock::time_point stop_at =
       start + std::chrono::microseconds(
                   static_cast<int64_t>(options.max_seconds * 1e6));
+  // Each client its own channel and connections, as separate robots
+  // would have.
+  std::vector<std::unique_ptr<v1::Perception::Stub>> stubs;
+  for (int i = 0; i < options.clients; ++i) {
+    absl::StatusOr<std::shared_ptr<grpc::Channel>> channel =
+        client::CreateBalancedChannel(options.server, client::ClientOptions());
+    if (!channel.ok()) return channel.status();
+    stubs.push_back(v1::Perception::NewStub(*channel));
+  }
   auto client = [&](int index) {
-    // Each client its own channel (a distinct argument keeps gRPC from
-    // sharing the connection), as separate robots would.
-    grpc::ChannelArguments args;
-    args.SetInt("fovea.load_client", index);
-    auto stub = v1::Perception::NewStub(grpc::CreateCustomChannel(
-        options.server, grpc::InsecureChannelCredentials(), args));
+    v1::Perception::Stub* stub = stubs[index].get();
     while (issued.fetch_add(1) < options.requests && Clock::now() < stop_at) {
       CallResult result;
       if (options.rpc == "detect") {

@@ -8,9 +8,14 @@
 
 namespace fovea::bench {
 
-// `fovea-bench load`: closed-loop load on a running server over loopback.
+// `fovea-bench load`: closed-loop load on a running server, or several
+// replicas of it, over loopback.
 struct LoadOptions {
-  std::string server = "127.0.0.1:50051";  // loopback only
+  // HOST:PORT or a comma-separated list of replicas IP:PORT,IP:PORT,...
+  // (client/channel.h), every one on loopback. Each client spreads its
+  // calls round robin over the replicas that report SERVING and retries a
+  // call that fails with UNAVAILABLE, as FoveaClient does.
+  std::string server = "127.0.0.1:50051";
   int clients = 4;              // concurrent callers, each with its own channel
   int requests = 200;           // in all, shared among the clients
   double max_seconds = 60;      // stop issuing after this long
@@ -28,8 +33,7 @@ struct LoadReport {
   std::map<std::string, int> codes;  // gRPC code name -> calls
 };
 
-// INVALID_ARGUMENT for a non-loopback server or bad numbers; UNAVAILABLE
-// when the server does not answer health.
+// INVALID_ARGUMENT for a non-loopback server, a bad list or bad numbers.
 absl::StatusOr<LoadReport> RunLoad(const LoadOptions& options);
 
 }  // namespace fovea::bench

@@ -6,7 +6,8 @@
 //                    [--seconds S] [--rpc detect|segment|segment-incremental]
 //                    (closed-loop load on a running server, loopback only:
 //                    throughput, p50/p99 latency, time to first object,
-//                    calls per status code)
+//                    calls per status code; --server may list replicas,
+//                    127.0.0.1:P1,127.0.0.1:P2, to load them round robin)
 //
 // Inputs: synthetic scenes (core/synth, seeds kSynthSeeds) and, when
 // FOVEA_OSD_DIR names the OSD data (learn/learn*.pcd), the same cases on

@@ -5,6 +5,7 @@ import grpc
 from fovea.health.v1 import health_pb2
 from fovea.v1 import detect_pb2, perception_pb2, perception_pb2_grpc, segment_pb2
 
+from fovea_client.channel import channel_options, channel_target
 from fovea_client.frame import frame_from_numpy
 
 _HEALTH_CHECK = "/grpc.health.v1.Health/Check"
@@ -30,26 +31,40 @@ def detect_options(**options):
 
 
 class FoveaClient:
-    """One channel to a Fovea server, e.g. FoveaClient("127.0.0.1:50051").
+    """Channels to a Fovea server or its replicas.
 
-    Calls raise grpc.RpcError on failure (e.code(), e.details()); the
-    server names the offending field in INVALID_ARGUMENT details. `timeout`
-    arguments are seconds (None = no deadline).
+    FoveaClient("127.0.0.1:50051"), FoveaClient("10.0.0.5:50051,
+    10.0.0.6:50051") or FoveaClient("dns:///fovea.ns.svc:50051") (see
+    fovea_client.channel): calls go round robin to the replicas that report
+    SERVING and are retried on UNAVAILABLE (up to `max_attempts` in all);
+    health() asks the next reachable replica, NOT_SERVING or not. Raises
+    ValueError for a bad `target`. Calls raise grpc.RpcError on failure
+    (e.code(), e.details()); the server names the offending field in
+    INVALID_ARGUMENT details. `timeout` arguments are seconds (None = no
+    deadline). With `channel`, every call goes through it as it is.
     """
 
-    def __init__(self, target, channel=None):
-        self._channel = channel or grpc.insecure_channel(
-            target,
-            options=[("grpc.max_receive_message_length", _MAX_MESSAGE_BYTES),
-                     ("grpc.max_send_message_length", _MAX_MESSAGE_BYTES)])
+    def __init__(self, target, channel=None, max_attempts=4):
+        if channel is not None:
+            self._channel = self._health_channel = channel
+        else:
+            target = channel_target(target)
+            self._channel = grpc.insecure_channel(
+                target, options=channel_options(_MAX_MESSAGE_BYTES,
+                                                max_attempts))
+            self._health_channel = grpc.insecure_channel(
+                target, options=channel_options(_MAX_MESSAGE_BYTES,
+                                                balanced=False))
         self._stub = perception_pb2_grpc.PerceptionStub(self._channel)
-        self._health = self._channel.unary_unary(
+        self._health = self._health_channel.unary_unary(
             _HEALTH_CHECK,
             request_serializer=health_pb2.HealthCheckRequest.SerializeToString,
             response_deserializer=health_pb2.HealthCheckResponse.FromString)
 
     def close(self):
         self._channel.close()
+        if self._health_channel is not self._channel:
+            self._health_channel.close()
 
     def __enter__(self):
         return self

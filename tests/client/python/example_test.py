@@ -88,6 +88,14 @@ class ExampleTest(unittest.TestCase):
         self.assertNotIn("MISMATCH", run.stdout)
         self.assertIn("support plane", run.stdout)
 
+    def test_replica_list_skips_one_that_is_down(self):
+        # Port 1 on loopback has no listener: round robin skips it.
+        with FoveaClient(f"127.0.0.1:1,{self.target}") as client:
+            self.assertEqual(client.health(timeout=10), "SERVING")
+            for _ in range(4):
+                capabilities = client.capabilities(timeout=10)
+                self.assertIn("32FC1", capabilities.depth_encodings)
+
     def test_bad_frame_is_invalid_argument(self):
         rgb = numpy.zeros((4, 4, 3), numpy.uint8)
         depth = numpy.zeros((4, 4), numpy.float32)
