@@ -119,6 +119,7 @@ struct PngSpec {
   int bit_depth = 8;
   int color_type = 0;       // 0 grey, 2 RGB, 3 palette, 4 grey + alpha, 6 RGBA
   bool interlaced = false;  // Adam7; bit_depth 8 or 16 only
+  int data_rows = -1;       // rows in IDAT if >= 0 (non-interlaced only)
   std::string plte;
   std::string trns;
 };
@@ -148,7 +149,8 @@ std::string MakePng(const PngSpec& spec, unsigned seed) {
   }
   std::string raw;
   if (!spec.interlaced) {
-    for (const std::string& row : rows) raw += '\0' + row;
+    const int data_rows = spec.data_rows >= 0 ? spec.data_rows : spec.height;
+    for (int v = 0; v < data_rows; ++v) raw += '\0' + rows[v];
   } else {
     const int bytes_per_pixel = bits_per_pixel / 8;
     constexpr int kPasses[7][4] = {{0, 0, 8, 8}, {4, 0, 8, 8}, {0, 4, 4, 8},
@@ -584,6 +586,25 @@ TEST(ImageCodecTest, RefusesGarbage) {
   ASSERT_NE(sos, std::string::npos);
   for (size_t i = sos + 20; i + 2 < jpeg.size(); ++i) jpeg[i] ^= 0x5A;
   ExpectInvalid(Decode(jpeg, ImageDecodeMode::kColor), "scrambled JPEG");
+}
+
+TEST(ImageCodecTest, RefusesWellFormedFilesWithMissingPixels) {
+  // Every chunk and CRC valid, but IDAT holds 3 of the 4 rows IHDR claims.
+  PngSpec spec;
+  spec.color_type = 2;
+  spec.data_rows = 3;
+  ExpectInvalid(Decode(MakePng(spec, 11), ImageDecodeMode::kColor),
+                "PNG with a row missing");
+  spec.data_rows = -1;
+  ASSERT_TRUE(Decode(MakePng(spec, 11), ImageDecodeMode::kColor).ok());
+
+  // The scan cut in the middle, then a proper end-of-image marker.
+  const std::string jpeg = OpenCvEncode(".jpg", SmoothBgr(64, 64));
+  const size_t sos = jpeg.find("\xff\xda");
+  ASSERT_NE(sos, std::string::npos);
+  const std::string cut =
+      jpeg.substr(0, (sos + jpeg.size()) / 2) + std::string("\xff\xd9", 2);
+  ExpectInvalid(Decode(cut, ImageDecodeMode::kColor), "JPEG with half a scan");
 }
 
 // ---------------------------------------------------------------- options
