@@ -1,19 +1,23 @@
 #include "client/cli_frame.h"
 
-#include <opencv2/imgcodecs.hpp>
+#include <cstdint>
 #include <opencv2/imgproc.hpp>
 #include <utility>
-#include <vector>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "client/frame_builder.h"
+#include "core/frame/image_codec.h"
 #include "core/frame/osd_pcd.h"
 #include "core/frame/rgbd_frame.h"
 #include "core/synth/synth_scene.h"
 
 namespace fovea::client {
 namespace {
+
+// Largest side of a colour file decoded for the overlays, pixels: the
+// server takes no larger frame (FrameLimits is at most 1 << 15).
+constexpr uint32_t kMaxOverlaySide = 1u << 15;
 
 // The source's intrinsics: each flag given wins over `fallback`.
 Intrinsics ChooseIntrinsics(const FrameSource& source,
@@ -67,12 +71,14 @@ absl::StatusOr<LoadedFrame> FromFiles(const FrameSource& source) {
   if (!depth_bytes.ok()) return depth_bytes.status();
 
   LoadedFrame loaded;
-  try {
-    const std::vector<uchar> buffer(color_bytes->begin(), color_bytes->end());
-    loaded.color_bgr = cv::imdecode(buffer, cv::IMREAD_COLOR);
-  } catch (const cv::Exception&) {
-    loaded.color_bgr.release();  // the server will say what is wrong
-  }
+  ImageDecodeOptions options;
+  options.mode = ImageDecodeMode::kColor;
+  options.max_width = kMaxOverlaySide;
+  options.max_height = kMaxOverlaySide;
+  absl::StatusOr<cv::Mat> color_bgr =
+      DecodeImage(*color_bytes, options, "--color");
+  // Left empty when undecodable: the server will say what is wrong.
+  if (color_bgr.ok()) loaded.color_bgr = *std::move(color_bgr);
   absl::StatusOr<fovea::v1::Image> color =
       MakeCompressedImage(*std::move(color_bytes));
   if (!color.ok()) {

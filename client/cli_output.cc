@@ -4,7 +4,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <utility>
 
@@ -14,6 +13,7 @@
 #include "absl/strings/str_join.h"
 #include "client/option_names.h"
 #include "client/rle.h"
+#include "core/frame/image_codec.h"
 #include "google/protobuf/util/json_util.h"
 
 namespace fovea::client {
@@ -41,13 +41,12 @@ absl::Status WriteText(const std::filesystem::path& path,
 }
 
 absl::Status WritePng(const std::filesystem::path& path, const cv::Mat& image) {
-  try {
-    if (cv::imwrite(path.string(), image)) return absl::OkStatus();
-  } catch (const cv::Exception& e) {
-    return absl::InternalError(
-        absl::StrCat("cannot write ", path.string(), ": ", e.what()));
+  absl::StatusOr<std::string> png = EncodePng(image);
+  if (!png.ok()) {
+    return absl::InternalError(absl::StrCat("cannot write ", path.string(),
+                                            ": ", png.status().message()));
   }
-  return absl::InternalError(absl::StrCat("cannot write ", path.string()));
+  return WriteText(path, *png);
 }
 
 // A saliency map image (16-bit grey PNG, value / 65535 in [0, 1]; or raw
@@ -56,9 +55,14 @@ absl::StatusOr<cv::Mat> DecodeMap(const fovea::v1::Image& image) {
   cv::Mat decoded;
   try {
     if (!image.compressed().empty()) {
-      const std::vector<uchar> bytes(image.compressed().begin(),
-                                     image.compressed().end());
-      decoded = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
+      ImageDecodeOptions options;
+      options.mode = ImageDecodeMode::kUnchanged;
+      options.max_width = kLargestDecodeSide;
+      options.max_height = kLargestDecodeSide;
+      absl::StatusOr<cv::Mat> png =
+          DecodeImage(image.compressed(), options, "image.compressed");
+      if (!png.ok()) return png.status();
+      decoded = *std::move(png);
     } else if (!image.data().empty()) {
       int type = -1;
       if (image.encoding() == "16UC1" || image.encoding() == "mono16") {

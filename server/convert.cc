@@ -4,11 +4,11 @@
 #include <cmath>
 #include <cstdint>
 #include <exception>
-#include <opencv2/imgcodecs.hpp>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "core/base/strings.h"
+#include "core/frame/image_codec.h"
 
 namespace fovea::server {
 namespace {
@@ -501,11 +501,12 @@ absl::StatusOr<std::string> EncodeSaliencyPng(const cv::Mat& map) {
     cv::Mat pixels;
     // convertTo rounds and saturates to [0, 65535].
     finite.convertTo(pixels, CV_16UC1, kPngFullScale);
-    std::vector<uchar> png;
-    if (!cv::imencode(".png", pixels, png)) {
-      return absl::InternalError("saliency map: PNG encoding failed");
+    absl::StatusOr<std::string> png = EncodePng(pixels);
+    if (!png.ok()) {
+      return absl::InternalError(absl::StrCat(
+          "saliency map: PNG encoding failed: ", png.status().message()));
     }
-    return std::string(png.begin(), png.end());
+    return png;
   } catch (const std::exception& e) {
     return absl::InternalError(
         absl::StrCat("saliency map: PNG encoding failed: ", e.what()));

@@ -65,7 +65,7 @@ v1::Extraction ToProtoEnum(ExtractionKind extraction);
 
 // A saliency map (CV_32FC1, values in [0, 1]) as a 16-bit grey PNG file:
 // pixel = round(value * 65535), clamped to [0, 65535], NaN as 0. INTERNAL
-// for a map of another type or when OpenCV fails.
+// for a map of another type or when encoding fails.
 absl::StatusOr<std::string> EncodeSaliencyPng(const cv::Mat& map);
 
 // The response to `request` from core's result: request_id, frame_id and

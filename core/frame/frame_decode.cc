@@ -9,7 +9,6 @@
 #include <limits>
 #include <new>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
 #include <string_view>
@@ -21,6 +20,7 @@
 #include "absl/strings/string_view.h"
 #include "core/base/check.h"
 #include "core/base/strings.h"
+#include "core/frame/image_codec.h"
 
 namespace fovea {
 namespace {
@@ -344,18 +344,16 @@ absl::StatusOr<Layout> Inspect(const RawImage& image, Slot slot,
   return InspectRaw(image, slot, field, limits);
 }
 
-// cv::imdecode on a non-owning view; empty on any failure.
-cv::Mat DecodeFile(absl::string_view file, int flags) {
-  if (file.size() > static_cast<size_t>(std::numeric_limits<int>::max())) {
-    return cv::Mat();
-  }
-  try {
-    const cv::Mat bytes(1, static_cast<int>(file.size()), CV_8UC1,
-                        const_cast<char*>(file.data()));
-    return cv::imdecode(bytes, flags | cv::IMREAD_IGNORE_ORIENTATION);
-  } catch (const std::exception&) {
-    return cv::Mat();
-  }
+// Decodes a compressed file already inspected into `layout`: the codec
+// checks the file's header against the layout's size before allocating.
+absl::StatusOr<cv::Mat> DecodeFile(std::string_view file, const Layout& layout,
+                                   ImageDecodeMode mode,
+                                   absl::string_view field) {
+  ImageDecodeOptions options;
+  options.mode = mode;
+  options.max_width = layout.width;
+  options.max_height = layout.height;
+  return DecodeImage(file, options, absl::StrCat(field, ".compressed"));
 }
 
 float DepthFromMetres(float metres) {
@@ -424,7 +422,10 @@ absl::StatusOr<cv::Mat> DecodeColor(const RawImage& image, const Layout& layout,
     return ColorFromRaw(image, layout);
   }
   const absl::string_view kind = layout.format == Format::kPng ? "PNG" : "JPEG";
-  cv::Mat bgr = DecodeFile(AbslView(image.compressed), cv::IMREAD_COLOR);
+  absl::StatusOr<cv::Mat> decoded =
+      DecodeFile(image.compressed, layout, ImageDecodeMode::kColor, field);
+  if (!decoded.ok()) return decoded.status();
+  const cv::Mat& bgr = *decoded;
   if (bgr.type() != CV_8UC3 || bgr.cols != static_cast<int>(layout.width) ||
       bgr.rows != static_cast<int>(layout.height)) {
     return absl::InvalidArgumentError(
@@ -439,8 +440,10 @@ absl::StatusOr<cv::Mat> DecodeColor(const RawImage& image, const Layout& layout,
 absl::StatusOr<cv::Mat> DecodeDepth(const RawImage& image, const Layout& layout,
                                     double scale, absl::string_view field) {
   if (layout.format != Format::kPng) return DepthFromRaw(image, layout, scale);
-  const cv::Mat units =
-      DecodeFile(AbslView(image.compressed), cv::IMREAD_ANYDEPTH);
+  absl::StatusOr<cv::Mat> decoded =
+      DecodeFile(image.compressed, layout, ImageDecodeMode::kAnyDepth, field);
+  if (!decoded.ok()) return decoded.status();
+  const cv::Mat& units = *decoded;
   if (units.type() != CV_16UC1 ||
       units.cols != static_cast<int>(layout.width) ||
       units.rows != static_cast<int>(layout.height)) {

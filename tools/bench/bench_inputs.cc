@@ -4,13 +4,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string_view>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "core/base/strings.h"
+#include "core/frame/image_codec.h"
 #include "core/frame/osd_pcd.h"
 #include "core/pipeline/detect.h"
 #include "core/saliency/rso.h"
@@ -27,10 +27,6 @@ constexpr uint64_t kEbsTrainingSeeds[] = {101, 102, 103};
 constexpr float kMaxWireDepthUnits = 65535.0f;
 
 std::string_view View(const std::string& s) { return {s.data(), s.size()}; }
-
-std::string ToBytes(const std::vector<uint8_t>& bytes) {
-  return std::string(bytes.begin(), bytes.end());
-}
 
 // Row-major rgb8 bytes of a CV_8UC3 RGB image.
 std::string EncodeRgb8(const cv::Mat& rgb) {
@@ -113,17 +109,16 @@ absl::Status PrepareScene(const RgbdFrame& frame, BenchScene& scene) {
 
   cv::Mat bgr;
   cv::cvtColor(frame.color, bgr, cv::COLOR_RGB2BGR);
-  std::vector<uint8_t> file;
-  if (!cv::imencode(".png", bgr, file)) {
-    return StageError(scene, "encode colour PNG",
-                      absl::InternalError("cv::imencode failed"));
+  absl::StatusOr<std::string> color_png = EncodePng(bgr);
+  if (!color_png.ok()) {
+    return StageError(scene, "encode colour PNG", color_png.status());
   }
-  scene.color_png = ToBytes(file);
-  if (!cv::imencode(".png", depth_units, file)) {
-    return StageError(scene, "encode depth PNG",
-                      absl::InternalError("cv::imencode failed"));
+  scene.color_png = *std::move(color_png);
+  absl::StatusOr<std::string> depth_png = EncodePng(depth_units);
+  if (!depth_png.ok()) {
+    return StageError(scene, "encode depth PNG", depth_png.status());
   }
-  scene.depth_png = ToBytes(file);
+  scene.depth_png = *std::move(depth_png);
 
   scene.raw_wire = RawFrame{};
   scene.raw_wire.color =
