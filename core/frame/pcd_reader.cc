@@ -12,6 +12,7 @@
 #include <limits>
 #include <new>
 #include <optional>
+#include <set>
 #include <string>
 #include <system_error>
 #include <type_traits>
@@ -109,6 +110,7 @@ absl::StatusOr<PcdHeader> ParseHeader(absl::string_view head,
   uint64_t width = 0, height = 1, points = 0;
   bool has_width = false, has_points = false;
   std::optional<PcdEncoding> encoding;
+  std::set<std::string> seen_keys;
   size_t pos = 0;
   while (!encoding.has_value()) {
     const size_t end = head.find('\n', pos);
@@ -126,6 +128,13 @@ absl::StatusOr<PcdHeader> ParseHeader(absl::string_view head,
     if (absl::StartsWith(tokens[0], "#")) continue;
     const absl::string_view key = tokens[0];
     const size_t values = tokens.size() - 1;
+    // Each line once: a second SIZE after TYPE would leave the types
+    // (derived from the first) disagreeing with the point layout.
+    if (!seen_keys.insert(std::string(key.substr(0, 16))).second) {
+      return PcdError(path, absl::StrCat("header line '",
+                                         absl::CHexEscape(key.substr(0, 16)),
+                                         "' appears twice"));
+    }
     if (key == "VERSION" || key == "VIEWPOINT") continue;
     if (key == "FIELDS") {
       if (values == 0 || values > kMaxPcdFields) {

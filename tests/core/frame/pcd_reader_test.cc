@@ -355,6 +355,17 @@ TEST(ReadPcdTest, CorruptLzfDataIsRefusedWithItsByteOffset) {
       "expands to 3 bytes, 24 expected");
 }
 
+// Found by fuzz_pcd_load: a second SIZE line after TYPE made the layout
+// (from the second) disagree with the types (from the first), and
+// LoadOsdPcd's FOVEA_CHECK that every field fits its point aborted.
+TEST(ReadPcdTest, RepeatedHeaderLineIsRefused) {
+  const std::string header =
+      "FIELDS label x y z\nSIZE 4 4 4 4\nTYPE U F F F\nSIZE 2 4 4 4\n"
+      "COUNT 1 1 1 1\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n";
+  ExpectInvalid(WriteFile(TestDir() / "twice.pcd", header + "1 2 3 4\n"),
+                "header line 'SIZE' appears twice");
+}
+
 TEST(ReadPcdTest, HeaderSizesAreCheckedBeforeAllocating) {
   const std::filesystem::path dir = TestDir();
   // 100000 points (1.2 MB) from 3 bytes of LZF: at most 264 bytes.
