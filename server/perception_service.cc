@@ -240,6 +240,7 @@ class StreamReactor final
       broken_ = true;
     }
     changed_.notify_all();
+    if (config_.on_stream_cancelled) config_.on_stream_cancelled();
   }
 
   void OnDone() override { delete this; }

@@ -25,6 +25,12 @@ struct ServiceConfig {
   // stages), right before the deadline and cancellation check there.
   // Tests block it to let a deadline pass in the middle of the pipeline.
   std::function<void()> at_stage_boundary;
+  // Test hook, null in production: called on gRPC's thread when it tells a
+  // Segment or SegmentIncremental call that the call was cancelled (by the
+  // client, its deadline or a shutdown), after which the job's checks see
+  // it. Tests wait for it before releasing a job they hold, since a
+  // client's cancellation reaches the server asynchronously.
+  std::function<void()> on_stream_cancelled;
   // The trained models (not owned: they outlive the service) and their
   // (name, version) pairs for GetCapabilities.
   SegmentModels segment_models;
