@@ -59,7 +59,9 @@ struct ServiceConfig {
 // client's deadline and cancellation are checked between stages, between
 // objects and inside the methods' loops, and a failed write stops the
 // work. What was made before a deadline has been sent; the call then ends
-// DEADLINE_EXCEEDED.
+// DEADLINE_EXCEEDED. A call whose stream broke before its last message was
+// written ends as its client saw it, DEADLINE_EXCEEDED once the deadline
+// passed, else CANCELLED, even when its job had finished.
 // SegmentIncremental: the same streaming, with INC's objects in order of
 // saliency; also stops on the request's time budget.
 // GetCapabilities: BuildCapabilities, computed once.
