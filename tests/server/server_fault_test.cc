@@ -1,6 +1,7 @@
 // Faults end to end: an in-process FoveaServer on loopback, a real gRPC
 // channel, and the server's test hooks to put each fault at a chosen point
-// of a job: a client that cancels mid-stream.
+// of a job: a client that cancels mid-stream,
+// a deadline that passes at each stage boundary.
 // Every wait is bounded and waits for a fact (a gate count, a metric, a
 // client's status), never for a duration to pass.
 
@@ -228,6 +229,165 @@ INSTANTIATE_TEST_SUITE_P(Streams, CancelMidStreamTest,
                          [](const ::testing::TestParamInfo<Method>& info) {
                            return MethodName(info.param);
                          });
+
+// ------------------------------------------- a deadline at every boundary
+
+// The stage boundaries a whole call of each method passes on
+// SmallRequests(): Detect 1 after decoding + 3 of core's; Segment and
+// SegmentIncremental those of the scene, the seeds and each of
+// kStreamObjects objects. DeadlineSweepCoversEveryBoundary checks them, so
+// that the sweep below keeps covering every boundary when the pipeline
+// changes.
+constexpr int kDetectBoundaries = 4;
+constexpr int kSegmentBoundaries = 11;
+constexpr int kIncrementalBoundaries = 10;
+
+int Boundaries(Method method) {
+  switch (method) {
+    case Method::kDetect:
+      return kDetectBoundaries;
+    case Method::kSegment:
+      return kSegmentBoundaries;
+    case Method::kSegmentIncremental:
+      break;
+  }
+  return kIncrementalBoundaries;
+}
+
+TEST_F(FaultTest, DeadlineSweepCoversEveryBoundary) {
+  Start();
+  for (Method method :
+       {Method::kDetect, Method::kSegment, Method::kSegmentIncremental}) {
+    EXPECT_EQ(CountBoundaries(method), Boundaries(method))
+        << MethodName(method) << ": update the sweep's boundary count";
+  }
+}
+
+// The first deadline tried; doubled while the job cannot reach its
+// boundary in time (a loaded machine), up to kLastDeadline.
+constexpr auto kFirstDeadline = std::chrono::milliseconds(300);
+constexpr auto kLastDeadline = std::chrono::milliseconds(9600);
+
+// (method, k): the deadline passes while the job is held at stage boundary
+// k, 1-based; k = 0 while it waits in the queue for a worker.
+class DeadlineAtBoundaryTest
+    : public FaultTest,
+      public ::testing::WithParamInterface<std::tuple<Method, int>> {
+ protected:
+  // Holds the job at boundary k until its deadline passed for the client
+  // (its status says so) and for the server (kServerDeadlineMargin later),
+  // then releases it. Retries with a longer deadline while the job cannot
+  // reach boundary k in time. On return the call was handled.
+  void HoldAtBoundaryPastTheDeadline(Method method, int k) {
+    for (auto deadline = kFirstDeadline;; deadline *= 2) {
+      ASSERT_LE(deadline, kLastDeadline)
+          << "the job never reached boundary " << k << " in time";
+      const int start = stage_gate_.entered();
+      const double handled = HandledNow(method, "DeadlineExceeded");
+      stage_gate_.CloseAtPass(start + k);
+      grpc::ClientContext context;
+      const auto expiry = std::chrono::system_clock::now() + deadline;
+      context.set_deadline(expiry);
+      std::future<CallResult> call = CallAsync(method, context);
+      EXPECT_EQ(call.get().status.error_code(),
+                grpc::StatusCode::DEADLINE_EXCEEDED);
+      ASSERT_TRUE(WaitFor(
+          [&] {
+            return std::chrono::system_clock::now() >
+                   expiry + kServerDeadlineMargin;
+          },
+          kCallTimeout));
+      // Now the job is held at k, or it stopped before k because its
+      // deadline came first: then try again with a longer one.
+      bool held = false;
+      ASSERT_TRUE(WaitFor(
+          [&] {
+            held = stage_gate_.entered() == start + k;
+            return held ||
+                   MetricValue(Scrape(), "fovea_inflight_requests", {}) == 0;
+          },
+          kCallTimeout));
+      if (!held) {
+        stage_gate_.Open();
+        continue;
+      }
+      stage_gate_.Open();
+      ASSERT_TRUE(WaitForHandled(method, "DeadlineExceeded", handled + 1));
+      EXPECT_LE(stage_gate_.entered(), start + k + 1)
+          << "the job went on after boundary " << k;
+      RecordProperty("deadline_ms", static_cast<int>(deadline.count()));
+      return;
+    }
+  }
+
+  // Holds a Detect at the start of the only worker's job (gate_) and queues
+  // the call; its deadline passes in the queue, then the worker is freed.
+  void ExpireInTheQueue(Method method) {
+    const double handled = HandledNow(method, "DeadlineExceeded");
+    const std::string before = Scrape();
+    const int start = stage_gate_.entered();
+    std::future<grpc::Status> holder = StartHeldDetect(SmallRequests().detect);
+    grpc::ClientContext context;
+    const auto expiry = std::chrono::system_clock::now() + kFirstDeadline;
+    context.set_deadline(expiry);
+    std::future<CallResult> call = CallAsync(method, context);
+    ASSERT_TRUE(
+        WaitFor([this] { return server_->queued_jobs() == 1; }, kCallTimeout));
+    EXPECT_EQ(call.get().status.error_code(),
+              grpc::StatusCode::DEADLINE_EXCEEDED);
+    ASSERT_TRUE(WaitFor(
+        [&] {
+          return std::chrono::system_clock::now() >
+                 expiry + kServerDeadlineMargin;
+        },
+        kCallTimeout));
+    gate_.Open();
+    EXPECT_TRUE(holder.get().ok());
+    ASSERT_TRUE(WaitForHandled(method, "DeadlineExceeded", handled + 1));
+    // Only the holder was decoded and passed boundaries.
+    EXPECT_EQ(stage_gate_.entered(), start + kDetectBoundaries);
+    auto decodes = [](const std::string& text) {
+      return MetricValue(text, "fovea_stage_duration_seconds_count",
+                         {"stage=\"decode\""})
+          .value_or(-1);
+    };
+    EXPECT_EQ(decodes(Scrape()), decodes(before) + 1);
+  }
+};
+
+TEST_P(DeadlineAtBoundaryTest, JobStopsThereAndServerGoesOn) {
+  const auto [method, k] = GetParam();
+  ServerConfig config = DefaultConfig();
+  config.warm_up = false;
+  if (k == 0) config.concurrency = 1;  // one job holds the only worker
+  StartServer(config);
+  if (k == 0) {
+    ExpireInTheQueue(method);
+  } else {
+    HoldAtBoundaryPastTheDeadline(method, k);
+  }
+  if (HasFatalFailure()) return;
+  const CallResult next = Call(method);
+  EXPECT_TRUE(next.status.ok()) << next.status.error_message();
+}
+
+std::vector<std::tuple<Method, int>> EveryBoundary() {
+  std::vector<std::tuple<Method, int>> cases;
+  for (Method method :
+       {Method::kDetect, Method::kSegment, Method::kSegmentIncremental}) {
+    for (int k = 0; k <= Boundaries(method); ++k) cases.emplace_back(method, k);
+  }
+  return cases;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    EveryMethod, DeadlineAtBoundaryTest, ::testing::ValuesIn(EveryBoundary()),
+    [](const ::testing::TestParamInfo<std::tuple<Method, int>>& info) {
+      const int k = std::get<1>(info.param);
+      return MethodName(std::get<0>(info.param)) +
+             (k == 0 ? std::string("_InTheQueue")
+                     : "_AtBoundary" + std::to_string(k));
+    });
 
 }  // namespace
 }  // namespace fovea::server
