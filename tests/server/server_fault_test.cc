@@ -1,7 +1,8 @@
 // Faults end to end: an in-process FoveaServer on loopback, a real gRPC
 // channel, and the server's test hooks to put each fault at a chosen point
 // of a job: a client that cancels mid-stream,
-// a deadline that passes at each stage boundary.
+// a deadline that passes at each stage boundary, a client that stops
+// reading.
 // Every wait is bounded and waits for a fact (a gate count, a metric, a
 // client's status), never for a duration to pass.
 
@@ -387,6 +388,220 @@ INSTANTIATE_TEST_SUITE_P(
       return MethodName(std::get<0>(info.param)) +
              (k == 0 ? std::string("_InTheQueue")
                      : "_AtBoundary" + std::to_string(k));
+    });
+
+// ------------------------------------------ a client that stops reading
+
+// How a stalled stream ends.
+enum class Ending { kCancel, kDeadline };
+
+// A request_id is echoed in every message of a stream: this many bytes
+// make each message far larger than HTTP/2's initial 64 KiB window.
+constexpr size_t kBigRequestIdBytes = 1 << 20;
+// Progress (stage boundaries, messages written) unchanged for this many
+// polls in a row (WaitFor polls every few ms) counts as stalled.
+constexpr int kStablePolls = 40;
+// The stalled call's deadline when Ending::kDeadline.
+constexpr auto kStalledDeadline = std::chrono::seconds(2);
+
+// SmallRequests() with every object and a kBigRequestIdBytes request_id.
+Requests BigMessageRequests() {
+  Requests requests = SmallRequests();
+  const std::string big_id(kBigRequestIdBytes, 'x');
+  requests.segment.set_request_id(big_id);
+  requests.segment.set_max_objects(0);
+  requests.incremental.set_request_id(big_id);
+  requests.incremental.set_max_objects(0);
+  return requests;
+}
+
+// A stub on a channel of its own to `port` whose HTTP/2 receive window
+// stays at its initial 64 KiB: BDP probing, which grows the window while
+// a client reads quickly, is off (on a default channel the window grows
+// to megabytes).
+std::unique_ptr<v1::Perception::Stub> SmallWindowStub(int port) {
+  grpc::ChannelArguments args;
+  args.SetInt(GRPC_ARG_HTTP2_BDP_PROBE, 0);
+  return v1::Perception::NewStub(
+      grpc::CreateCustomChannel("127.0.0.1:" + std::to_string(port),
+                                grpc::InsecureChannelCredentials(), args));
+}
+
+class StalledReaderTest
+    : public FaultTest,
+      public ::testing::WithParamInterface<std::tuple<Method, Ending>> {
+ protected:
+  double Sent(Method method) {
+    return MetricValue(Scrape(), "grpc_server_msg_sent_total",
+                       {"grpc_method=\"" + MethodName(method) + "\""})
+        .value_or(-1);
+  }
+
+  static std::unique_ptr<grpc::ClientReader<v1::SegmentResponse>> Open(
+      v1::Perception::Stub& stub, Method method, const Requests& requests,
+      grpc::ClientContext& context) {
+    return method == Method::kSegment
+               ? stub.Segment(&context, requests.segment)
+               : stub.SegmentIncremental(&context, requests.incremental);
+  }
+};
+
+// What bounds the memory of a stream whose client reads nothing: the
+// reactor keeps at most kMaxPendingMessages (2) unwritten messages plus the
+// one being written, and gRPC sends that one only as far as the client's
+// HTTP/2 flow-control window lets it. The window is the client's: 64 KiB
+// at first, grown by BDP probing only while the client reads. The job
+// blocks in its next Send until the client reads, cancels or runs out of
+// time. Here each message is > 1 MiB and the window 64 KiB, so not even
+// the first message is written whole: the job must stop partway, holding
+// its worker while the other worker still serves, and be released when
+// the call ends.
+TEST_P(StalledReaderTest, JobBlocksPartwayAndIsReleasedWhenTheCallEnds) {
+  const auto [method, ending] = GetParam();
+  Start();
+  const Requests requests = BigMessageRequests();
+  const std::unique_ptr<v1::Perception::Stub> stub =
+      SmallWindowStub(server_->port());
+
+  // A client that reads: how many messages and boundaries the whole call
+  // makes.
+  int start = stage_gate_.entered();
+  double sent_before = Sent(method);
+  {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + kCallTimeout);
+    const CallResult full = ReadAll(*Open(*stub, method, requests, context));
+    ASSERT_TRUE(full.status.ok()) << full.status.error_message();
+    // One being written and two queued: a fourth must wait.
+    ASSERT_GE(full.messages.size(), 4u) << "too few messages to fill up";
+  }
+  const int total_boundaries = stage_gate_.entered() - start;
+  const double total_messages = Sent(method) - sent_before;
+
+  // A client that reads nothing.
+  const double cancelled = HandledNow(method, "Canceled");
+  const double expired = HandledNow(method, "DeadlineExceeded");
+  start = stage_gate_.entered();
+  sent_before = Sent(method);
+  grpc::ClientContext context;
+  context.set_deadline(
+      std::chrono::system_clock::now() +
+      (ending == Ending::kDeadline ? kStalledDeadline : kCallTimeout));
+  auto reader = Open(*stub, method, requests, context);
+  int last_entered = -1;
+  double last_sent = -1;
+  int stable = 0;
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        const int entered = stage_gate_.entered();
+        const double sent = Sent(method);
+        stable = entered > start && entered == last_entered && sent == last_sent
+                     ? stable + 1
+                     : 0;
+        last_entered = entered;
+        last_sent = sent;
+        return stable >= kStablePolls;
+      },
+      kCallTimeout));
+  const int stalled_boundaries = last_entered - start;
+  const double stalled_messages = last_sent - sent_before;
+  RecordProperty("boundaries_of_a_whole_call", total_boundaries);
+  RecordProperty("boundaries_before_the_stall", stalled_boundaries);
+  RecordProperty("messages_of_a_whole_call", static_cast<int>(total_messages));
+  RecordProperty("messages_written_before_the_stall",
+                 static_cast<int>(stalled_messages));
+  EXPECT_LT(stalled_boundaries, total_boundaries);
+  EXPECT_EQ(stalled_messages, 0);
+
+  if (ending == Ending::kCancel) {
+    // Still in flight, and the other worker still serves.
+    EXPECT_EQ(MetricValue(Scrape(), "fovea_inflight_requests", {}), 1);
+    const CallResult detect = Call(Method::kDetect);
+    EXPECT_TRUE(detect.status.ok()) << detect.status.error_message();
+    EXPECT_EQ(stage_gate_.entered(),
+              start + stalled_boundaries + kDetectBoundaries)
+        << "the stalled job went on";
+    context.TryCancel();
+    ASSERT_TRUE(WaitForHandled(method, "Canceled", cancelled + 1));
+  } else {
+    // The server records DEADLINE_EXCEEDED when its own copy of the
+    // deadline passed first; the client's RST_STREAM on expiry can reach
+    // it a moment before (that copy is re-based on the request's arrival),
+    // and then the server saw a cancellation.
+    ASSERT_TRUE(WaitFor(
+        [&] {
+          const std::string text = Scrape();
+          return Handled(text, MethodName(method), "DeadlineExceeded") +
+                         Handled(text, MethodName(method), "Canceled") ==
+                     expired + cancelled + 1 &&
+                 MetricValue(text, "fovea_inflight_requests", {}) == 0;
+        },
+        kCallTimeout));
+  }
+  // Released from its Send, the job stopped without another boundary.
+  EXPECT_EQ(stage_gate_.entered(),
+            start + stalled_boundaries +
+                (ending == Ending::kCancel ? kDetectBoundaries : 0));
+  v1::SegmentResponse message;
+  while (reader->Read(&message)) {
+  }
+  const grpc::Status status = reader->Finish();
+  EXPECT_EQ(status.error_code(), ending == Ending::kCancel
+                                     ? grpc::StatusCode::CANCELLED
+                                     : grpc::StatusCode::DEADLINE_EXCEEDED);
+  const CallResult next = Call(method);
+  EXPECT_TRUE(next.status.ok()) << next.status.error_message();
+}
+
+// A job that made all its messages before the client read them has
+// finished, but its call has not: the last messages still wait to be
+// written. When the client then leaves, the call ends CANCELLED for the
+// server too (its record says what the client got), not OK.
+TEST_F(FaultTest, StreamWhoseClientLeavesBeforeTheLastMessageIsNotRecordedOk) {
+  Start();
+  Requests requests = BigMessageRequests();
+  requests.segment.set_max_objects(1);  // 3 messages: all fit the queue
+  const std::unique_ptr<v1::Perception::Stub> stub =
+      SmallWindowStub(server_->port());
+  const std::string before = Scrape();
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + kCallTimeout);
+  auto reader = stub->Segment(&context, requests.segment);
+  // The job is done once it recorded its stop reason.
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        return MetricValue(
+                   Scrape(), "fovea_segment_stops_total",
+                   {"grpc_method=\"Segment\"", "reason=\"max_objects\""}) ==
+               MetricValue(
+                   before, "fovea_segment_stops_total",
+                   {"grpc_method=\"Segment\"", "reason=\"max_objects\""})
+                       .value_or(-1) +
+                   1;
+      },
+      kCallTimeout));
+  EXPECT_EQ(MetricValue(Scrape(), "fovea_inflight_requests", {}), 1)
+      << "the call ended before its messages were read";
+  context.TryCancel();
+  ASSERT_TRUE(WaitForHandled(Method::kSegment, "Canceled",
+                             Handled(before, "Segment", "Canceled") + 1));
+  EXPECT_EQ(Handled(Scrape(), "Segment", "OK"),
+            Handled(before, "Segment", "OK"));
+  v1::SegmentResponse message;
+  while (reader->Read(&message)) {
+  }
+  EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::CANCELLED);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Streams, StalledReaderTest,
+    ::testing::Combine(::testing::Values(Method::kSegment,
+                                         Method::kSegmentIncremental),
+                       ::testing::Values(Ending::kCancel, Ending::kDeadline)),
+    [](const ::testing::TestParamInfo<std::tuple<Method, Ending>>& info) {
+      return MethodName(std::get<0>(info.param)) +
+             (std::get<1>(info.param) == Ending::kCancel ? "_Cancelled"
+                                                         : "_DeadlinePassed");
     });
 
 }  // namespace
