@@ -1,11 +1,11 @@
 // Faults end to end: an in-process FoveaServer on loopback, a real gRPC
 // channel, and the server's test hooks to put each fault at a chosen point
-// of a job: a client that cancels mid-stream,
-// a deadline that passes at each stage boundary, a client that stops
-// reading.
-// Every wait is bounded and waits for a fact (a gate count, a metric, a
-// client's status), never for a duration to pass.
+// of a job: a client that cancels mid-stream, a deadline that passes at
+// each stage boundary, a client that stops reading, bytes that are not a
+// request. Every wait is bounded and waits for a fact (a gate count, a
+// metric, a client's status), never for a duration to pass.
 
+#include <grpcpp/generic/generic_stub.h>
 #include <grpcpp/grpcpp.h>
 
 #include <chrono>
@@ -32,6 +32,9 @@ using ::fovea::server::testing::kCallTimeout;
 using ::fovea::server::testing::MetricValue;
 using ::fovea::server::testing::ServerTest;
 using ::fovea::server::testing::WaitFor;
+using ::testing::AnyOf;
+using ::testing::Eq;
+using ::testing::HasSubstr;
 
 enum class Method { kDetect, kSegment, kSegmentIncremental };
 
@@ -603,6 +606,144 @@ INSTANTIATE_TEST_SUITE_P(
              (std::get<1>(info.param) == Ending::kCancel ? "_Cancelled"
                                                          : "_DeadlinePassed");
     });
+
+// -------------------------------------------------- malformed protobuf
+
+// The status of a call of `method` (e.g. "/fovea.v1.Perception/Detect")
+// whose one request message is `bytes`, and the number of messages
+// answered. Sent with the generic stub, which does not serialise.
+struct RawCallResult {
+  grpc::Status status;
+  int messages = 0;
+};
+
+RawCallResult CallWithBytes(const std::shared_ptr<grpc::Channel>& channel,
+                            const std::string& method,
+                            const std::string& bytes) {
+  grpc::GenericStub stub(channel);
+  grpc::CompletionQueue queue;
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + kCallTimeout);
+  std::unique_ptr<grpc::GenericClientAsyncReaderWriter> call =
+      stub.PrepareCall(&context, method, &queue);
+  // Each operation is started, then its tag awaited before the next.
+  auto await = [&queue](intptr_t tag) {
+    void* got = nullptr;
+    bool ok = false;
+    EXPECT_TRUE(queue.Next(&got, &ok));
+    EXPECT_EQ(reinterpret_cast<intptr_t>(got), tag);
+    return ok;
+  };
+  RawCallResult result;
+  call->StartCall(reinterpret_cast<void*>(1));
+  await(1);
+  grpc::Slice slice(bytes);
+  call->WriteLast(grpc::ByteBuffer(&slice, 1), grpc::WriteOptions(),
+                  reinterpret_cast<void*>(2));
+  await(2);  // fails when the server ended the call first: fine
+  grpc::ByteBuffer response;
+  while (true) {
+    call->Read(&response, reinterpret_cast<void*>(3));
+    if (!await(3)) break;
+    ++result.messages;
+  }
+  call->Finish(&result.status, reinterpret_cast<void*>(4));
+  await(4);
+  queue.Shutdown();
+  void* tag = nullptr;
+  bool ok = false;
+  while (queue.Next(&tag, &ok)) {
+  }
+  return result;
+}
+
+// Bytes that no protobuf parser accepts, each as the whole request.
+struct Malformed {
+  const char* name;
+  std::string bytes;
+};
+
+std::vector<Malformed> MalformedRequests() {
+  return {
+      // Field 1, varint, whose bytes all say "more follows".
+      {"truncated varint", std::string("\x08\xff\xff\xff", 4)},
+      // Field 1 with wire type 7, which does not exist.
+      {"wire type 7", std::string("\x0f\x01\x02\x03", 4)},
+      // Field 2 (the frame), length-delimited, claiming 2^31 bytes.
+      {"2 GiB length", std::string("\x12\x80\x80\x80\x80\x08\x0a\x00", 8)},
+      // Field 2 (the frame) cut short: 5 bytes claimed, 2 given.
+      {"short sub-message", std::string("\x12\x05\x0a\x00", 4)},
+      // request_id (a proto3 string) that is not UTF-8.
+      {"bad UTF-8", std::string("\x0a\x02\xc3\x28", 4)},
+  };
+}
+
+// gRPC refuses such a request before any handler of the server runs (so
+// the server neither counts nor logs it). gRPC 1.51's callback API answers
+// UNIMPLEMENTED with an empty message ("if deserialization or reactor
+// creator failed, we need to fail the call"), misleading but harmless;
+// other versions may say INTERNAL or INVALID_ARGUMENT.
+TEST_F(FaultTest, MalformedProtobufIsRefusedAndServerGoesOn) {
+  Start();
+  for (Method method :
+       {Method::kDetect, Method::kSegment, Method::kSegmentIncremental}) {
+    const std::string path = "/fovea.v1.Perception/" + MethodName(method);
+    for (const Malformed& malformed : MalformedRequests()) {
+      const RawCallResult result =
+          CallWithBytes(channel_, path, malformed.bytes);
+      EXPECT_THAT(result.status.error_code(),
+                  AnyOf(Eq(grpc::StatusCode::UNIMPLEMENTED),
+                        Eq(grpc::StatusCode::INTERNAL),
+                        Eq(grpc::StatusCode::INVALID_ARGUMENT)))
+          << path << ", " << malformed.name << ": "
+          << result.status.error_message();
+      EXPECT_EQ(result.messages, 0) << path << ", " << malformed.name;
+      RecordProperty(MethodName(method) + " " + malformed.name,
+                     result.status.error_code());
+    }
+    // The same path with a good request's bytes works.
+    std::string good;
+    ASSERT_TRUE(method == Method::kDetect
+                    ? SmallRequests().detect.SerializeToString(&good)
+                : method == Method::kSegment
+                    ? SmallRequests().segment.SerializeToString(&good)
+                    : SmallRequests().incremental.SerializeToString(&good));
+    const RawCallResult result = CallWithBytes(channel_, path, good);
+    EXPECT_TRUE(result.status.ok())
+        << path << ": " << result.status.error_message();
+    EXPECT_GE(result.messages, 1) << path;
+  }
+  EXPECT_EQ(MetricValue(Scrape(), "fovea_inflight_requests", {}), 0);
+}
+
+// Consistent encodings but 4e9 x 4e9 pixels over a few bytes of data:
+// refused naming the field before anything the size of the claim is
+// allocated (that would fail with RESOURCE_EXHAUSTED, or worse).
+TEST_F(FaultTest, FrameClaimingEnormousSizeIsInvalidArgumentNamingIt) {
+  Start();
+  constexpr uint32_t kHuge = 4000000000u;
+  v1::DetectRequest request = SmallRequests().detect;
+  for (v1::Image* image : {request.mutable_frame()->mutable_color(),
+                           request.mutable_frame()->mutable_depth()}) {
+    image->set_width(kHuge);
+    image->set_height(kHuge);
+    image->set_step(kHuge);
+    image->set_data("tiny");
+  }
+  v1::DetectResponse response;
+  grpc::Status status = Detect(request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("frame.color.width"));
+
+  // Only the height enormous: the step fits, the rows do not.
+  request = SmallRequests().detect;
+  request.mutable_frame()->mutable_depth()->set_height(kHuge);
+  status = Detect(request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("frame.depth.height"));
+
+  EXPECT_TRUE(Call(Method::kDetect).status.ok());
+}
 
 }  // namespace
 }  // namespace fovea::server
