@@ -227,7 +227,7 @@ class StreamReactor final
         StartNextWriteLocked();
       } else if (final_status_ && !finished_) {
         finished_ = true;
-        finish = *final_status_;
+        finish = EndStatusLocked(*final_status_);
       }
     }
     changed_.notify_all();
@@ -240,6 +240,7 @@ class StreamReactor final
       broken_ = true;
     }
     changed_.notify_all();
+    if (config_.on_stream_cancelled) config_.on_stream_cancelled();
   }
 
   void OnDone() override { delete this; }
@@ -294,9 +295,7 @@ class StreamReactor final
     changed_.wait(lock, [this] {
       return broken_ || pending_.size() < kMaxPendingMessages;
     });
-    if (broken_) {
-      return absl::CancelledError("the client cancelled or stopped reading");
-    }
+    if (broken_) return BrokenStatus();
     pending_.push_back(std::move(message));
     if (!writing_) StartNextWriteLocked();
     return absl::OkStatus();
@@ -311,17 +310,33 @@ class StreamReactor final
 
   // Finishes now when nothing is being written, else after the last write.
   void FinishOnce(const absl::Status& status) {
-    bool now = false;
+    std::optional<absl::Status> finish;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (finished_ || final_status_) return;
       final_status_ = status;
       if (!writing_ && pending_.empty()) {
         finished_ = true;
-        now = true;
+        finish = EndStatusLocked(status);
       }
     }
-    if (now) Finish(call_.EndStream(status));
+    if (finish) Finish(call_.EndStream(*finish));
+  }
+
+  // Why the stream broke (the client cancelled, went away or stopped
+  // reading, or its deadline passed): DEADLINE_EXCEEDED once the deadline
+  // passed, else CANCELLED.
+  absl::Status BrokenStatus() const {
+    absl::Status status = CheckInterrupt(*context_);
+    if (!status.ok()) return status;
+    return absl::CancelledError("the client cancelled or stopped reading");
+  }
+
+  // The status the call ends with when the job ended with `status`: a job
+  // that succeeded but whose stream broke before its last message was
+  // written did not deliver, so the call ends as the client saw it.
+  absl::Status EndStatusLocked(const absl::Status& status) const {
+    return status.ok() && broken_ ? BrokenStatus() : status;
   }
 
   const std::string_view method_;  // a string literal

@@ -25,6 +25,12 @@ struct ServiceConfig {
   // stages), right before the deadline and cancellation check there.
   // Tests block it to let a deadline pass in the middle of the pipeline.
   std::function<void()> at_stage_boundary;
+  // Test hook, null in production: called on gRPC's thread when it tells a
+  // Segment or SegmentIncremental call that the call was cancelled (by the
+  // client, its deadline or a shutdown), after which the job's checks see
+  // it. Tests wait for it before releasing a job they hold, since a
+  // client's cancellation reaches the server asynchronously.
+  std::function<void()> on_stream_cancelled;
   // The trained models (not owned: they outlive the service) and their
   // (name, version) pairs for GetCapabilities.
   SegmentModels segment_models;
@@ -53,7 +59,9 @@ struct ServiceConfig {
 // client's deadline and cancellation are checked between stages, between
 // objects and inside the methods' loops, and a failed write stops the
 // work. What was made before a deadline has been sent; the call then ends
-// DEADLINE_EXCEEDED.
+// DEADLINE_EXCEEDED. A call whose stream broke before its last message was
+// written ends as its client saw it, DEADLINE_EXCEEDED once the deadline
+// passed, else CANCELLED, even when its job had finished.
 // SegmentIncremental: the same streaming, with INC's objects in order of
 // saliency; also stops on the request's time budget.
 // GetCapabilities: BuildCapabilities, computed once.

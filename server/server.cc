@@ -126,7 +126,8 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
       ServiceConfig{config.limits,
                     static_cast<uint64_t>(config.max_message_bytes),
                     config.before_detect_job, config.at_stage_boundary,
-                    server->models_->View(), server->models_->versions},
+                    config.on_stream_cancelled, server->models_->View(),
+                    server->models_->versions},
       server->work_.get());
 
   grpc::EnableDefaultHealthCheckService(true);

@@ -41,10 +41,11 @@ struct ServerConfig {
   // Folder of the trained models (LoadModels); start-up fails when a model
   // is missing or corrupt.
   std::string models_dir = FOVEA_DEFAULT_MODELS_DIR;
-  // Test hooks, null in production: see ServiceConfig::before_detect_job
-  // and ServiceConfig::at_stage_boundary.
+  // Test hooks, null in production: see ServiceConfig::before_detect_job,
+  // ServiceConfig::at_stage_boundary and ServiceConfig::on_stream_cancelled.
   std::function<void()> before_detect_job;
   std::function<void()> at_stage_boundary;
+  std::function<void()> on_stream_cancelled;
   // Test hook, null in production: called on the warm-up thread before the
   // warm-up Detect; tests block it to observe health before warm-up ends.
   std::function<void()> before_warm_up;

@@ -44,6 +44,7 @@ void ServerTest::StartServer(ServerConfig config, bool wait_serving) {
     ThrowIfAsked();
   };
   config.at_stage_boundary = [this] { stage_gate_.Pass(); };
+  config.on_stream_cancelled = [this] { ++stream_cancels_; };
   absl::StatusOr<std::unique_ptr<FoveaServer>> server =
       FoveaServer::Start(std::move(config));
   ASSERT_TRUE(server.ok()) << server.status();

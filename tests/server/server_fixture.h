@@ -45,7 +45,8 @@ class Gate {
 
 // An in-process FoveaServer on loopback with a channel and stub to it.
 // The server's test hooks are wired to `gate_` (start of each Detect job,
-// where ThrowInNextJob also acts) and `stage_gate_` (each stage boundary).
+// where ThrowInNextJob also acts), `stage_gate_` (each stage boundary) and
+// stream_cancels() (each cancellation gRPC reports to a stream).
 class ServerTest : public ::testing::Test {
  protected:
   // What the next Detect job throws from its start hook.
@@ -84,6 +85,10 @@ class ServerTest : public ::testing::Test {
 
   void ThrowInNextJob(Throw what) { throw_next_.store(what); }
 
+  // Segment and SegmentIncremental calls gRPC has told the server were
+  // cancelled so far; from then on their jobs' checks see it.
+  int stream_cancels() const { return stream_cancels_.load(); }
+
   Gate gate_;
   Gate stage_gate_;
   std::unique_ptr<FoveaServer> server_;
@@ -94,6 +99,7 @@ class ServerTest : public ::testing::Test {
   void ThrowIfAsked();
 
   std::atomic<Throw> throw_next_{Throw::kNothing};
+  std::atomic<int> stream_cancels_{0};
 };
 
 }  // namespace fovea::server::testing

@@ -6,6 +6,8 @@
 #include <chrono>
 #include <cstring>
 #include <limits>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
 
@@ -166,6 +168,119 @@ TEST_F(HostileRequestTest, ExceptionInAJobIsInternalAndServerGoesOn) {
   EXPECT_EQ(Handled(after, "Detect", "Internal"),
             Handled(before, "Detect", "Internal") + 2);
   EXPECT_EQ(MetricValue(after, "fovea_inflight_requests", {}), 0);
+}
+
+// NaN and infinite depths are "no data", like a Kinect's holes: a frame
+// with some is computed; a frame with nothing else is refused naming the
+// depth.
+TEST_F(HostileRequestTest, NonFiniteDepthsAreNoDataAndAllOfThemIsInvalid) {
+  StartServer();
+  constexpr float kNonFinite[] = {std::numeric_limits<float>::quiet_NaN(),
+                                  std::numeric_limits<float>::infinity(),
+                                  -std::numeric_limits<float>::infinity()};
+  v1::DetectRequest some = ShRequest();
+  const int width = static_cast<int>(some.frame().depth().width());
+  const int height = static_cast<int>(some.frame().depth().height());
+  for (int i = 0; i < 3000; ++i) {
+    SetDepth(some, (i * 37) % width, (i * 29) % height, kNonFinite[i % 3]);
+  }
+  v1::DetectResponse response;
+  grpc::Status status = Detect(some, &response);
+  EXPECT_TRUE(status.ok()) << status.error_message();
+  EXPECT_GT(response.points_size(), 0);
+
+  for (const float value : kNonFinite) {
+    v1::DetectRequest all = ShRequest();
+    for (int v = 0; v < height; ++v) {
+      for (int u = 0; u < width; ++u) SetDepth(all, u, v, value);
+    }
+    status = Detect(all, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << value;
+    EXPECT_THAT(status.error_message(), HasSubstr("frame.depth")) << value;
+    EXPECT_THAT(status.error_message(), HasSubstr("no valid depth pixel"))
+        << value;
+  }
+  ExpectStillServing();
+}
+
+// The file `extension` (".png", ".jpg") of `image`'s raw wire pixels.
+std::string EncodeImage(const v1::Image& image, int cv_type,
+                        const std::string& extension) {
+  const cv::Mat pixels(static_cast<int>(image.height()),
+                       static_cast<int>(image.width()), cv_type,
+                       const_cast<char*>(image.data().data()), image.step());
+  std::vector<uchar> file;
+  EXPECT_TRUE(cv::imencode(extension, pixels, file));
+  return std::string(file.begin(), file.end());
+}
+
+// Replaces `image`'s raw pixels by the compressed `file`.
+void SetCompressed(v1::Image& image, const std::string& file) {
+  image.Clear();
+  image.set_compressed(file);
+}
+
+// A 16-bit depth PNG cut in the middle of its image data: refused naming
+// the field, while the whole file is accepted.
+TEST_F(HostileRequestTest, DepthPngTruncatedMidIdatIsInvalidArgument) {
+  StartServer();
+  const v1::DetectRequest raw = MakeSyntheticRequest(1, true).request;
+  const std::string png = EncodeImage(raw.frame().depth(), CV_16UC1, ".png");
+  const size_t idat = png.find("IDAT");
+  ASSERT_NE(idat, std::string::npos);
+  ASSERT_GE(idat, 4u);
+  const uint32_t length =
+      (uint32_t{static_cast<uint8_t>(png[idat - 4])} << 24) |
+      (uint32_t{static_cast<uint8_t>(png[idat - 3])} << 16) |
+      (uint32_t{static_cast<uint8_t>(png[idat - 2])} << 8) |
+      uint32_t{static_cast<uint8_t>(png[idat - 1])};
+  ASSERT_GT(length, 16u);
+
+  v1::DetectRequest whole = raw;
+  SetCompressed(*whole.mutable_frame()->mutable_depth(), png);
+  v1::DetectResponse response;
+  grpc::Status status = Detect(whole, &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+
+  v1::DetectRequest truncated = raw;
+  SetCompressed(*truncated.mutable_frame()->mutable_depth(),
+                png.substr(0, idat + 4 + length / 2));
+  status = Detect(truncated, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("frame.depth.compressed"));
+  ExpectStillServing();
+}
+
+// A colour JPEG whose start-of-frame header claims 65500 x 65500 pixels
+// (about 12 GB decoded): refused from the header naming the field, before
+// decoding; the unpatched file is accepted.
+TEST_F(HostileRequestTest, JpegClaimingHugeSizeIsRefusedFromItsHeader) {
+  StartServer();
+  const v1::DetectRequest raw = MakeSyntheticRequest(1, false).request;
+  const std::string jpeg = EncodeImage(raw.frame().color(), CV_8UC3, ".jpg");
+  // SOF0: FF C0, segment length (2), precision (1), height (2), width (2).
+  const size_t sof = jpeg.find(std::string("\xff\xc0", 2));
+  ASSERT_NE(sof, std::string::npos);
+  ASSERT_LT(sof + 9, jpeg.size());
+
+  v1::DetectRequest whole = raw;
+  SetCompressed(*whole.mutable_frame()->mutable_color(), jpeg);
+  v1::DetectResponse response;
+  grpc::Status status = Detect(whole, &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+
+  std::string huge = jpeg;
+  for (const size_t at : {sof + 5, sof + 7}) {  // height, width
+    huge[at] = static_cast<char>(0xFF);
+    huge[at + 1] = static_cast<char>(0xDC);  // 65500
+  }
+  v1::DetectRequest claiming = raw;
+  SetCompressed(*claiming.mutable_frame()->mutable_color(), huge);
+  status = Detect(claiming, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("frame.color.width"));
+  EXPECT_THAT(status.error_message(), HasSubstr("65500"));
+  ExpectStillServing();
 }
 
 }  // namespace
