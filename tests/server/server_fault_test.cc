@@ -282,6 +282,18 @@ class DeadlineAtBoundaryTest
   // (its status says so) and for the server (kServerDeadlineMargin later),
   // then releases it. Retries with a longer deadline while the job cannot
   // reach boundary k in time. On return the call was handled.
+  // Waits until `expiry` plus kServerDeadlineMargin has passed, so the
+  // server's own copy of the call's deadline has passed too.
+  static bool WaitPastServerDeadline(
+      std::chrono::system_clock::time_point expiry) {
+    return WaitFor(
+        [&] {
+          return std::chrono::system_clock::now() >
+                 expiry + kServerDeadlineMargin;
+        },
+        kCallTimeout);
+  }
+
   void HoldAtBoundaryPastTheDeadline(Method method, int k) {
     for (auto deadline = kFirstDeadline;; deadline *= 2) {
       ASSERT_LE(deadline, kLastDeadline)
@@ -295,12 +307,7 @@ class DeadlineAtBoundaryTest
       std::future<CallResult> call = CallAsync(method, context);
       EXPECT_EQ(call.get().status.error_code(),
                 grpc::StatusCode::DEADLINE_EXCEEDED);
-      ASSERT_TRUE(WaitFor(
-          [&] {
-            return std::chrono::system_clock::now() >
-                   expiry + kServerDeadlineMargin;
-          },
-          kCallTimeout));
+      ASSERT_TRUE(WaitPastServerDeadline(expiry));
       // Now the job is held at k, or it stopped before k because its
       // deadline came first: then try again with a longer one.
       bool held = false;
@@ -339,12 +346,7 @@ class DeadlineAtBoundaryTest
         WaitFor([this] { return server_->queued_jobs() == 1; }, kCallTimeout));
     EXPECT_EQ(call.get().status.error_code(),
               grpc::StatusCode::DEADLINE_EXCEEDED);
-    ASSERT_TRUE(WaitFor(
-        [&] {
-          return std::chrono::system_clock::now() >
-                 expiry + kServerDeadlineMargin;
-        },
-        kCallTimeout));
+    ASSERT_TRUE(WaitPastServerDeadline(expiry));
     gate_.Open();
     EXPECT_TRUE(holder.get().ok());
     ASSERT_TRUE(WaitForHandled(method, "DeadlineExceeded", handled + 1));

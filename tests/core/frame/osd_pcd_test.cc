@@ -21,10 +21,12 @@
 #include "absl/status/statusor.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "tests/core/testing/files.h"
 
 namespace fovea {
 namespace {
 
+using ::fovea::testing::WriteFile;
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 using ::testing::IsEmpty;
@@ -37,20 +39,7 @@ uint32_t PackRgb(int r, int g, int b) {
 
 // A fresh, empty folder for the current test.
 std::filesystem::path TestDir() {
-  const std::filesystem::path dir =
-      std::filesystem::path(testing::TempDir()) /
-      (std::string("osd_pcd_test_") +
-       testing::UnitTest::GetInstance()->current_test_info()->name());
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
-
-std::string WriteFile(const std::filesystem::path& path,
-                      const std::string& contents) {
-  std::ofstream out(path, std::ios::binary);
-  out << contents;
-  return path.string();
+  return ::fovea::testing::FreshTestDir("osd_pcd_test_");
 }
 
 // PCD v0.7 header for `fields` ("x y z rgb"), `types` ("F F F F") of 4 bytes.
@@ -115,7 +104,7 @@ TEST(OsdPcdTest, OrganizedCloudKeepsItsLayoutLabelsColourAndNaN) {
   EXPECT_EQ(frame.intrinsics.fy, 510.0);
   for (int v = 0; v < 3; ++v) {
     for (int u = 0; u < 4; ++u) {
-      SCOPED_TRACE(testing::Message() << "u=" << u << " v=" << v);
+      SCOPED_TRACE(::testing::Message() << "u=" << u << " v=" << v);
       const float z = frame.depth.at<float>(v, u);
       if (u == 2 && v == 1) {
         EXPECT_TRUE(std::isnan(z));

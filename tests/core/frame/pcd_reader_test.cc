@@ -23,28 +23,17 @@
 #include "core/frame/osd_pcd.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
+#include "tests/core/testing/files.h"
 
 namespace fovea {
 namespace {
 
+using ::fovea::testing::WriteFile;
 using ::testing::HasSubstr;
 
 // A fresh, empty folder for the current test.
 std::filesystem::path TestDir() {
-  const std::filesystem::path dir =
-      std::filesystem::path(testing::TempDir()) /
-      (std::string("pcd_reader_test_") +
-       testing::UnitTest::GetInstance()->current_test_info()->name());
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
-
-std::string WriteFile(const std::filesystem::path& path,
-                      const std::string& contents) {
-  std::ofstream out(path, std::ios::binary);
-  out << contents;
-  return path.string();
+  return ::fovea::testing::FreshTestDir("pcd_reader_test_");
 }
 
 template <typename T>
@@ -151,7 +140,7 @@ TEST(ReadPcdTest, PclWrittenCloudReadsIdenticallyInEveryEncoding) {
     ASSERT_EQ(read.height, 4u);
     for (int v = 0; v < 4; ++v) {
       for (int u = 0; u < 5; ++u) {
-        SCOPED_TRACE(testing::Message() << "u=" << u << " v=" << v);
+        SCOPED_TRACE(::testing::Message() << "u=" << u << " v=" << v);
         const size_t i = 5 * v + u;
         const pcl::PointXYZRGBL& point = cloud.at(u, v);
         for (const char* axis : {"x", "y", "z"}) {
