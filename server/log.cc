@@ -6,17 +6,17 @@
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
-#include "absl/synchronization/mutex.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
+#include "core/base/mutex.h"
 
 namespace fovea::server {
 namespace {
 
 std::atomic<int> min_level{static_cast<int>(LogLevel::kInfo)};
 
-absl::Mutex& WriteMutex() {
-  static absl::Mutex* mutex = new absl::Mutex;
+Mutex& WriteMutex() {
+  static Mutex* mutex = new Mutex;
   return *mutex;
 }
 
@@ -64,7 +64,7 @@ void Log(LogLevel level, std::string_view message) {
   line += ' ';
   line.append(message);
   line += '\n';
-  absl::MutexLock lock(&WriteMutex());
+  MutexLock lock(&WriteMutex());
   std::fwrite(line.data(), 1, line.size(), stderr);
   std::fflush(stderr);
 }

@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/time/clock.h"
 #include "core/synth/synth_scene.h"
 #include "server/capabilities.h"
 #include "server/clock.h"
@@ -176,7 +177,7 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
         });
   } else {
     {
-      absl::MutexLock lock(&server->mu_);
+      MutexLock lock(&server->mu_);
       server->warmed_up_ = true;
     }
     server->SetServing(true);
@@ -191,7 +192,7 @@ int FoveaServer::metrics_port() const {
 }
 
 bool FoveaServer::warmed_up() const {
-  absl::MutexLock lock(&mu_);
+  MutexLock lock(&mu_);
   return warmed_up_;
 }
 
@@ -222,7 +223,7 @@ void FoveaServer::WarmUp(const FrameLimits& limits,
         "warm-up Detect failed after ", absl::StrFormat("%.1f", ms),
         " ms (serving anyway): ", response.status().ToString()));
   }
-  absl::MutexLock lock(&mu_);
+  MutexLock lock(&mu_);
   warmed_up_ = true;
   if (!draining_) {
     SetServing(true);
@@ -231,7 +232,7 @@ void FoveaServer::WarmUp(const FrameLimits& limits,
 }
 
 void FoveaServer::Drain() {
-  absl::MutexLock lock(&mu_);
+  MutexLock lock(&mu_);
   if (draining_) return;
   draining_ = true;
   SetServing(false);
@@ -240,7 +241,7 @@ void FoveaServer::Drain() {
 
 void FoveaServer::Shutdown(absl::Duration grace) {
   {
-    absl::MutexLock lock(&mu_);
+    MutexLock lock(&mu_);
     if (shut_down_) return;
     shut_down_ = true;
   }

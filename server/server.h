@@ -10,8 +10,8 @@
 
 #include "absl/base/thread_annotations.h"
 #include "absl/status/statusor.h"
-#include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
+#include "core/base/mutex.h"
 #include "core/frame/frame_decode.h"
 #include "core/pipeline/models.h"
 #include "server/metrics.h"
@@ -116,7 +116,7 @@ class FoveaServer {
   std::unique_ptr<grpc::Server> server_;  // after service_: destroyed first
   std::thread warm_up_thread_;
 
-  mutable absl::Mutex mu_;
+  mutable Mutex mu_;
   bool warmed_up_ ABSL_GUARDED_BY(mu_) = false;
   bool draining_ ABSL_GUARDED_BY(mu_) = false;
   bool shut_down_ ABSL_GUARDED_BY(mu_) = false;

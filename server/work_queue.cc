@@ -39,7 +39,7 @@ WorkQueue::WorkQueue(int workers, int queue_capacity)
 WorkQueue::~WorkQueue() { Stop(); }
 
 bool WorkQueue::TrySubmit(absl::AnyInvocable<void() &&> job) {
-  absl::MutexLock lock(&mu_);
+  MutexLock lock(&mu_);
   if (stopping_) return false;
   // A job counts against the queue only if no worker is free to take it.
   const int in_system = running_ + static_cast<int>(jobs_.size());
@@ -49,9 +49,9 @@ bool WorkQueue::TrySubmit(absl::AnyInvocable<void() &&> job) {
 }
 
 void WorkQueue::Stop() {
-  absl::MutexLock stop_lock(&stop_mu_);
+  MutexLock stop_lock(&stop_mu_);
   {
-    absl::MutexLock lock(&mu_);
+    MutexLock lock(&mu_);
     stopping_ = true;
   }
   for (std::thread& thread : threads_) {
@@ -60,12 +60,12 @@ void WorkQueue::Stop() {
 }
 
 int WorkQueue::waiting() const {
-  absl::MutexLock lock(&mu_);
+  MutexLock lock(&mu_);
   return static_cast<int>(jobs_.size());
 }
 
 int WorkQueue::running() const {
-  absl::MutexLock lock(&mu_);
+  MutexLock lock(&mu_);
   return running_;
 }
 
@@ -73,16 +73,17 @@ void WorkQueue::WorkerLoop() {
   while (true) {
     absl::AnyInvocable<void() &&> job;
     {
-      absl::MutexLock lock(&mu_);
-      auto has_work_or_stop = [this]() { return !jobs_.empty() || stopping_; };
-      mu_.Await(absl::Condition(&has_work_or_stop));
+      MutexLock lock(&mu_);
+      mu_.Await([this]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {
+        return !jobs_.empty() || stopping_;
+      });
       if (jobs_.empty()) return;  // stopping and drained
       job = std::move(jobs_.front());
       jobs_.pop_front();
       ++running_;
     }
     RunGuarded(std::move(job));
-    absl::MutexLock lock(&mu_);
+    MutexLock lock(&mu_);
     --running_;
   }
 }

@@ -7,7 +7,7 @@
 
 #include "absl/base/thread_annotations.h"
 #include "absl/functional/any_invocable.h"
-#include "absl/synchronization/mutex.h"
+#include "core/base/mutex.h"
 
 namespace fovea::server {
 
@@ -62,9 +62,9 @@ class WorkQueue {
   // Held by Stop while it joins `threads_`, so concurrent Stops neither
   // join a thread twice nor return before the workers are gone. Taken
   // before mu_, never while holding it.
-  absl::Mutex stop_mu_;
+  Mutex stop_mu_;
 
-  mutable absl::Mutex mu_;
+  mutable Mutex mu_;
   std::deque<absl::AnyInvocable<void() &&>> jobs_ ABSL_GUARDED_BY(mu_);
   int running_ ABSL_GUARDED_BY(mu_) = 0;
   bool stopping_ ABSL_GUARDED_BY(mu_) = false;

@@ -14,9 +14,10 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
-#include "absl/synchronization/mutex.h"
+#include "absl/time/clock.h"
 #include "absl/time/time.h"
 #include "client/fovea_client.h"
+#include "core/base/mutex.h"
 #include "gtest/gtest.h"
 #include "server/server.h"
 #include "tests/server/server_fixture.h"
@@ -42,39 +43,40 @@ class Checkpoint {
  public:
   // The hook.
   void Pass() {
-    absl::MutexLock lock(&mu_);
+    MutexLock lock(&mu_);
     ++passed_;
     if (hold_from_ == 0 || passed_ < hold_from_) return;
     ++held_;
-    mu_.Await(absl::Condition(
-        +[](int* hold_from) { return *hold_from == 0; }, &hold_from_));
+    mu_.Await([this]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) {
+      return hold_from_ == 0;
+    });
   }
   // Holds every pass from now on.
   void Hold() {
-    absl::MutexLock lock(&mu_);
+    MutexLock lock(&mu_);
     hold_from_ = passed_ + 1;
   }
   // Holds the `n`-th pass from now (1-based) and every later one.
   void HoldFrom(int n) {
-    absl::MutexLock lock(&mu_);
+    MutexLock lock(&mu_);
     hold_from_ = passed_ + n;
   }
   void Release() {
-    absl::MutexLock lock(&mu_);
+    MutexLock lock(&mu_);
     hold_from_ = 0;
   }
   int passed() const {
-    absl::MutexLock lock(&mu_);
+    MutexLock lock(&mu_);
     return passed_;
   }
   // Passes that were held, released or not.
   int held() const {
-    absl::MutexLock lock(&mu_);
+    MutexLock lock(&mu_);
     return held_;
   }
 
  private:
-  mutable absl::Mutex mu_;
+  mutable Mutex mu_;
   int hold_from_ ABSL_GUARDED_BY(mu_) = 0;  // 0: not holding
   int passed_ ABSL_GUARDED_BY(mu_) = 0;
   int held_ ABSL_GUARDED_BY(mu_) = 0;
@@ -109,7 +111,7 @@ class Load {
         while (!stop_.load()) {
           const int started = phase_.load();
           absl::Status status = call();
-          absl::MutexLock lock(&mu_);
+          MutexLock lock(&mu_);
           calls_.push_back({std::move(status), started, phase_.load()});
           if (started == phase_.load()) ++done_[t];
         }
@@ -120,14 +122,14 @@ class Load {
 
   // Starts the next phase (the first is 0).
   void NextPhase() {
-    absl::MutexLock lock(&mu_);
+    MutexLock lock(&mu_);
     phase_.fetch_add(1);
     std::fill(done_.begin(), done_.end(), 0);
   }
   // True when every thread finished at least `n` calls it started in the
   // current phase (so none is stuck in an older call).
   bool EachThreadDid(int n) const {
-    absl::MutexLock lock(&mu_);
+    MutexLock lock(&mu_);
     for (int done : done_) {
       if (done < n) return false;
     }
@@ -140,14 +142,14 @@ class Load {
     }
   }
   std::vector<Call> calls() const {
-    absl::MutexLock lock(&mu_);
+    MutexLock lock(&mu_);
     return calls_;
   }
 
  private:
   std::atomic<bool> stop_{false};
   std::atomic<int> phase_{0};
-  mutable absl::Mutex mu_;
+  mutable Mutex mu_;
   std::vector<Call> calls_ ABSL_GUARDED_BY(mu_);
   std::vector<int> done_ ABSL_GUARDED_BY(mu_);  // per thread, this phase
   std::vector<std::thread> threads_;
@@ -177,31 +179,31 @@ class StreamCall {
           absl::Status status =
               client.Segment(request, kCallDeadline,
                              [this](const fovea::v1::SegmentResponse& message) {
-                               absl::MutexLock lock(&mu_);
+                               MutexLock lock(&mu_);
                                messages_.push_back(message);
                              });
-          absl::MutexLock lock(&mu_);
+          MutexLock lock(&mu_);
           status_ = std::move(status);
           done_ = true;
         }) {}
   ~StreamCall() { thread_.join(); }
 
   bool done() const {
-    absl::MutexLock lock(&mu_);
+    MutexLock lock(&mu_);
     return done_;
   }
   // The stream's final status, once done.
   absl::Status status() const {
-    absl::MutexLock lock(&mu_);
+    MutexLock lock(&mu_);
     return status_;
   }
   std::vector<fovea::v1::SegmentResponse> messages() const {
-    absl::MutexLock lock(&mu_);
+    MutexLock lock(&mu_);
     return messages_;
   }
 
  private:
-  mutable absl::Mutex mu_;
+  mutable Mutex mu_;
   std::vector<fovea::v1::SegmentResponse> messages_ ABSL_GUARDED_BY(mu_);
   absl::Status status_ ABSL_GUARDED_BY(mu_);
   bool done_ ABSL_GUARDED_BY(mu_) = false;

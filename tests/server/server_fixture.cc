@@ -8,32 +8,32 @@
 namespace fovea::server::testing {
 
 void Gate::Close() {
-  absl::MutexLock lock(&mu_);
+  MutexLock lock(&mu_);
   open_ = false;
 }
 
 void Gate::CloseAtPass(int n) {
-  absl::MutexLock lock(&mu_);
+  MutexLock lock(&mu_);
   close_at_ = n;
   if (entered_ >= n) open_ = false;
 }
 
 void Gate::Open() {
-  absl::MutexLock lock(&mu_);
+  MutexLock lock(&mu_);
   open_ = true;
   close_at_ = 0;
 }
 
 int Gate::entered() const {
-  absl::MutexLock lock(&mu_);
+  MutexLock lock(&mu_);
   return entered_;
 }
 
 void Gate::Pass() {
-  absl::MutexLock lock(&mu_);
+  MutexLock lock(&mu_);
   ++entered_;
   if (entered_ == close_at_) open_ = false;
-  mu_.Await(absl::Condition(&open_));
+  mu_.Await([this]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) { return open_; });
 }
 
 void ServerTest::StartServer(ServerConfig config, bool wait_serving) {

@@ -9,7 +9,7 @@
 #include <memory>
 #include <string>
 
-#include "absl/synchronization/mutex.h"
+#include "core/base/mutex.h"
 #include "fovea/v1/perception.grpc.pb.h"
 #include "gtest/gtest.h"
 #include "server/server.h"
@@ -37,7 +37,7 @@ class Gate {
   void Pass();
 
  private:
-  mutable absl::Mutex mu_;
+  mutable Mutex mu_;
   bool open_ ABSL_GUARDED_BY(mu_) = true;
   int close_at_ ABSL_GUARDED_BY(mu_) = 0;  // 0: never
   int entered_ ABSL_GUARDED_BY(mu_) = 0;

@@ -9,7 +9,7 @@
 
 #include <string>
 
-#include "absl/synchronization/notification.h"
+#include "core/base/mutex.h"
 #include "core/pipeline/detect.h"
 #include "gtest/gtest.h"
 #include "server/server.h"
@@ -33,7 +33,7 @@ class StartupTest : public ServerTest {
     ServerTest::TearDown();
   }
 
-  absl::Notification release_warm_up_;
+  Notification release_warm_up_;
 };
 
 TEST_F(StartupTest, HealthIsNotServingUntilTheWarmUpCompletes) {

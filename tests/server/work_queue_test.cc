@@ -9,9 +9,9 @@
 #include <thread>
 #include <vector>
 
-#include "absl/synchronization/mutex.h"
-#include "absl/synchronization/notification.h"
+#include "absl/time/clock.h"
 #include "absl/time/time.h"
+#include "core/base/mutex.h"
 #include "gtest/gtest.h"
 
 namespace fovea::server {
@@ -32,7 +32,7 @@ bool Eventually(Condition condition) {
 
 // Submits a job that waits for `release`, then counts itself in `ran`,
 // and waits until a worker runs it. False when refused or never started.
-bool SubmitHeldJob(WorkQueue& queue, absl::Notification& release,
+bool SubmitHeldJob(WorkQueue& queue, Notification& release,
                    std::atomic<int>& ran) {
   const int running = queue.running();
   return queue.TrySubmit([&release, &ran] {
@@ -55,7 +55,7 @@ TEST(WorkQueueTest, RunsEveryAcceptedJob) {
 
 TEST(WorkQueueTest, RefusesBeyondWorkersPlusQueue) {
   WorkQueue queue(1, 1);
-  absl::Notification release;
+  Notification release;
   std::atomic<int> ran{0};
   ASSERT_TRUE(SubmitHeldJob(queue, release, ran));
   EXPECT_TRUE(queue.TrySubmit([&] { ran.fetch_add(1); }));
@@ -68,7 +68,7 @@ TEST(WorkQueueTest, RefusesBeyondWorkersPlusQueue) {
 
 TEST(WorkQueueTest, ZeroQueueStillFeedsAnIdleWorker) {
   WorkQueue queue(1, 0);
-  absl::Notification release;
+  Notification release;
   ASSERT_TRUE(queue.TrySubmit([&] { release.WaitForNotification(); }));
   ASSERT_TRUE(Eventually([&] { return queue.running() == 1; }));
   EXPECT_FALSE(queue.TrySubmit([] {}));
@@ -80,18 +80,18 @@ TEST(WorkQueueTest, ZeroQueueStillFeedsAnIdleWorker) {
 TEST(WorkQueueTest, NeverRunsMoreThanWorkersAtOnce) {
   constexpr int kWorkers = 2;
   WorkQueue queue(kWorkers, 100);
-  absl::Mutex mu;
+  Mutex mu;
   int now = 0;
   int most = 0;
-  absl::Notification release;
+  Notification release;
   for (int i = 0; i < 20; ++i) {
     ASSERT_TRUE(queue.TrySubmit([&] {
       {
-        absl::MutexLock lock(&mu);
+        MutexLock lock(&mu);
         most = std::max(most, ++now);
       }
       release.WaitForNotification();
-      absl::MutexLock lock(&mu);
+      MutexLock lock(&mu);
       --now;
     }));
   }
@@ -106,7 +106,7 @@ TEST(WorkQueueTest, NeverRunsMoreThanWorkersAtOnce) {
 TEST(WorkQueueTest, StopRunsQueuedJobsAndRefusesNewOnes) {
   std::atomic<int> ran{0};
   WorkQueue queue(1, 5);
-  absl::Notification release;
+  Notification release;
   ASSERT_TRUE(SubmitHeldJob(queue, release, ran));
   for (int i = 0; i < 5; ++i) {
     ASSERT_TRUE(queue.TrySubmit([&] { ran.fetch_add(1); }));
@@ -135,7 +135,7 @@ TEST(WorkQueueTest, JobThatThrowsDoesNotStopItsWorker) {
 TEST(WorkQueueTest, ConcurrentStopsJoinOnceAndReturnAfterTheJobs) {
   constexpr int kStoppers = 4;
   WorkQueue queue(2, 2);
-  absl::Notification release;
+  Notification release;
   std::atomic<int> ran{0};
   ASSERT_TRUE(SubmitHeldJob(queue, release, ran));
   // Every stopper reaches the joins while the job is held.
