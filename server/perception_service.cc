@@ -15,6 +15,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/base/strings.h"
+#include "core/base/tsan.h"
 #include "server/capabilities.h"
 #include "server/clock.h"
 #include "server/convert.h"
@@ -105,6 +106,7 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
     }
     options_ = *std::move(options);
     submitted_ = Clock::now();
+    // The worker sees all of this through the queue's lock.
     if (!work.TrySubmit([this] { Run(); })) {
       Complete(absl::ResourceExhaustedError(
           absl::StrCat("server busy: ", work.workers(), " frames in work and ",
@@ -112,7 +114,15 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
     }
   }
 
-  void OnDone() override { delete this; }
+  // gRPC calls OnDone after Finish, on any of its threads; the request and
+  // response it owns are deleted right after. (The Tsan* calls tell
+  // ThreadSanitizer about that ordering, which libgrpc makes where TSan
+  // cannot see it; they are empty in other builds.)
+  void OnDone() override {
+    TsanHappensAfter(this);
+    TsanHappensBefore(&config_);  // before the service's destruction
+    delete this;
+  }
 
  private:
   // On a worker thread. Completes the call exactly once, whatever
@@ -160,7 +170,11 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
   }
 
   // The last thing the reactor does: OnDone may delete it right after.
-  void Complete(const absl::Status& status) { Finish(call_.EndUnary(status)); }
+  void Complete(const absl::Status& status) {
+    const grpc::Status end = call_.EndUnary(status);
+    TsanHappensBefore(this);  // before OnDone
+    Finish(end);
+  }
 
   const ServiceConfig& config_;  // the service's; outlives every call
   // gRPC's, valid until OnDone.
@@ -205,6 +219,7 @@ class StreamReactor final
       return;
     }
     options_ = *std::move(options);
+    TsanHappensBefore(this);  // before the reactions (OnCancel, ...)
     if (!work.TrySubmit([this] { Run(); })) {
       FinishOnce(absl::ResourceExhaustedError(
           absl::StrCat("server busy: ", work.workers(), " frames in work and ",
@@ -212,7 +227,11 @@ class StreamReactor final
     }
   }
 
+  // Each reaction starts with TsanHappensAfter(this) and ends with
+  // TsanHappensBefore: gRPC runs them one after another, and after the
+  // constructor, on any of its threads (see DetectReactor::OnDone).
   void OnWriteDone(bool ok) override {
+    TsanHappensAfter(this);
     std::optional<absl::Status> finish;
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -231,19 +250,31 @@ class StreamReactor final
       }
     }
     changed_.notify_all();
-    if (finish) Finish(call_.EndStream(*finish));
+    if (finish) {
+      const grpc::Status end = call_.EndStream(*finish);
+      TsanHappensBefore(this);
+      Finish(end);
+    } else {
+      TsanHappensBefore(this);
+    }
   }
 
   void OnCancel() override {
+    TsanHappensAfter(this);
     {
       std::lock_guard<std::mutex> lock(mutex_);
       broken_ = true;
     }
     changed_.notify_all();
     if (config_.on_stream_cancelled) config_.on_stream_cancelled();
+    TsanHappensBefore(this);
   }
 
-  void OnDone() override { delete this; }
+  void OnDone() override {
+    TsanHappensAfter(this);
+    TsanHappensBefore(&config_);  // before the service's destruction
+    delete this;
+  }
 
  private:
   // At most this many messages wait unwritten before the worker blocks.
@@ -320,7 +351,11 @@ class StreamReactor final
         finish = EndStatusLocked(status);
       }
     }
-    if (finish) Finish(call_.EndStream(*finish));
+    if (finish) {
+      const grpc::Status end = call_.EndStream(*finish);
+      TsanHappensBefore(this);
+      Finish(end);
+    }
   }
 
   // Why the stream broke (the client cancelled, went away or stopped
@@ -364,16 +399,27 @@ PerceptionService::PerceptionService(ServiceConfig config, WorkQueue* work)
     : config_(std::move(config)),
       work_(work),
       capabilities_(BuildCapabilities(config_.limits, config_.max_message_bytes,
-                                      config_.model_versions)) {}
+                                      config_.model_versions)) {
+  // gRPC's threads call the methods below; what was built here (and the
+  // work queue before it) happens before, through libgrpc (see
+  // DetectReactor::OnDone).
+  TsanHappensBefore(&config_);
+}
+
+PerceptionService::~PerceptionService() {
+  TsanHappensAfter(&config_);  // after every call's OnDone
+}
 
 grpc::ServerUnaryReactor* PerceptionService::Detect(
     grpc::CallbackServerContext* context, const v1::DetectRequest* request,
     v1::DetectResponse* response) {
+  TsanHappensAfter(&config_);
   return new DetectReactor(config_, *work_, context, request, response);
 }
 
 grpc::ServerWriteReactor<v1::SegmentResponse>* PerceptionService::Segment(
     grpc::CallbackServerContext* context, const v1::SegmentRequest* request) {
+  TsanHappensAfter(&config_);
   return new StreamReactor<v1::SegmentRequest, SegmentOptions>(
       "Segment", &ToSegmentOptions, &HandleSegment, config_, *work_, context,
       request);
@@ -383,6 +429,7 @@ grpc::ServerWriteReactor<v1::SegmentResponse>*
 PerceptionService::SegmentIncremental(
     grpc::CallbackServerContext* context,
     const v1::SegmentIncrementalRequest* request) {
+  TsanHappensAfter(&config_);
   return new StreamReactor<v1::SegmentIncrementalRequest, IncrementalOptions>(
       "SegmentIncremental", &ToIncrementalOptions, &HandleSegmentIncremental,
       config_, *work_, context, request);
@@ -391,6 +438,7 @@ PerceptionService::SegmentIncremental(
 grpc::ServerUnaryReactor* PerceptionService::GetCapabilities(
     grpc::CallbackServerContext* context,
     const v1::GetCapabilitiesRequest* request, v1::Capabilities* response) {
+  TsanHappensAfter(&config_);
   CallRecord call("GetCapabilities", "");
   *response = capabilities_;
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();

@@ -70,6 +70,7 @@ class PerceptionService final : public v1::Perception::CallbackService {
   // `work` is not owned; it must outlive every call the service starts
   // (the server stops it only after grpc::Server::Shutdown returned).
   PerceptionService(ServiceConfig config, WorkQueue* work);
+  ~PerceptionService() override;
 
   grpc::ServerUnaryReactor* Detect(grpc::CallbackServerContext* context,
                                    const v1::DetectRequest* request,
