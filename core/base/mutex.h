@@ -49,10 +49,15 @@ class ABSL_LOCKABLE Mutex {
     lock.release();
   }
 
-  // Await for at most `timeout`; returns `done()` at the end.
+  // Await for at most `timeout` (absl::InfiniteDuration() waits as Await
+  // does); returns `done()` at the end.
   template <typename Predicate>
   bool AwaitWithTimeout(Predicate done, absl::Duration timeout)
       ABSL_EXCLUSIVE_LOCKS_REQUIRED(this) {
+    if (timeout == absl::InfiniteDuration()) {
+      Await(done);
+      return true;
+    }
     std::unique_lock<std::mutex> lock(mutex_, std::adopt_lock);
     ++waiters_;
     const bool result = changed_.wait_for(

@@ -59,6 +59,8 @@ TEST(MutexTest, AwaitWithTimeoutGivesUpAndReportsThePredicate) {
   EXPECT_FALSE(
       mu.AwaitWithTimeout([] { return false; }, absl::Milliseconds(5)));
   EXPECT_TRUE(mu.AwaitWithTimeout([] { return true; }, absl::Hours(1)));
+  EXPECT_TRUE(
+      mu.AwaitWithTimeout([] { return true; }, absl::InfiniteDuration()));
 }
 
 TEST(NotificationTest, WaitReturnsAfterNotifyFromAnotherThread) {
