@@ -250,13 +250,10 @@ class StreamReactor final
       }
     }
     changed_.notify_all();
-    if (finish) {
-      const grpc::Status end = call_.EndStream(*finish);
-      TsanHappensBefore(this);
-      Finish(end);
-    } else {
-      TsanHappensBefore(this);
-    }
+    std::optional<grpc::Status> end;
+    if (finish) end = call_.EndStream(*finish);
+    TsanHappensBefore(this);
+    if (end) Finish(*end);
   }
 
   void OnCancel() override {
