@@ -250,10 +250,11 @@ class StreamReactor final
       }
     }
     changed_.notify_all();
-    std::optional<grpc::Status> end;
-    if (finish) end = call_.EndStream(*finish);
-    TsanHappensBefore(this);
-    if (end) Finish(*end);
+    if (finish) {
+      EndCall(*finish);
+    } else {
+      TsanHappensBefore(this);
+    }
   }
 
   void OnCancel() override {
@@ -348,11 +349,15 @@ class StreamReactor final
         finish = EndStatusLocked(status);
       }
     }
-    if (finish) {
-      const grpc::Status end = call_.EndStream(*finish);
-      TsanHappensBefore(this);
-      Finish(end);
-    }
+    if (finish) EndCall(*finish);
+  }
+
+  // Records the call's end and finishes it: the reactor's last touch, as
+  // OnDone may delete it right after.
+  void EndCall(const absl::Status& status) {
+    const grpc::Status end = call_.EndStream(status);
+    TsanHappensBefore(this);
+    Finish(end);
   }
 
   // Why the stream broke (the client cancelled, went away or stopped
