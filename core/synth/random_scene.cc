@@ -72,8 +72,10 @@ constexpr float kOcclusionLateralShare = 0.6f;  // of the target's radius
 // Footprint corners must project this far inside the image, pixels.
 constexpr float kViewMarginPx = 8.0f;
 constexpr int kAttemptsPerObject = 40;
-// Minimum pixels of every object on the half-resolution visibility render.
+// Minimum pixels of every object on the half-resolution visibility render,
+// which is at most this wide.
 constexpr int kMinVisiblePixelsHalfRes = 40;
+constexpr int kVisibilityCastWidth = 320;
 
 // Object colours: HSV ranges; dark objects have value below kDarkValueMax.
 constexpr float kSaturationMin = 0.35f;
@@ -395,21 +397,29 @@ bool Admissible(const Candidate& c, const std::vector<Placed>& placed,
   return true;
 }
 
-// Pixels of each object in a half-resolution ray cast of `spec`.
+// Pixels of each object in a reduced ray cast of `spec`: half of a
+// 640-pixel-wide frame, so at most kVisibilityCastWidth columns whatever
+// the frame's resolution (the room around the table is left out: it never
+// stands between the camera and the table's objects).
 std::vector<int> HalfResolutionPixelCounts(SceneSpec spec) {
-  spec.width /= 2;
-  spec.height /= 2;
+  const double scale =
+      std::min(0.5, static_cast<double>(kVisibilityCastWidth) / spec.width);
+  spec.width = std::max(1, static_cast<int>(spec.width * scale));
+  spec.height = std::max(1, static_cast<int>(spec.height * scale));
+  spec.background.clear();
   Intrinsics& k = spec.intrinsics;
-  k.fx /= 2.0;
-  k.fy /= 2.0;
-  k.cx = (k.cx + 0.5) / 2.0 - 0.5;
-  k.cy = (k.cy + 0.5) / 2.0 - 0.5;
+  k.fx *= scale;
+  k.fy *= scale;
+  k.cx = (k.cx + 0.5) * scale - 0.5;
+  k.cy = (k.cy + 0.5) * scale - 0.5;
   const RaycastImage ray = RaycastScene(spec);
   std::vector<int> counts(spec.objects.size(), 0);
   for (int v = 0; v < ray.hit.rows; ++v) {
     const int* row = ray.hit.ptr<int>(v);
     for (int u = 0; u < ray.hit.cols; ++u) {
-      if (row[u] > 0) ++counts[row[u] - 1];
+      if (row[u] > 0 && row[u] <= static_cast<int>(counts.size())) {
+        ++counts[row[u] - 1];
+      }
     }
   }
   return counts;
@@ -518,17 +528,11 @@ Eigen::Isometry3f LookAt(const Vector3f& eye, const Vector3f& target) {
   return pose;
 }
 
-SceneSpec RandomSceneSpec(uint64_t seed, const RandomSceneOptions& options) {
-  FOVEA_CHECK(Validate(options).ok());
-  Random rng(seed);
-  SceneSpec spec;
-  const float j = options.camera_jitter;
-  const Vector3f eye(rng.Uniform(-j, j),
-                     -options.camera_distance + rng.Uniform(-j, j),
-                     options.camera_height + rng.Uniform(-j, j));
-  const Vector3f target(rng.Uniform(-j, j), rng.Uniform(-j, j), 0.0f);
-  spec.camera_pose = LookAt(eye, target);
+namespace {
 
+// The objects of RandomSceneSpec / PlaceRandomObjects, from `rng`.
+void PlaceObjects(const RandomSceneOptions& options, const Vector2f& target,
+                  Random& rng, SceneSpec& spec) {
   const int wanted = rng.UniformInt(options.min_objects, options.max_objects);
   std::vector<Placed> placed;
   std::vector<int> alone;  // half-resolution pixels of each object alone
@@ -546,7 +550,29 @@ SceneSpec RandomSceneSpec(uint64_t seed, const RandomSceneOptions& options) {
     placed.push_back(c->placed);
   }
   for (const Placed& p : placed) spec.objects.push_back(p.primitive);
+}
+
+}  // namespace
+
+SceneSpec RandomSceneSpec(uint64_t seed, const RandomSceneOptions& options) {
+  FOVEA_CHECK(Validate(options).ok());
+  Random rng(seed);
+  SceneSpec spec;
+  const float j = options.camera_jitter;
+  const Vector3f eye(rng.Uniform(-j, j),
+                     -options.camera_distance + rng.Uniform(-j, j),
+                     options.camera_height + rng.Uniform(-j, j));
+  const Vector3f target(rng.Uniform(-j, j), rng.Uniform(-j, j), 0.0f);
+  spec.camera_pose = LookAt(eye, target);
+  PlaceObjects(options, target.head<2>(), rng, spec);
   return spec;
+}
+
+void PlaceRandomObjects(uint64_t seed, const RandomSceneOptions& options,
+                        const Eigen::Vector2f& target, SceneSpec& spec) {
+  FOVEA_CHECK(Validate(options).ok());
+  Random rng(seed);
+  PlaceObjects(options, target, rng, spec);
 }
 
 }  // namespace fovea::synth

@@ -248,9 +248,19 @@ RaycastImage RaycastScene(const SceneSpec& spec) {
   const Eigen::Matrix3f cam_to_world = spec.camera_pose.linear();
   const Vector3f eye = spec.camera_pose.translation();
 
+  // Objects first, then the background parts: hit index k + 1 is
+  // prepared[k].
+  std::vector<const Primitive*> primitives;
+  primitives.reserve(spec.objects.size() + spec.background.size());
+  for (const Primitive& primitive : spec.objects)
+    primitives.push_back(&primitive);
+  for (const BackgroundPart& part : spec.background) {
+    primitives.push_back(&part.primitive);
+  }
   std::vector<PreparedPrimitive> prepared;
-  prepared.reserve(spec.objects.size());
-  for (const Primitive& primitive : spec.objects) {
+  prepared.reserve(primitives.size());
+  for (const Primitive* primitive_ptr : primitives) {
+    const Primitive& primitive = *primitive_ptr;
     PreparedPrimitive p;
     p.primitive = &primitive;
     p.world_to_local = primitive.pose.linear().transpose();

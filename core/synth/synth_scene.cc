@@ -88,12 +88,108 @@ cv::Mat EdgeDropoutMask(const cv::Mat& depth, const NoiseOptions& noise) {
   return band & (DepthBehindNearest(depth, k) > noise.edge_jump_m);
 }
 
+// CV_8UC1, 255 where the second viewpoint (noise.shadow_baseline_m to the
+// camera's right) does not see the surface: a pixel at column u and depth z
+// lands at u - f b / z there, and is hidden when a pixel to its right lands
+// at or left of it (the two crossed, the nearer one in front); with
+// border_band also where it lands left of the image.
+cv::Mat ShadowMask(const cv::Mat& depth, float focal_px,
+                   const NoiseOptions& noise) {
+  cv::Mat shadow(depth.size(), CV_8UC1, cv::Scalar(0));
+  if (!(noise.shadow_baseline_m > 0.0f)) return shadow;
+  const float fb = focal_px * noise.shadow_baseline_m;
+  for (int v = 0; v < depth.rows; ++v) {
+    const float* z = depth.ptr<float>(v);
+    uint8_t* out = shadow.ptr<uint8_t>(v);
+    float nearest_landing = std::numeric_limits<float>::infinity();
+    for (int u = depth.cols - 1; u >= 0; --u) {
+      if (std::isnan(z[u])) continue;
+      const float landing = static_cast<float>(u) - fb / z[u];
+      if (landing >= nearest_landing || (noise.border_band && landing < 0.0f)) {
+        out[u] = 255;
+      }
+      nearest_landing = std::min(nearest_landing, landing);
+    }
+  }
+  return shadow;
+}
+
+// Standard normal noise per pixel, smoothed over `correlation_px` (Gaussian
+// sigma) and rescaled to unit variance.
+cv::Mat CorrelatedNormalField(cv::Size size, float correlation_px,
+                              Random& rng) {
+  cv::Mat field(size, CV_32FC1);
+  for (int v = 0; v < size.height; ++v) {
+    float* row = field.ptr<float>(v);
+    for (int u = 0; u < size.width; ++u) row[u] = rng.ApproxNormal();
+  }
+  cv::GaussianBlur(field, field, cv::Size(), correlation_px, correlation_px,
+                   cv::BORDER_REFLECT);
+  cv::Scalar mean, stddev;
+  cv::meanStdDev(field, mean, stddev);
+  if (stddev[0] > 0.0) field = (field - mean[0]) / stddev[0];
+  return field;
+}
+
+// Hash of an integer cell to [0, 1).
+float CellHash(int x, int y, int z) {
+  uint64_t h = static_cast<uint64_t>(static_cast<uint32_t>(x)) * 0x9e3779b1ULL ^
+               static_cast<uint64_t>(static_cast<uint32_t>(y)) * 0x85ebca77ULL ^
+               static_cast<uint64_t>(static_cast<uint32_t>(z)) * 0xc2b2ae3dULL;
+  h ^= h >> 29;
+  h *= 0xbf58476d1ce4e5b9ULL;
+  h ^= h >> 32;
+  return static_cast<float>(h & 0xffffff) / 16777216.0f;
+}
+
+// Trilinear value noise of cells `cell` metres wide, [0, 1).
+float ValueNoise(const Eigen::Vector3f& p, float cell) {
+  const Eigen::Vector3f q = p / cell;
+  const int x = static_cast<int>(std::floor(q.x()));
+  const int y = static_cast<int>(std::floor(q.y()));
+  const int z = static_cast<int>(std::floor(q.z()));
+  const float fx = q.x() - x, fy = q.y() - y, fz = q.z() - z;
+  float value = 0.0f;
+  for (int i = 0; i < 8; ++i) {
+    const int dx = i & 1, dy = (i >> 1) & 1, dz = i >> 2;
+    const float w =
+        (dx ? fx : 1.0f - fx) * (dy ? fy : 1.0f - fy) * (dz ? fz : 1.0f - fz);
+    value += w * CellHash(x + dx, y + dy, z + dz);
+  }
+  return value;
+}
+
+// The factor a texture multiplies the albedo by at world point p.
+float TextureFactor(Texture texture, const Eigen::Vector3f& p) {
+  constexpr float kTwoPi = 6.2831853f;
+  switch (texture) {
+    case Texture::kFlat:
+      return 1.0f;
+    case Texture::kWood: {
+      // Grain along world x: stripes across y whose phase wanders slowly.
+      const float wander = 3.0f * ValueNoise(p, 0.15f);
+      const float grain =
+          0.5f + 0.5f * std::sin(kTwoPi * (p.y() / 0.013f + wander));
+      return 0.88f + 0.12f * grain + 0.08f * (ValueNoise(p, 0.03f) - 0.5f);
+    }
+    case Texture::kCarpet:
+      return 0.75f +
+             0.5f * CellHash(static_cast<int>(std::floor(p.x() / 0.004f)),
+                             static_cast<int>(std::floor(p.y() / 0.004f)),
+                             static_cast<int>(std::floor(p.z() / 0.004f)));
+    case Texture::kPaint:
+      return 0.95f + 0.1f * ValueNoise(p, 0.2f);
+  }
+  return 1.0f;
+}
+
 // Axial noise and disparity quantisation of one depth, or NaN when the
-// quantised disparity is not positive (out of range).
+// quantised disparity is not positive (out of range). `normal` is a
+// standard normal draw.
 float NoisyDepth(float z, float focal_px, const NoiseOptions& noise,
-                 Random& rng) {
-  const float sigma = noise.sigma_per_z2 * z * z;
-  const float noisy = z + sigma * static_cast<float>(rng.Normal());
+                 float normal) {
+  const float sigma = noise.sigma0_m + noise.sigma_per_z2 * z * z;
+  const float noisy = z + sigma * normal;
   const float fb = focal_px * noise.baseline_m;  // disparity = fb / z
   const float disparity = std::round(fb / noisy / noise.disparity_step_px) *
                           noise.disparity_step_px;
@@ -177,7 +273,35 @@ absl::Status Validate(const NoiseOptions& options) {
   if (!(options.color_sigma >= 0.0f)) {
     return absl::InvalidArgumentError("NoiseOptions.color_sigma must be >= 0");
   }
+  if (!(options.sigma0_m >= 0.0f) || !(options.noise_correlation_px >= 0.0f) ||
+      !(options.shadow_baseline_m >= 0.0f)) {
+    return absl::InvalidArgumentError(
+        "NoiseOptions.sigma0_m, noise_correlation_px and shadow_baseline_m "
+        "must be >= 0");
+  }
   return absl::OkStatus();
+}
+
+NoiseOptions KinectV1Noise() {
+  NoiseOptions noise;
+  noise.shadow_baseline_m = 0.075f;
+  return noise;
+}
+
+NoiseOptions ActiveStereoNoise() {
+  NoiseOptions noise;
+  noise.sigma0_m = 0.001f;
+  noise.sigma_per_z2 = 2.5e-3f;
+  noise.noise_correlation_px = 1.5f;
+  noise.baseline_m = 0.05f;
+  noise.disparity_step_px = 0.05f;
+  noise.edge_dropout_px = 1;
+  noise.shadow_baseline_m = 0.05f;
+  noise.border_band = true;
+  noise.dark_albedo = 0.15f;
+  noise.dark_dropout_probability = 0.7f;
+  noise.color_sigma = 2.5f;
+  return noise;
 }
 
 SynthScene RenderScene(const SceneSpec& spec, const NoiseOptions& noise,
@@ -187,17 +311,40 @@ SynthScene RenderScene(const SceneSpec& spec, const NoiseOptions& noise,
   RaycastImage ray = RaycastScene(spec);
   Random rng(seed ^ kNoiseStream);
   const bool noisy = noise.enabled;
-  const cv::Mat edge_dropout =
-      noisy ? EdgeDropoutMask(ray.depth, noise) : cv::Mat();
   const float focal = static_cast<float>(spec.intrinsics.fx);
+  cv::Mat edge_dropout;
+  if (noisy) {
+    edge_dropout =
+        EdgeDropoutMask(ray.depth, noise) | ShadowMask(ray.depth, focal, noise);
+  }
+  const cv::Mat depth_noise =
+      noisy && noise.noise_correlation_px > 0.0f
+          ? CorrelatedNormalField(ray.depth.size(), noise.noise_correlation_px,
+                                  rng)
+          : cv::Mat();
 
-  // Albedo, label and darkness of each hit index (0 table, k + 1 object).
+  // Albedo, texture, label and darkness of each hit index (0 table, k + 1
+  // object, then the background parts).
   std::vector<Eigen::Vector3f> albedo = {spec.table_rgb};
+  std::vector<Texture> texture = {spec.table_texture};
   std::vector<int> label = {kTableLabel};
   for (size_t k = 0; k < spec.objects.size(); ++k) {
     albedo.push_back(spec.objects[k].rgb);
+    texture.push_back(spec.objects[k].texture);
     label.push_back(ObjectLabel(static_cast<int>(k)));
   }
+  for (const BackgroundPart& part : spec.background) {
+    albedo.push_back(part.primitive.rgb);
+    texture.push_back(part.primitive.texture);
+    label.push_back(part.label);
+  }
+  const int object_hits = static_cast<int>(spec.objects.size());
+  const Eigen::Matrix3f cam_to_world = spec.camera_pose.linear();
+  const Eigen::Vector3f eye = spec.camera_pose.translation();
+  const float fx = static_cast<float>(spec.intrinsics.fx);
+  const float fy = static_cast<float>(spec.intrinsics.fy);
+  const float cx = static_cast<float>(spec.intrinsics.cx);
+  const float cy = static_cast<float>(spec.intrinsics.cy);
   std::vector<bool> dark;
   for (const Eigen::Vector3f& rgb : albedo) {
     dark.push_back(Luminance(rgb) < noise.dark_albedo);
@@ -225,17 +372,31 @@ SynthScene RenderScene(const SceneSpec& spec, const NoiseOptions& noise,
         const float lambert = std::max(0.0f, n[0] * kLightDirection.x() +
                                                  n[1] * kLightDirection.y() +
                                                  n[2] * kLightDirection.z());
-        rgb = albedo[hit] * (kAmbient + kDiffuse * lambert);
+        float shade = kAmbient + kDiffuse * lambert;
+        if (texture[hit] != Texture::kFlat) {
+          const float z = depth_row[u];
+          const Eigen::Vector3f world =
+              eye + cam_to_world * Eigen::Vector3f((u - cx) / fx * z,
+                                                   (v - cy) / fy * z, z);
+          shade *= TextureFactor(texture[hit], world);
+        }
+        rgb = (albedo[hit] * shade).cwiseMin(1.0f);
         if (noisy) {
           const bool dropped =
               edge_dropout.at<uint8_t>(v, u) != 0 ||
               (dark[hit] && rng.Bernoulli(noise.dark_dropout_probability));
-          depth_row[u] =
-              dropped ? nan : NoisyDepth(depth_row[u], focal, noise, rng);
+          if (dropped) {
+            depth_row[u] = nan;
+          } else {
+            const float normal = depth_noise.empty()
+                                     ? static_cast<float>(rng.Normal())
+                                     : depth_noise.at<float>(v, u);
+            depth_row[u] = NoisyDepth(depth_row[u], focal, noise, normal);
+          }
         }
         if (!std::isnan(depth_row[u])) {
           label_row[u] = label[hit];
-          if (hit > 0) ++visible[hit - 1];
+          if (hit > 0 && hit <= object_hits) ++visible[hit - 1];
         }
       }
       for (int c = 0; c < 3; ++c) {

@@ -23,6 +23,16 @@ namespace fovea::synth {
 
 enum class Shape { kBox, kCylinder, kSphere, kCone };
 
+// Procedural surface textures, in world coordinates (metres), modulating
+// the albedo: what makes a floor, a table top or a wall look like one to
+// colour operators instead of a flat fill.
+enum class Texture {
+  kFlat,    // the albedo as is
+  kWood,    // grain: stripes along world x, +-12 % brightness, 4-9 mm period
+  kCarpet,  // fine speckle, +-25 % brightness per 4 mm cell
+  kPaint,   // slow blotches, +-5 % over 20 cm (walls, furniture)
+};
+
 struct Primitive {
   Shape shape = Shape::kBox;
   // Pose of the primitive's local frame in the world. Local frames:
@@ -36,13 +46,34 @@ struct Primitive {
   Eigen::Vector3f half_extents = Eigen::Vector3f::Constant(0.05f);
   float radius = 0.05f;
   Eigen::Vector3f rgb = {0.8f, 0.2f, 0.2f};  // albedo, [0, 1]
+  Texture texture = Texture::kFlat;
+};
+
+// Labels of what is not an object on the support table (OSD keeps 1-9
+// for the table; rooms use the same range so that ObjectId is 0 for all).
+inline constexpr int kSupportTableLabel = 1;  // top and edge of the support
+inline constexpr int kFloorLabel = 2;
+inline constexpr int kWallLabel = 3;
+inline constexpr int kFurnitureLabel = 4;    // legs, chairs, cabinets
+inline constexpr int kOtherTableLabel = 5;   // another table's top
+inline constexpr int kOtherObjectLabel = 6;  // objects not on the support
+
+// A surface of the room around the table: rendered and labelled, never an
+// object of the ground truth.
+struct BackgroundPart {
+  Primitive primitive;
+  int label = kFurnitureLabel;  // one of the labels above, 1..9
 };
 
 struct SceneSpec {
   // Table top: a rectangle of the plane z = 0 centred at the origin.
   Eigen::Vector2f table_half_size = {0.6f, 0.4f};  // metres
   Eigen::Vector3f table_rgb = {0.55f, 0.45f, 0.35f};
+  Texture table_texture = Texture::kFlat;
   std::vector<Primitive> objects;
+  // The room: floor, walls, furniture, other tables and what stands on
+  // them (empty for a bare table-top scene).
+  std::vector<BackgroundPart> background;
   // Camera pose in the world (camera frame: x right, y down, z forward).
   Eigen::Isometry3f camera_pose = Eigen::Isometry3f::Identity();
   Intrinsics intrinsics = kKinectV1Intrinsics;
@@ -57,8 +88,14 @@ absl::Status Validate(const SceneSpec& spec);
 
 struct NoiseOptions {
   bool enabled = true;
-  // Axial noise sigma = k * z^2 (Khoshelham & Elberink 2012: 1.43e-3 / m).
+  // Axial noise sigma = sigma0_m + k * z^2 (Khoshelham & Elberink 2012:
+  // 1.43e-3 / m, no floor, for the Kinect v1).
   float sigma_per_z2 = 1.43e-3f;
+  float sigma0_m = 0.0f;
+  // The axial noise is smoothed over this many pixels (Gaussian sigma) and
+  // rescaled to keep its sigma: stereo matching windows make neighbouring
+  // depths err together. 0 = independent per pixel.
+  float noise_correlation_px = 0.0f;
   // Disparity quantisation: depth is quantised to steps of
   // z^2 / (focal_px * baseline_m) * disparity_step (Kinect: 1/8 px,
   // baseline 0.075 m).
@@ -68,6 +105,16 @@ struct NoiseOptions {
   // `edge_jump_m` (the projector shadow and edge dropouts).
   int edge_dropout_px = 2;
   float edge_jump_m = 0.03f;
+  // Shadows: a point hidden from a second viewpoint `shadow_baseline_m` to
+  // the camera's right (the projector, or the second imager of a stereo
+  // pair) has no depth. This is the band left of every foreground object
+  // that both sensors show, f * b * (1 / z_near - 1 / z_far) pixels wide.
+  // 0 = off.
+  float shadow_baseline_m = 0.0f;
+  // With shadows on: the image's left border, which the second viewpoint
+  // does not see (f * b / z pixels wide), has no depth either (active
+  // stereo; the Kinect's projector covers it).
+  bool border_band = false;
   // Surfaces darker than this albedo lose their depth with probability
   // `dark_dropout_probability` per pixel.
   float dark_albedo = 0.12f;
@@ -79,6 +126,14 @@ struct NoiseOptions {
 // OK, or INVALID_ARGUMENT naming the field (negative sigmas, non-positive
 // baseline or disparity step, probabilities outside [0, 1]).
 absl::Status Validate(const NoiseOptions& options);
+
+// The two sensors rooms are rendered with. Kinect v1: the defaults above
+// with its projector's shadow (7.5 cm baseline). Active stereo (RealSense
+// D4xx-like): sigma 1 mm + 2.5e-3 z^2 correlated over 1.5 px, sub-pixel
+// disparity steps of 1/20 px over a 5 cm baseline, shadows and the left
+// border band, dark surfaces losing depth more often.
+NoiseOptions KinectV1Noise();
+NoiseOptions ActiveStereoNoise();
 
 // Ground truth of one object as rendered.
 struct ObjectTruth {
@@ -106,12 +161,13 @@ struct SynthScene {
 //                      world-frame light), RGB; pixels seeing nothing show a
 //                      flat grey background;
 //   frame.labels:      0 where depth is NaN, 1 table, 10 * (k + 2) for
-//                      spec.objects[k];
+//                      spec.objects[k], each background part's label;
 //   frame.name:        "synth-<seed>"; frame.frame.intrinsics =
 //                      spec.intrinsics.
 // With noise.enabled the depth gets, in this order, edge dropouts (computed
 // on the noise-free depth), dark-surface dropouts, axial Gaussian noise and
-// disparity quantisation, and the colour gets Gaussian noise.
+// disparity quantisation, and the colour gets Gaussian noise. Shadows
+// (shadow_baseline_m) are computed on the noise-free depth too.
 // Precondition (checked): Validate(spec) and Validate(noise) are OK.
 SynthScene RenderScene(const SceneSpec& spec, const NoiseOptions& noise,
                        uint64_t seed);
@@ -157,6 +213,14 @@ absl::Status Validate(const RandomSceneOptions& options);
 // table fewer may fit. Deterministic: the same seed gives the same spec.
 // Precondition (checked): Validate(options) is OK.
 SceneSpec RandomSceneSpec(uint64_t seed, const RandomSceneOptions& options);
+
+// RandomSceneSpec's objects added to `spec` as it is (its table, camera,
+// resolution and intrinsics), free ones within the work area around
+// `target` (world x, y on the table). The room's background parts do not
+// take part in the visibility checks. Deterministic in `seed`.
+// Precondition (checked): Validate(options) is OK.
+void PlaceRandomObjects(uint64_t seed, const RandomSceneOptions& options,
+                        const Eigen::Vector2f& target, SceneSpec& spec);
 
 // The camera pose (camera to world) looking at `target` from `eye` with the
 // world +z up: camera z along target - eye, camera x horizontal, camera y
