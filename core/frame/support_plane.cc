@@ -1,343 +1,423 @@
+// SearchSupport: candidate planes by sequential RANSAC on a grid, their
+// connected parts as candidate surfaces, and the choice among them
+// (support_score.cc scores them and grows the chosen region).
+
 #include "core/frame/support_plane.h"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <vector>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "core/base/strings.h"
+#include "core/frame/support_grid.h"
 
 namespace fovea {
 namespace {
 
+using support_internal::Candidate;
+using support_internal::Grid;
+using support_internal::Plane;
+
 constexpr float kDegToRad = static_cast<float>(M_PI / 180.0);
 // Hypotheses are first scored on at most this many samples, then the best
 // few are re-scored on all samples (preemptive RANSAC, Nister 2003).
-constexpr int kQuickScoreSamples = 1500;
+constexpr int kQuickScoreSamples = 600;
 constexpr int kFullScoreCandidates = 8;
-// Pixel stride for the least-squares refinement.
-constexpr int kRefineStride = 2;
-// Pixel stride for the convex hull's points (the hull is found to within
-// this many pixels, a few millimetres at table range).
-constexpr int kHullStride = 4;
-// The connected components are labelled on every kComponentStride-th row
-// and column; a full-resolution inlier belongs to the table when its
-// block's sample does.
-constexpr int kComponentStride = 2;
+// Two planes closer than this are the same one found twice.
+constexpr float kDuplicateAngleDeg = 5.0f;
+constexpr float kDuplicateDistance = 0.02f;  // metres
+// Least-squares refinements of a RANSAC plane, at most.
+constexpr int kMaxRefinements = 6;
+// Fewest grid points a plane needs, whatever the fraction.
+constexpr int kMinPlanePoints = 30;
+// Candidates within this angle share one "up" when it is estimated.
+constexpr float kSameUpAngleDeg = 10.0f;
 
-struct Sample {
-  Eigen::Vector3f p;
-  Eigen::Vector3f n;
-};
-
-struct PlaneHypothesis {
-  Eigen::Vector3f normal;
-  float d = 0.0f;
-  int support = 0;
-};
-
-std::vector<Sample> Subsample(const OrganizedCloud& cloud, int stride) {
-  std::vector<Sample> samples;
-  samples.reserve(static_cast<size_t>(cloud.width() / stride + 1) *
-                  (cloud.height() / stride + 1));
-  for (int v = 0; v < cloud.height(); v += stride) {
-    const cv::Vec3f* p = cloud.xyz.ptr<cv::Vec3f>(v);
-    const cv::Vec3f* n = cloud.normals.ptr<cv::Vec3f>(v);
-    for (int u = 0; u < cloud.width(); u += stride) {
-      if (std::isnan(p[u][2]) || std::isnan(n[u][2])) continue;
-      samples.push_back(
-          {{p[u][0], p[u][1], p[u][2]}, {n[u][0], n[u][1], n[u][2]}});
-    }
-  }
-  return samples;
-}
-
-// Orients the normal towards the camera (origin): the camera is on the
-// positive side, n . 0 + d > 0.
 void OrientTowardsCamera(Eigen::Vector3f& normal, float& d) {
-  if (d < 0.0f) {
-    normal = -normal;
-    d = -d;
-  }
+  support_internal::OrientTowardsCamera(normal, d);
 }
 
-int CountSupport(const PlaneHypothesis& h, const std::vector<Sample>& samples,
-                 size_t limit, float max_dist, float min_cos) {
+// Whether a plane's normal may belong to a support: perpendicular to
+// gravity when it is known, else facing the camera's up (-y).
+bool OrientationAllowed(const Eigen::Vector3f& normal,
+                        const SupportPlaneOptions& options,
+                        const SupportHints& hints) {
+  if (hints.gravity.has_value()) {
+    const Eigen::Vector3f up = -hints.gravity->normalized();
+    return normal.dot(up) >=
+           std::cos(options.gravity_tolerance_deg * kDegToRad) - 1e-6f;
+  }
+  return -normal.y() >=
+         std::cos(options.max_tilt_from_camera_up_deg * kDegToRad) - 1e-6f;
+}
+
+int CountSupport(const Plane& plane, const Grid& grid,
+                 const std::vector<int>& pool, size_t limit,
+                 const SupportPlaneOptions& options, float min_cos) {
   int support = 0;
-  const size_t n = std::min(limit, samples.size());
-  for (size_t i = 0; i < n; ++i) {
-    const Sample& s = samples[i];
-    if (std::abs(h.normal.dot(s.p) + h.d) <= max_dist &&
-        std::abs(h.normal.dot(s.n)) >= min_cos) {
-      ++support;
-    }
+  const size_t n = std::min(limit, pool.size());
+  for (size_t k = 0; k < n; ++k) {
+    const int i = pool[k];
+    if (support_internal::IsInlier(grid, i, plane, options, min_cos)) ++support;
   }
   return support;
 }
 
-bool FaceUp(const Eigen::Vector3f& normal, float max_tilt_deg) {
-  // Camera "up" is -y in the camera frame.
-  return -normal.y() >= std::cos(max_tilt_deg * kDegToRad) - 1e-6f;
+// The plane of RANSAC's best hypothesis on `pool` (shuffled grid indices
+// with normals), or nullopt when no hypothesis of an allowed orientation
+// has enough support.
+std::optional<Plane> RansacPlane(const Grid& grid, const std::vector<int>& pool,
+                                 int min_support,
+                                 const SupportPlaneOptions& options,
+                                 const SupportHints& hints, float min_cos,
+                                 std::mt19937& rng) {
+  if (pool.size() < 3) return std::nullopt;
+  std::uniform_int_distribution<size_t> pick(0, pool.size() - 1);
+  struct Hypothesis {
+    Plane plane;
+    int support = 0;
+  };
+  std::vector<Hypothesis> hypotheses;
+  hypotheses.reserve(options.ransac_iterations);
+  for (int it = 0; it < options.ransac_iterations; ++it) {
+    // One point and its (smoothed) normal make a hypothesis: a random
+    // point lies on a plane with the plane's share of the points, where
+    // three random points all do with its cube, so a few dozen draws find
+    // planes of a few percent; the refinement corrects the normal's noise.
+    const int i = pool[pick(rng)];
+    Eigen::Vector3f normal = grid.n[i];
+    const float norm = normal.norm();
+    if (!(norm > 1e-9f)) continue;
+    normal /= norm;
+    float d = -normal.dot(grid.p[i]);
+    OrientTowardsCamera(normal, d);
+    if (!OrientationAllowed(normal, options, hints)) continue;
+    Hypothesis h{{normal, d}, 0};
+    h.support =
+        CountSupport(h.plane, grid, pool, kQuickScoreSamples, options, min_cos);
+    hypotheses.push_back(h);
+  }
+  if (hypotheses.empty()) return std::nullopt;
+  const size_t keep = std::min<size_t>(kFullScoreCandidates, hypotheses.size());
+  std::partial_sort(hypotheses.begin(), hypotheses.begin() + keep,
+                    hypotheses.end(),
+                    [](const Hypothesis& x, const Hypothesis& y) {
+                      return x.support > y.support;
+                    });
+  // No plane can have enough support if the best quick score, scaled to
+  // the pool, falls well short (what is left is objects and clutter).
+  const size_t quick = std::min<size_t>(kQuickScoreSamples, pool.size());
+  if (2.0 * hypotheses[0].support * pool.size() < 1.0 * min_support * quick) {
+    return std::nullopt;
+  }
+  Hypothesis best{{}, -1};
+  for (size_t i = 0; i < keep; ++i) {
+    Hypothesis h = hypotheses[i];
+    h.support =
+        CountSupport(h.plane, grid, pool, pool.size(), options, min_cos);
+    if (h.support > best.support) best = h;
+  }
+  if (best.support < min_support) return std::nullopt;
+  return best.plane;
 }
 
-// Least-squares plane (PCA) through the points within `max_dist` of the
-// hypothesis whose normals agree, on a stride-`kRefineStride` grid.
-bool RefinePlane(const OrganizedCloud& cloud, float max_dist, float min_cos,
-                 Eigen::Vector3f& normal, float& d) {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
-  int count = 0;
-  for (int v = 0; v < cloud.height(); v += kRefineStride) {
-    const cv::Vec3f* p = cloud.xyz.ptr<cv::Vec3f>(v);
-    const cv::Vec3f* n = cloud.normals.ptr<cv::Vec3f>(v);
-    for (int u = 0; u < cloud.width(); u += kRefineStride) {
-      if (std::isnan(p[u][2]) || std::isnan(n[u][2])) continue;
-      const Eigen::Vector3f q(p[u][0], p[u][1], p[u][2]);
-      const Eigen::Vector3f m(n[u][0], n[u][1], n[u][2]);
-      if (std::abs(normal.dot(q) + d) > max_dist ||
-          std::abs(normal.dot(m)) < min_cos) {
-        continue;
+// Refits `plane` on the pool's inliers until their number stops growing
+// (each refit can admit points the coarse plane missed; a RANSAC plane
+// tilted by a degree leaves the far part of a table out of its band).
+Plane Refine(const Grid& grid, const std::vector<int>& pool, Plane plane,
+             const SupportPlaneOptions& options, float min_cos) {
+  size_t last = 0;
+  for (int round = 0; round < kMaxRefinements; ++round) {
+    std::vector<int> inliers;
+    for (const int i : pool) {
+      if (support_internal::IsInlier(grid, i, plane, options, min_cos)) {
+        inliers.push_back(i);
       }
-      const Eigen::Vector3d qd = q.cast<double>();
-      sum += qd;
-      outer += qd * qd.transpose();
-      ++count;
     }
+    if (round > 0 && inliers.size() <= last) break;
+    last = inliers.size();
+    const std::optional<Plane> refit =
+        support_internal::FitPlane(grid, inliers);
+    if (!refit) break;
+    plane = *refit;
   }
-  if (count < 3) return false;
-  const Eigen::Vector3d mean = sum / count;
-  const Eigen::Matrix3d cov = outer / count - mean * mean.transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-  Eigen::Vector3f refined = eig.eigenvectors().col(0).cast<float>();
-  if (refined.dot(normal) < 0.0f) refined = -refined;
-  normal = refined.normalized();
-  d = -normal.dot(mean.cast<float>());
-  OrientTowardsCamera(normal, d);
-  return true;
+  return plane;
 }
 
-// Inlier mask at full resolution, reduced to its largest 8-connected
-// component.
-cv::Mat LargestInlierComponent(const OrganizedCloud& cloud,
-                               const Eigen::Vector3f& normal, float d,
-                               float max_dist, float min_cos, int& count) {
-  cv::Mat mask(cloud.height(), cloud.width(), CV_8UC1, cv::Scalar(0));
-  for (int v = 0; v < cloud.height(); ++v) {
-    const cv::Vec3f* p = cloud.xyz.ptr<cv::Vec3f>(v);
-    const cv::Vec3f* n = cloud.normals.ptr<cv::Vec3f>(v);
-    uint8_t* m = mask.ptr<uint8_t>(v);
-    for (int u = 0; u < cloud.width(); ++u) {
-      if (std::isnan(p[u][2])) continue;
-      const float dist = normal.x() * p[u][0] + normal.y() * p[u][1] +
-                         normal.z() * p[u][2] + d;
-      if (std::abs(dist) > max_dist) continue;
-      // Points without a normal (edges, noise) count when they are close.
-      if (!std::isnan(n[u][2]) &&
-          std::abs(normal.x() * n[u][0] + normal.y() * n[u][1] +
-                   normal.z() * n[u][2]) < min_cos) {
-        continue;
-      }
-      m[u] = 255;
-    }
-  }
-  cv::Mat coarse;
-  cv::resize(mask, coarse,
-             cv::Size((mask.cols + kComponentStride - 1) / kComponentStride,
-                      (mask.rows + kComponentStride - 1) / kComponentStride),
-             0, 0, cv::INTER_NEAREST);
-  cv::Mat labels, stats, centroids;
-  const int n = cv::connectedComponentsWithStats(coarse, labels, stats,
-                                                 centroids, 8, CV_32S);
-  int best = 0, best_area = 0;
-  for (int i = 1; i < n; ++i) {
-    const int area = stats.at<int>(i, cv::CC_STAT_AREA);
-    if (area > best_area) {
-      best_area = area;
-      best = i;
-    }
-  }
-  count = 0;
-  for (int v = 0; v < mask.rows; ++v) {
-    uint8_t* m = mask.ptr<uint8_t>(v);
-    const int* l =
-        labels.ptr<int>(std::min(v / kComponentStride, labels.rows - 1));
-    for (int u = 0; u < mask.cols; ++u) {
-      if (!m[u]) continue;
-      if (best == 0 ||
-          l[std::min(u / kComponentStride, labels.cols - 1)] != best) {
-        m[u] = 0;
-      } else {
-        ++count;
-      }
-    }
-  }
-  return mask;
+bool SamePlane(const Plane& a, const Plane& b) {
+  return a.normal.dot(b.normal) >= std::cos(kDuplicateAngleDeg * kDegToRad) &&
+         std::abs(a.d - b.d) < kDuplicateDistance;
 }
 
-std::vector<Eigen::Vector2f> HullInPlane(const OrganizedCloud& cloud,
-                                         const cv::Mat& inliers,
-                                         const SupportPlane& plane) {
-  std::vector<cv::Point2f> pts;
-  for (int v = 0; v < cloud.height(); v += kHullStride) {
-    const cv::Vec3f* p = cloud.xyz.ptr<cv::Vec3f>(v);
-    const uint8_t* m = inliers.ptr<uint8_t>(v);
-    for (int u = 0; u < cloud.width(); u += kHullStride) {
-      if (!m[u]) continue;
-      const Eigen::Vector2f q = plane.ToPlane({p[u][0], p[u][1], p[u][2]});
-      pts.emplace_back(q.x(), q.y());
+// Up to options.max_planes planes of allowed orientation, each found by
+// RANSAC on the grid points the earlier ones did not take.
+std::vector<Plane> FindPlanes(const Grid& grid,
+                              const SupportPlaneOptions& options,
+                              const SupportHints& hints, float min_cos) {
+  std::vector<int> pool;
+  int valid = 0;
+  for (int i = 0; i < grid.size(); ++i) {
+    if (!grid.HasPoint(i)) continue;
+    ++valid;
+    if (grid.HasNormal(i)) pool.push_back(i);
+  }
+  std::mt19937 rng(options.seed);
+  std::shuffle(pool.begin(), pool.end(), rng);
+  const int min_support = std::max(
+      kMinPlanePoints,
+      static_cast<int>(std::ceil(options.min_inlier_fraction * valid)));
+  std::vector<Plane> planes;
+  for (int round = 0; round < options.max_planes; ++round) {
+    const std::optional<Plane> found =
+        RansacPlane(grid, pool, min_support, options, hints, min_cos, rng);
+    if (!found) break;
+    const Plane plane = Refine(grid, pool, *found, options, min_cos);
+    // Take the points of the RANSAC plane and of its refinement out, so the
+    // next round finds another plane.
+    std::vector<int> rest;
+    rest.reserve(pool.size());
+    for (const int i : pool) {
+      if (!support_internal::IsInlier(grid, i, *found, options, min_cos) &&
+          !support_internal::IsInlier(grid, i, plane, options, min_cos)) {
+        rest.push_back(i);
+      }
+    }
+    pool.swap(rest);
+    if (!OrientationAllowed(plane.normal, options, hints)) continue;
+    bool duplicate = false;
+    for (const Plane& q : planes) duplicate = duplicate || SamePlane(q, plane);
+    if (!duplicate) planes.push_back(plane);
+  }
+  return planes;
+}
+
+// The normal most candidate area agrees with (within kSameUpAngleDeg),
+// area-weighted: floors and tables are parallel, walls are not.
+Eigen::Vector3f EstimateUp(const std::vector<Candidate>& candidates) {
+  const float same = std::cos(kSameUpAngleDeg * kDegToRad);
+  float best_weight = -1.0f;
+  Eigen::Vector3f up = -Eigen::Vector3f::UnitY();
+  for (const Candidate& c : candidates) {
+    Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+    float weight = 0.0f;
+    for (const Candidate& o : candidates) {
+      if (c.plane.normal.dot(o.plane.normal) >= same) {
+        weight += o.area_m2;
+        sum += o.area_m2 * o.plane.normal;
+      }
+    }
+    if (weight > best_weight && sum.norm() > 0.0f) {
+      best_weight = weight;
+      up = sum.normalized();
     }
   }
-  std::vector<Eigen::Vector2f> hull;
-  if (pts.size() < 3) return hull;
-  std::vector<cv::Point2f> h;
-  cv::convexHull(pts, h, /*clockwise=*/false);
-  hull.reserve(h.size());
-  for (const cv::Point2f& q : h) hull.emplace_back(q.x, q.y);
-  // Make sure the order is counter-clockwise (positive signed area).
-  double area = 0.0;
-  for (size_t i = 0; i < hull.size(); ++i) {
-    const Eigen::Vector2f& a = hull[i];
-    const Eigen::Vector2f& b = hull[(i + 1) % hull.size()];
-    area +=
-        static_cast<double>(a.x()) * b.y() - static_cast<double>(b.x()) * a.y();
+  return up;
+}
+
+absl::Status ValidateUnit(const Eigen::Vector3f& v, std::string_view field) {
+  if (!v.allFinite()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(AbslView(field), ": must be finite, got (", v.x(), ", ",
+                     v.y(), ", ", v.z(), ")"));
   }
-  if (area < 0.0) std::reverse(hull.begin(), hull.end());
-  return hull;
+  const float norm = v.norm();
+  if (!(std::abs(norm - 1.0f) <= 0.01f)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        AbslView(field), ": must be a unit vector, got length ", norm));
+  }
+  return absl::OkStatus();
 }
 
 }  // namespace
 
 bool SupportPlane::ProjectsInsideHull(const Eigen::Vector3f& p,
                                       float margin) const {
-  if (hull.size() < 3 || !p.allFinite()) return false;
-  const Eigen::Vector2f q = ToPlane(p);
-  const float margin2 = margin * margin;
-  for (size_t i = 0; i < hull.size(); ++i) {
-    const Eigen::Vector2f& a = hull[i];
-    const Eigen::Vector2f edge = hull[(i + 1) % hull.size()] - a;
-    // cross = |edge| times the signed distance of q from the edge's line,
-    // positive inside (the hull is counter-clockwise). Inside by `margin`:
-    // cross >= margin |edge|, compared squared to avoid a square root.
-    const float cross = edge.x() * (q.y() - a.y()) - edge.y() * (q.x() - a.x());
-    if (!(cross >= 0.0f)) return false;  // NaN is outside too
-    if (margin > 0.0f && cross * cross < margin2 * edge.squaredNorm()) {
-      return false;
-    }
-  }
-  return true;
+  if (!p.allFinite()) return false;
+  return support_internal::InsideHull(hull, ToPlane(p), margin);
 }
 
-absl::Status Validate(const SupportPlaneOptions& options) {
-  if (!(options.inlier_distance > 0.0f)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("support_plane.inlier_distance must be > 0, got ",
-                     options.inlier_distance));
+absl::Status Validate(const SupportHints& hints) {
+  if (hints.gravity.has_value()) {
+    if (absl::Status s = ValidateUnit(*hints.gravity, "gravity"); !s.ok()) {
+      return s;
+    }
   }
-  if (!(options.max_normal_angle_deg > 0.0f &&
-        options.max_normal_angle_deg <= 90.0f)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "support_plane.max_normal_angle_deg must be in (0, 90], got ",
-        options.max_normal_angle_deg));
-  }
-  if (options.ransac_iterations < 1) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("support_plane.ransac_iterations must be >= 1, got ",
-                     options.ransac_iterations));
-  }
-  if (options.subsample_stride < 1) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("support_plane.subsample_stride must be >= 1, got ",
-                     options.subsample_stride));
-  }
-  if (!(options.max_tilt_from_camera_up_deg > 0.0f &&
-        options.max_tilt_from_camera_up_deg <= 180.0f)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "support_plane.max_tilt_from_camera_up_deg must be in (0, 180], got ",
-        options.max_tilt_from_camera_up_deg));
-  }
-  if (!(options.min_inlier_fraction >= 0.0f &&
-        options.min_inlier_fraction < 1.0f)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "support_plane.min_inlier_fraction must be in [0, 1), got ",
-        options.min_inlier_fraction));
+  if (hints.plane.has_value()) {
+    if (absl::Status s =
+            ValidateUnit(hints.plane->head<3>(), "support_plane.normal");
+        !s.ok()) {
+      return s;
+    }
+    if (!std::isfinite((*hints.plane)[3])) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "support_plane.d: must be finite, got ", (*hints.plane)[3]));
+    }
   }
   return absl::OkStatus();
 }
 
-absl::StatusOr<SupportPlane> FindSupportPlane(
-    const OrganizedCloud& cloud, const SupportPlaneOptions& options) {
+absl::Status Validate(const SupportPlaneOptions& o) {
+  auto invalid = [](std::string_view field, std::string_view rule,
+                    double value) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("support_plane.", AbslView(field), " must be ",
+                     AbslView(rule), ", got ", value));
+  };
+  if (!(o.inlier_distance > 0.0f)) {
+    return invalid("inlier_distance", "> 0", o.inlier_distance);
+  }
+  if (!(o.inlier_sigmas >= 0.0f)) {
+    return invalid("inlier_sigmas", ">= 0", o.inlier_sigmas);
+  }
+  if (!(o.sigma0_m >= 0.0f)) return invalid("sigma0_m", ">= 0", o.sigma0_m);
+  if (!(o.sigma_per_z2 >= 0.0f)) {
+    return invalid("sigma_per_z2", ">= 0", o.sigma_per_z2);
+  }
+  if (!(o.max_normal_angle_deg > 0.0f && o.max_normal_angle_deg <= 90.0f)) {
+    return invalid("max_normal_angle_deg", "in (0, 90]",
+                   o.max_normal_angle_deg);
+  }
+  if (o.ransac_iterations < 1) {
+    return invalid("ransac_iterations", ">= 1", o.ransac_iterations);
+  }
+  if (o.grid_columns < 16)
+    return invalid("grid_columns", ">= 16", o.grid_columns);
+  if (o.max_planes < 1) return invalid("max_planes", ">= 1", o.max_planes);
+  if (!(o.max_tilt_from_camera_up_deg > 0.0f &&
+        o.max_tilt_from_camera_up_deg <= 180.0f)) {
+    return invalid("max_tilt_from_camera_up_deg", "in (0, 180]",
+                   o.max_tilt_from_camera_up_deg);
+  }
+  if (!(o.gravity_tolerance_deg > 0.0f && o.gravity_tolerance_deg <= 90.0f)) {
+    return invalid("gravity_tolerance_deg", "in (0, 90]",
+                   o.gravity_tolerance_deg);
+  }
+  if (!(o.max_tilt_from_estimated_up_deg > 0.0f &&
+        o.max_tilt_from_estimated_up_deg <= 90.0f)) {
+    return invalid("max_tilt_from_estimated_up_deg", "in (0, 90]",
+                   o.max_tilt_from_estimated_up_deg);
+  }
+  if (!(o.min_inlier_fraction >= 0.0f && o.min_inlier_fraction < 1.0f)) {
+    return invalid("min_inlier_fraction", "in [0, 1)", o.min_inlier_fraction);
+  }
+  const std::pair<std::string_view, float> non_negative[] = {
+      {"min_candidate_area_m2", o.min_candidate_area_m2},
+      {"max_contact_gap", o.max_contact_gap},
+      {"min_object_area_m2", o.min_object_area_m2},
+      {"object_weight", o.object_weight},
+      {"area_weight", o.area_weight},
+      {"near_weight", o.near_weight},
+      {"view_weight", o.view_weight},
+      {"level_weight", o.level_weight},
+      {"under_weight", o.under_weight},
+      {"under_height", o.under_height},
+      {"under_reach", o.under_reach},
+      {"max_occlusion_gap", o.max_occlusion_gap},
+  };
+  for (const auto& [field, value] : non_negative) {
+    if (!(value >= 0.0f) || !std::isfinite(value)) {
+      return invalid(field, "finite and >= 0", value);
+    }
+  }
+  const std::pair<std::string_view, float> positive[] = {
+      {"max_object_height", o.max_object_height},
+      {"max_object_size", o.max_object_size},
+      {"reference_area_m2", o.reference_area_m2},
+      {"near_scale_m", o.near_scale_m},
+      {"view_scale_deg", o.view_scale_deg},
+  };
+  for (const auto& [field, value] : positive) {
+    if (!(value > 0.0f) || !std::isfinite(value)) {
+      return invalid(field, "finite and > 0", value);
+    }
+  }
+  if (o.max_counted_objects < 0) {
+    return invalid("max_counted_objects", ">= 0", o.max_counted_objects);
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<SupportSearch> SearchSupport(const OrganizedCloud& cloud,
+                                            const SupportPlaneOptions& options,
+                                            const SupportHints& hints) {
   if (absl::Status s = Validate(options); !s.ok()) return s;
-  std::vector<Sample> samples = Subsample(cloud, options.subsample_stride);
-  if (samples.size() < 3) {
-    return absl::NotFoundError(
-        "support plane: fewer than 3 points with normals");
-  }
-  std::mt19937 rng(options.seed);
-  // Shuffle once so that the first kQuickScoreSamples are a random subset.
-  std::shuffle(samples.begin(), samples.end(), rng);
+  if (absl::Status s = Validate(hints); !s.ok()) return s;
+  const Grid grid = support_internal::MakeGrid(cloud, options.grid_columns);
   const float min_cos = std::cos(options.max_normal_angle_deg * kDegToRad);
-  std::uniform_int_distribution<size_t> pick(0, samples.size() - 1);
 
-  std::vector<PlaneHypothesis> hypotheses;
-  hypotheses.reserve(options.ransac_iterations);
-  for (int it = 0; it < options.ransac_iterations; ++it) {
-    const Sample& a = samples[pick(rng)];
-    const Sample& b = samples[pick(rng)];
-    const Sample& c = samples[pick(rng)];
-    Eigen::Vector3f normal = (b.p - a.p).cross(c.p - a.p);
-    const float norm = normal.norm();
-    if (!(norm > 1e-9f)) continue;
-    normal /= norm;
-    float d = -normal.dot(a.p);
-    OrientTowardsCamera(normal, d);
-    if (!FaceUp(normal, options.max_tilt_from_camera_up_deg)) continue;
-    PlaneHypothesis h{normal, d, 0};
-    h.support = CountSupport(h, samples, kQuickScoreSamples,
-                             options.inlier_distance, min_cos);
-    hypotheses.push_back(h);
+  std::vector<Plane> planes;
+  if (hints.plane.has_value()) {
+    Plane given{hints.plane->head<3>().normalized(), (*hints.plane)[3]};
+    OrientTowardsCamera(given.normal, given.d);
+    planes.push_back(given);
+  } else {
+    planes = FindPlanes(grid, options, hints, min_cos);
   }
-  if (hypotheses.empty()) {
+  std::vector<Candidate> candidates;
+  for (const Plane& plane : planes) {
+    std::vector<Candidate> parts = support_internal::SplitIntoSurfaces(
+        grid, plane, options, min_cos, /*refit=*/!hints.plane.has_value());
+    for (Candidate& c : parts) candidates.push_back(std::move(c));
+  }
+  // Surfaces facing another way than the floor and the tables (walls seen
+  // from above) are not supports.
+  Eigen::Vector3f up;
+  if (hints.gravity.has_value()) {
+    up = -hints.gravity->normalized();
+  } else {
+    up = EstimateUp(candidates);
+    if (!hints.plane.has_value()) {
+      const float min_up =
+          std::cos(options.max_tilt_from_estimated_up_deg * kDegToRad);
+      candidates.erase(std::remove_if(candidates.begin(), candidates.end(),
+                                      [&](const Candidate& c) {
+                                        return c.plane.normal.dot(up) < min_up;
+                                      }),
+                       candidates.end());
+    }
+  }
+  if (candidates.empty()) {
     return absl::NotFoundError(
-        "support plane: no plane facing the camera's up direction");
+        hints.plane.has_value()
+            ? "support plane: the given plane has no surface in view of at "
+              "least support_plane.min_candidate_area_m2"
+            : absl::StrCat("support plane: no surface facing up of at least ",
+                           options.min_candidate_area_m2, " m^2 in view (",
+                           planes.size(), " planes found)"));
   }
-  const size_t keep = std::min<size_t>(kFullScoreCandidates, hypotheses.size());
-  std::partial_sort(hypotheses.begin(), hypotheses.begin() + keep,
-                    hypotheses.end(),
-                    [](const PlaneHypothesis& x, const PlaneHypothesis& y) {
-                      return x.support > y.support;
-                    });
-  PlaneHypothesis best = hypotheses[0];
-  best.support = -1;
-  for (size_t i = 0; i < keep; ++i) {
-    PlaneHypothesis h = hypotheses[i];
-    h.support = CountSupport(h, samples, samples.size(),
-                             options.inlier_distance, min_cos);
-    if (h.support > best.support) best = h;
-  }
-  const int min_support =
-      static_cast<int>(std::ceil(options.min_inlier_fraction * samples.size()));
-  if (best.support < std::max(min_support, 3)) {
-    return absl::NotFoundError(
-        absl::StrCat("support plane: the best plane has ", best.support, " of ",
-                     samples.size(), " sampled points, fewer than the ",
-                     min_support, " required"));
-  }
+  support_internal::ScoreCandidates(grid, up, options, candidates);
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& a, const Candidate& b) {
+                     return a.score.total > b.score.total;
+                   });
 
-  SupportPlane plane;
-  plane.normal = best.normal;
-  plane.d = best.d;
-  // Two rounds: each refit can admit points the coarse plane missed.
-  for (int round = 0; round < 2; ++round) {
-    RefinePlane(cloud, options.inlier_distance, min_cos, plane.normal, plane.d);
+  SupportSearch search;
+  for (const Candidate& c : candidates) {
+    search.candidates.push_back({c.plane.normal, c.plane.d, c.centroid, c.score,
+                                 static_cast<int>(c.indices.size())});
   }
-  int inlier_count = 0;
-  const cv::Mat inliers =
-      LargestInlierComponent(cloud, plane.normal, plane.d,
-                             options.inlier_distance, min_cos, inlier_count);
-  return SupportPlaneFromInliers(cloud, plane.normal, plane.d, inliers);
+  absl::StatusOr<SupportPlane> chosen = support_internal::MakeSupportRegion(
+      cloud, grid, candidates[0], options, min_cos);
+  if (!chosen.ok()) return chosen.status();
+  search.chosen = *std::move(chosen);
+  search.chosen.candidate_count = static_cast<int>(candidates.size());
+  search.chosen.score = candidates[0].score;
+  search.chosen.given = hints.plane.has_value();
+  return search;
+}
+
+absl::StatusOr<SupportPlane> FindSupportPlane(
+    const OrganizedCloud& cloud, const SupportPlaneOptions& options,
+    const SupportHints& hints) {
+  absl::StatusOr<SupportSearch> search = SearchSupport(cloud, options, hints);
+  if (!search.ok()) return search.status();
+  return std::move(search->chosen);
 }
 
 absl::StatusOr<SupportPlane> SupportPlaneFromInliers(
@@ -359,14 +439,8 @@ absl::StatusOr<SupportPlane> SupportPlaneFromInliers(
   OrientTowardsCamera(plane.normal, plane.d);
   plane.inliers = inliers;
   plane.inlier_count = cv::countNonZero(inliers);
-  // Axes: u along the camera x projected into the plane.
-  Eigen::Vector3f u =
-      Eigen::Vector3f::UnitX() - plane.normal * plane.normal.x();
-  if (u.norm() < 1e-3f)
-    u = Eigen::Vector3f::UnitZ() - plane.normal * plane.normal.z();
-  plane.axis_u = u.normalized();
-  plane.axis_v = plane.normal.cross(plane.axis_u);
-  plane.hull = HullInPlane(cloud, plane.inliers, plane);
+  support_internal::SetAxes(plane);
+  plane.hull = support_internal::HullOfMask(cloud, plane.inliers, plane);
   if (plane.hull.size() < 3) {
     return absl::NotFoundError("support plane: inliers have no 2D extent");
   }

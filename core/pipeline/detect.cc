@@ -10,6 +10,7 @@
 #include "absl/strings/str_split.h"
 #include "core/base/strings.h"
 #include "core/pipeline/channels.h"
+#include "core/pipeline/sensor_adaptation.h"
 #include "core/pyramid/fusion.h"
 #include "core/saliency/saliency_map.h"
 
@@ -180,7 +181,24 @@ absl::StatusOr<FusionKind> ParseFusion(std::string_view text) {
       "fusion: unknown fusion '", AbslView(text), "' (known: sum max)"));
 }
 
+absl::Status Validate(const SceneOptions& options) {
+  if (options.processing_width < kMinProcessingWidth ||
+      options.processing_width > kMaxProcessingWidth) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "scene.processing_width must be in [", kMinProcessingWidth, ", ",
+        kMaxProcessingWidth, "], got ", options.processing_width));
+  }
+  if (absl::Status s = Validate(options.workspace); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("scene.", s.message()));
+  }
+  if (absl::Status s = Validate(options.support); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("scene.", s.message()));
+  }
+  return absl::OkStatus();
+}
+
 absl::Status Validate(const DetectOptions& options) {
+  if (absl::Status s = Validate(options.scene); !s.ok()) return s;
   if (options.channels.empty()) {
     return absl::InvalidArgumentError("options.saliency: no channel given");
   }
@@ -279,8 +297,8 @@ absl::StatusOr<std::vector<AttentionPoint>> ExtractAttentionPoints(
 }
 
 std::vector<std::string> DetectStageNames() {
-  std::vector<std::string> names = {"fill_holes", "cloud", "normals",
-                                    "support_plane", "fusion"};
+  std::vector<std::string> names = {"reduce",  "fill_holes",    "cloud",
+                                    "normals", "support_plane", "fusion"};
   for (const NamedOp& n : kOps) {
     if (IsImplemented(n.op)) {
       names.push_back(absl::StrCat("saliency.", AbslView(n.name)));
@@ -324,6 +342,19 @@ absl::StatusOr<DetectResult> RunDetect(const RgbdFrame& frame,
   if (!result.ok()) return result.status();
   result->timings.insert(result->timings.begin(), scene->timings.begin(),
                          scene->timings.end());
+  // Back to the frame as sent.
+  const FrameScale& scale = scene->scale;
+  if (scale.reduced()) {
+    for (AttentionPoint& p : result->points) {
+      const cv::Point q = scale.ToInput({p.u, p.v});
+      p.u = q.x;
+      p.v = q.y;
+    }
+    result->master = scale.MapToInput(result->master);
+    for (NamedMap& m : result->channel_maps) m.map = scale.MapToInput(m.map);
+    result->plane.inliers = scale.MaskToInput(result->plane.inliers);
+    result->plane.inlier_count = cv::countNonZero(result->plane.inliers);
+  }
   result->total_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
@@ -339,31 +370,40 @@ absl::StatusOr<PreparedScene> PrepareSceneUnguarded(
   if (absl::Status s = Validate(options); !s.ok()) return s;
   PreparedScene scene;
   StageClock clock(scene.timings);
+  scene.sensor = SensorModelFor(options.scene.sensor, frame.intrinsics);
 
+  ReducedFrame reduced =
+      ReduceForProcessing(frame, options.scene.processing_width);
+  scene.scale = reduced.scale;
+  if (scene.scale.reduced()) clock.Lap("reduce");
   RgbdFrame filled_frame;
-  const RgbdFrame* input = &frame;
+  const RgbdFrame* input = &reduced.frame;
   if (options.fill_holes) {
     absl::StatusOr<FilledDepth> filled =
-        FillDepthHoles(frame, options.hole_filling);
+        FillDepthHoles(reduced.frame, options.hole_filling);
     if (!filled.ok()) return filled.status();
-    filled_frame.color = frame.color;  // shares the pixels
+    filled_frame.color = reduced.frame.color;  // shares the pixels
     filled_frame.depth = std::move(filled->depth);
-    filled_frame.intrinsics = frame.intrinsics;
+    filled_frame.intrinsics = reduced.frame.intrinsics;
     input = &filled_frame;
     clock.Lap("fill_holes");
   }
   scene.cloud = BackProject(*input);
+  ApplyWorkspace(options.scene.workspace, scene.sensor, scene.cloud);
   clock.Lap("cloud");
   EstimateNormals(options.normals, scene.cloud);
   clock.Lap("normals");
   if (absl::Status s = Check(interrupt); !s.ok()) return s;
 
+  SupportPlaneOptions support_options = options.support_plane;
+  AdaptToSensor(scene.sensor, support_options);
   absl::StatusOr<SupportPlane> plane =
-      FindSupportPlane(scene.cloud, options.support_plane);
+      FindSupportPlane(scene.cloud, support_options, options.scene.support);
   if (!plane.ok()) return plane.status();
   scene.plane = *std::move(plane);
-  scene.table =
-      PrepareTableScene(scene.cloud, scene.plane, options.table_scene);
+  TableSceneOptions table_options = options.table_scene;
+  AdaptToSensor(scene.sensor, table_options);
+  scene.table = PrepareTableScene(scene.cloud, scene.plane, table_options);
   clock.Lap("support_plane");
   if (absl::Status s = Check(interrupt); !s.ok()) return s;
   return scene;

@@ -13,12 +13,15 @@
 #include "core/attention/tj.h"
 #include "core/attention/wta.h"
 #include "core/base/interrupt.h"
+#include "core/frame/frame_scale.h"
 #include "core/frame/hole_filling.h"
 #include "core/frame/organized_cloud.h"
 #include "core/frame/rgbd_frame.h"
+#include "core/frame/sensor_model.h"
 #include "core/frame/support_plane.h"
 #include "core/frame/surface_edges.h"
 #include "core/frame/table_scene.h"
+#include "core/frame/workspace.h"
 #include "core/pyramid/cloud_pyramid.h"
 #include "core/pyramid/feature_pyramid.h"
 #include "core/pyramid/normalization.h"
@@ -79,6 +82,30 @@ struct WeightedChannel {
 // ParseSaliencyOps reads them (weights left out).
 std::string ChannelsText(const std::vector<WeightedChannel>& channels);
 
+// The scene a request looks at: which sensor took it, at what resolution
+// to work, where to look, and what is known of the support. Shared by
+// Detect, Segment and SegmentIncremental (it is part of DetectOptions).
+struct SceneOptions {
+  // The sensor's noise model (core/frame/sensor_model.h); every
+  // noise-dependent threshold follows it. kGeneric takes it from the
+  // intrinsics.
+  SensorKind sensor = SensorKind::kGeneric;
+  // Frames wider than this are processed reduced (core/frame/frame_scale.h)
+  // and their points, masks and maps come back at the input resolution,
+  // pixels, [kMinProcessingWidth, kMaxProcessingWidth].
+  int processing_width = kDefaultProcessingWidth;
+  // Nothing outside it is considered; its depth range defaults to the
+  // sensor's (3 m for a generic camera).
+  Workspace workspace;
+  // Gravity and the support plane, when the caller knows them.
+  SupportHints support;
+};
+
+inline constexpr int kMinProcessingWidth = 160;
+inline constexpr int kMaxProcessingWidth = 1920;
+
+absl::Status Validate(const SceneOptions& options);
+
 struct DetectOptions {
   // Channels of the master map (thesis eq. 2.42-2.44), each operator at
   // most once. The defaults of this struct are the combination that
@@ -114,7 +141,12 @@ struct DetectOptions {
   // share one TJ component (learn scenes: HR 0.62 instead of 0.99).
   bool split_at_surface_edges = true;
 
-  // Options of each stage, documented with the stage.
+  SceneOptions scene;
+
+  // Options of each stage, documented with the stage. The noise-dependent
+  // thresholds of support_plane and table_scene are set from the scene's
+  // sensor model (core/pipeline/sensor_adaptation.h) when the scene is
+  // prepared.
   HoleFillingOptions hole_filling;
   NormalOptions normals;
   SupportPlaneOptions support_plane;
@@ -155,9 +187,11 @@ struct NamedMap {
   cv::Mat map;       // CV_32FC1, [0, 1]
 };
 
+// Pixels, maps and masks of results are those of the frame as sent; a
+// frame wider than the processing width was processed reduced.
 struct DetectResult {
   std::vector<AttentionPoint> points;  // most salient first, 3D filled in
-  cv::Mat master;                      // CV_32FC1, [0, 1]
+  cv::Mat master;                      // CV_32FC1, [0, 1], the frame's size
   std::vector<NamedMap> channel_maps;  // when keep_channel_maps
   SupportPlane plane;
   std::vector<StageTiming> timings;
@@ -175,9 +209,12 @@ absl::StatusOr<std::vector<AttentionPoint>> ExtractAttentionPoints(
 // and the table scene, with the stages' timings ("fill_holes", "cloud",
 // "normals", "support_plane").
 struct PreparedScene {
+  // At the processing resolution; `scale` maps it to the frame as sent.
   OrganizedCloud cloud;
   SupportPlane plane;
   TableScene table;
+  FrameScale scale;
+  SensorModel sensor;  // the scene's, for the frame's intrinsics
   std::vector<StageTiming> timings;
 };
 
@@ -199,9 +236,12 @@ absl::StatusOr<DetectResult> RunDetect(const RgbdFrame& frame,
 
 // RunDetect's two halves, for pipelines that need the scene too
 // (segmentation): PrepareScene validates `options` and builds the scene
-// (errors as RunDetect's); DetectOnScene computes the saliency maps and
-// attention points on it (its timings start at the first channel;
-// `scene.timings` are not copied).
+// (errors as RunDetect's): the frame reduced to the processing width, the
+// cloud within the workspace, normals, the support (searched, or the
+// hinted plane's region) and the table scene; DetectOnScene computes the
+// saliency maps and attention points on it, in the scene's (processing)
+// pixels (its timings start at the first channel; `scene.timings` are not
+// copied).
 absl::StatusOr<PreparedScene> PrepareScene(
     const RgbdFrame& frame, const DetectOptions& options,
     const InterruptCheck& interrupt = {});

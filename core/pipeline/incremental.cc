@@ -43,15 +43,27 @@ absl::StatusOr<SegmentSummary> RunUnguarded(const RgbdFrame& frame,
       PrepareScene(frame, options.detect, interrupt);
   if (!scene.ok()) return scene.status();
   summary.timings = scene->timings;
+  if (sinks.support) {
+    if (absl::Status s =
+            sinks.support(PlaneToInput(scene->scale, scene->plane));
+        !s.ok()) {
+      return s;
+    }
+  }
 
   std::vector<AttentionPoint> points;
   cv::Mat saliency;
   if (!options.attention_points.empty()) {
-    const float sigma = static_cast<float>(
-        options.attention_sigma_px * frame.intrinsics.fx / kReferenceFocalPx);
-    saliency = AttentionPointsSaliency(options.attention_points,
-                                       frame.depth.size(), sigma);
+    const float sigma =
+        static_cast<float>(options.attention_sigma_px *
+                           scene->cloud.intrinsics.fx / kReferenceFocalPx);
+    std::vector<cv::Point> attention;
     for (const cv::Point& p : options.attention_points) {
+      attention.push_back(scene->scale.ToProcessing(p));
+    }
+    saliency =
+        AttentionPointsSaliency(attention, scene->cloud.xyz.size(), sigma);
+    for (const cv::Point& p : attention) {
       AttentionPoint a;
       a.u = p.x;
       a.v = p.y;
@@ -70,15 +82,19 @@ absl::StatusOr<SegmentSummary> RunUnguarded(const RgbdFrame& frame,
     points = std::move(detect->points);
   }
   if (sinks.points) {
-    if (absl::Status s = sinks.points(points); !s.ok()) return s;
+    if (absl::Status s = sinks.points(PointsToInput(scene->scale, points));
+        !s.ok()) {
+      return s;
+    }
   }
   if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
 
   SteadyClock::time_point lap = SteadyClock::now();
-  absl::StatusOr<IncScene> inc =
-      BuildIncScene(scene->cloud, scene->plane, saliency, options.inc);
+  const IncOptions& inc_options = options.inc;
+  absl::StatusOr<IncScene> inc = BuildIncScene(
+      scene->cloud, scene->plane, saliency, inc_options, scene->table.region);
   if (!inc.ok()) return inc.status();
-  IncSegmenter segmenter(*inc, *svm, options.inc);
+  IncSegmenter segmenter(*inc, *svm, inc_options);
   summary.timings.push_back({"segment.prepare", SecondsSince(lap)});
 
   while (true) {
@@ -97,8 +113,10 @@ absl::StatusOr<SegmentSummary> RunUnguarded(const RgbdFrame& frame,
     if (!next.ok()) return next.status();
     summary.timings.push_back({"segment.object", SecondsSince(lap)});
     if (!next->has_value()) break;  // the scene is exhausted
+    if (VisibleArea(scene->cloud, (*next)->mask) < options.min_object_area_m2) {
+      continue;  // a fragment: it left the scene, but is not reported
+    }
     SegmentedObject object;
-    object.index = summary.objects++;
     object.seed.u = (*next)->seed.x;
     object.seed.v = (*next)->seed.y;
     object.seed.saliency = static_cast<float>((*next)->saliency);
@@ -107,6 +125,8 @@ absl::StatusOr<SegmentSummary> RunUnguarded(const RgbdFrame& frame,
     object.mask = std::move((*next)->mask);
     object.score = (*next)->score;
     DescribeObject(scene->cloud, object);
+    ObjectToInput(scene->scale, object);
+    object.index = summary.objects++;
     object.seconds_since_start = SecondsSince(start);
     if (sinks.object) {
       if (absl::Status s = sinks.object(std::move(object)); !s.ok()) return s;
@@ -138,6 +158,12 @@ absl::Status Validate(const IncrementalOptions& options) {
   if (options.max_objects < 0) {
     return absl::InvalidArgumentError(absl::StrCat(
         "max_objects must not be negative, got ", options.max_objects));
+  }
+  if (!(options.min_object_area_m2 >= 0.0) ||
+      !std::isfinite(options.min_object_area_m2)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("min_object_area_m2 must be finite and >= 0, got ",
+                     options.min_object_area_m2));
   }
   if (!(options.time_budget_seconds >= 0.0) ||
       !std::isfinite(options.time_budget_seconds)) {
@@ -192,8 +218,8 @@ absl::StatusOr<std::vector<SvmSample>> CollectIncSamples(
     absl::StatusOr<PreparedScene> scene = PrepareScene(frame.frame, detect);
     if (!scene.ok()) return scene.status();
     const cv::Mat flat(frame.frame.depth.size(), CV_32FC1, cv::Scalar(0));
-    absl::StatusOr<IncScene> inc_scene =
-        BuildIncScene(scene->cloud, scene->plane, flat, inc);
+    absl::StatusOr<IncScene> inc_scene = BuildIncScene(
+        scene->cloud, scene->plane, flat, inc, scene->table.region);
     if (!inc_scene.ok()) return inc_scene.status();
     return IncTrainingSamples(*inc_scene, frame.labels, group);
   } catch (const std::bad_alloc&) {

@@ -31,7 +31,10 @@ struct IncrementalOptions {
   // random-points protocol, F first: 0.61 / 0.72 / 0.58 at 20 / 50 / 100.
   float attention_sigma_px = 50.0f;
   DetectOptions detect;
-  int max_objects = 0;               // 0: no limit
+  int max_objects = 0;  // 0: no limit
+  // Objects showing less visible area are fragments and are not reported
+  // (they still leave the scene), m^2 (SegmentOptions::min_object_area_m2).
+  double min_object_area_m2 = kMinObjectAreaM2;
   double time_budget_seconds = 0.0;  // 0: no budget; checked between objects
   IncOptions inc;
 };

@@ -25,6 +25,48 @@ double SecondsSince(SteadyClock::time_point start) {
 
 }  // namespace
 
+double VisibleArea(const OrganizedCloud& cloud, const cv::Mat& mask) {
+  const double per_z2 = 1.0 / (cloud.intrinsics.fx * cloud.intrinsics.fy);
+  double area = 0.0;
+  for (int v = 0; v < mask.rows; ++v) {
+    const unsigned char* in = mask.ptr<unsigned char>(v);
+    const cv::Vec3f* xyz = cloud.xyz.ptr<cv::Vec3f>(v);
+    for (int u = 0; u < mask.cols; ++u) {
+      if (in[u] == 0 || std::isnan(xyz[u][2])) continue;
+      area += per_z2 * xyz[u][2] * xyz[u][2];
+    }
+  }
+  return area;
+}
+
+std::vector<AttentionPoint> PointsToInput(const FrameScale& scale,
+                                          std::vector<AttentionPoint> points) {
+  if (!scale.reduced()) return points;
+  for (AttentionPoint& p : points) {
+    const cv::Point q = scale.ToInput({p.u, p.v});
+    p.u = q.x;
+    p.v = q.y;
+  }
+  return points;
+}
+
+SupportPlane PlaneToInput(const FrameScale& scale, const SupportPlane& plane) {
+  SupportPlane out = plane;
+  out.inliers = scale.MaskToInput(plane.inliers);
+  if (scale.reduced()) out.inlier_count = cv::countNonZero(out.inliers);
+  return out;
+}
+
+void ObjectToInput(const FrameScale& scale, SegmentedObject& object) {
+  if (!scale.reduced()) return;
+  const cv::Point seed = scale.ToInput({object.seed.u, object.seed.v});
+  object.seed.u = seed.x;
+  object.seed.v = seed.y;
+  object.mask = scale.MaskToInput(object.mask);
+  object.area = cv::countNonZero(object.mask);
+  object.box = object.area > 0 ? cv::boundingRect(object.mask) : cv::Rect();
+}
+
 void DescribeObject(const OrganizedCloud& cloud, SegmentedObject& object) {
   object.area = cv::countNonZero(object.mask);
   object.box = object.area > 0 ? cv::boundingRect(object.mask) : cv::Rect();
@@ -78,7 +120,7 @@ class CosCutter final : public ObjectCutter {
       const PreparedScene& scene, const LinearSvm& svm,
       const CosOptions& options) {
     absl::StatusOr<CosScene> cos =
-        BuildCosScene(scene.cloud, scene.plane, options);
+        BuildCosScene(scene.cloud, scene.plane, options, scene.table.region);
     if (!cos.ok()) return cos.status();
     return std::unique_ptr<ObjectCutter>(
         new CosCutter(*std::move(cos), svm, options));
@@ -111,17 +153,21 @@ class EbsCutter final : public ObjectCutter {
   EbsCutter(const PreparedScene& scene, const EbsModel& model,
             const PolarContourOptions& options)
       : probability_(model.EdgeProbability(scene.cloud)), options_(options) {
-    // Pixels an object may cover: with depth, off the support plane.
+    // Pixels an object may cover: with depth, in the table's region, off
+    // the support plane.
     allowed_ = scene.cloud.xyz.size() == probability_.size()
                    ? cv::Mat(probability_.size(), CV_8UC1, cv::Scalar(0))
                    : cv::Mat();
+    const bool have_region = scene.table.region.size() == allowed_.size();
     for (int v = 0; v < allowed_.rows; ++v) {
       const cv::Vec3f* xyz = scene.cloud.xyz.ptr<cv::Vec3f>(v);
       unsigned char* out = allowed_.ptr<unsigned char>(v);
       for (int u = 0; u < allowed_.cols; ++u) {
         const bool on_plane = !scene.plane.inliers.empty() &&
                               scene.plane.inliers.at<unsigned char>(v, u) != 0;
-        out[u] = !std::isnan(xyz[u][2]) && !on_plane ? 255 : 0;
+        const bool in_region =
+            !have_region || scene.table.region.at<unsigned char>(v, u) != 0;
+        out[u] = !std::isnan(xyz[u][2]) && !on_plane && in_region ? 255 : 0;
       }
     }
   }
@@ -177,12 +223,15 @@ class EbsCutter final : public ObjectCutter {
   std::vector<cv::Mat> masks_;  // of the objects cut so far
 };
 
+// The seeds in the scene's (processing) pixels: the given ones mapped
+// there, or Detect's.
 absl::StatusOr<std::vector<AttentionPoint>> TakeSeeds(
     const PreparedScene& scene, const SegmentOptions& options,
     const InterruptCheck& interrupt, std::vector<StageTiming>& timings) {
   std::vector<AttentionPoint> seeds;
   if (!options.seeds.empty()) {
-    for (const cv::Point& p : options.seeds) {
+    for (const cv::Point& given : options.seeds) {
+      const cv::Point p = scene.scale.ToProcessing(given);
       AttentionPoint a;
       a.u = p.x;
       a.v = p.y;
@@ -222,12 +271,22 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
       PrepareScene(frame, options.detect, interrupt);
   if (!scene.ok()) return scene.status();
   summary.timings = scene->timings;
+  if (sinks.support) {
+    if (absl::Status s =
+            sinks.support(PlaneToInput(scene->scale, scene->plane));
+        !s.ok()) {
+      return s;
+    }
+  }
 
   absl::StatusOr<std::vector<AttentionPoint>> seeds =
       TakeSeeds(*scene, options, interrupt, summary.timings);
   if (!seeds.ok()) return seeds.status();
   if (sinks.points) {
-    if (absl::Status s = sinks.points(*seeds); !s.ok()) return s;
+    if (absl::Status s = sinks.points(PointsToInput(scene->scale, *seeds));
+        !s.ok()) {
+      return s;
+    }
   }
   if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
 
@@ -259,13 +318,17 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
     if (!cut.ok()) return cut.status();
     summary.timings.push_back({"segment.object", SecondsSince(lap)});
     if (!cut->has_value()) continue;
+    if (VisibleArea(scene->cloud, (*cut)->mask) < options.min_object_area_m2) {
+      continue;  // a fragment, not an object
+    }
     SegmentedObject object;
-    object.index = summary.objects++;
     object.seed = seed;
     object.mask = std::move((*cut)->mask);
     object.score = (*cut)->score;
     DescribeObject(scene->cloud, object);
     covered.setTo(255, object.mask);
+    ObjectToInput(scene->scale, object);
+    object.index = summary.objects++;
     object.seconds_since_start = SecondsSince(start);
     if (sinks.object) {
       if (absl::Status s = sinks.object(std::move(object)); !s.ok()) return s;
@@ -309,6 +372,12 @@ absl::Status Validate(const SegmentOptions& options) {
     return absl::InvalidArgumentError(absl::StrCat(
         "max_objects must not be negative, got ", options.max_objects));
   }
+  if (!(options.min_object_area_m2 >= 0.0) ||
+      !std::isfinite(options.min_object_area_m2)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("min_object_area_m2 must be finite and >= 0, got ",
+                     options.min_object_area_m2));
+  }
   if (options.seeds.size() > static_cast<size_t>(kMaxAttentionPoints)) {
     return absl::InvalidArgumentError(
         absl::StrCat("seeds: ", options.seeds.size(), " given, at most ",
@@ -341,7 +410,7 @@ absl::StatusOr<std::vector<SvmSample>> CollectCosSamples(
     absl::StatusOr<PreparedScene> scene = PrepareScene(frame.frame, detect);
     if (!scene.ok()) return scene.status();
     absl::StatusOr<CosScene> cos_scene =
-        BuildCosScene(scene->cloud, scene->plane, cos);
+        BuildCosScene(scene->cloud, scene->plane, cos, scene->table.region);
     if (!cos_scene.ok()) return cos_scene.status();
     return CosTrainingSamples(*cos_scene, frame.labels, group, cos);
   } catch (const std::bad_alloc&) {

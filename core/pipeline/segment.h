@@ -26,6 +26,9 @@ namespace fovea {
 
 enum class SegmentMethod { kCos, kEbs };
 
+// The smallest object reported by default, m^2 (SegmentOptions).
+inline constexpr double kMinObjectAreaM2 = 4e-4;
+
 std::string_view SegmentMethodName(SegmentMethod method);  // "cos", "ebs"
 // "cos" or "ebs"; INVALID_ARGUMENT naming the known ones otherwise.
 absl::StatusOr<SegmentMethod> ParseSegmentMethod(std::string_view text);
@@ -39,6 +42,10 @@ struct SegmentOptions {
   DetectOptions detect;
   // Objects to cut out at most; 0 = one per seed.
   int max_objects = 0;
+  // Masks showing less than this visible area are fragments (a rim, a
+  // sliver of an occluded object, sensor noise) and are not reported, m^2:
+  // 4 cm^2 is a 2 x 2 cm face (VisibleArea).
+  double min_object_area_m2 = kMinObjectAreaM2;
   CosOptions cos;
   // EBS's contour search at each seed.
   PolarContourOptions ebs_contour;
@@ -74,6 +81,20 @@ struct SegmentedObject {
 // cloud's points under it.
 void DescribeObject(const OrganizedCloud& cloud, SegmentedObject& object);
 
+// The area the mask's points show the camera, m^2: each pixel with depth z
+// covers z^2 / (fx fy) facing the camera (a lower bound of the surface's
+// area, exact for a face seen head-on).
+double VisibleArea(const OrganizedCloud& cloud, const cv::Mat& mask);
+
+// Results in the scene's (processing) pixels mapped to the frame as sent:
+// points' pixels; an object's seed, mask, box and area (its centroid and
+// extent are metric and stay).
+std::vector<AttentionPoint> PointsToInput(const FrameScale& scale,
+                                          std::vector<AttentionPoint> points);
+void ObjectToInput(const FrameScale& scale, SegmentedObject& object);
+// The plane with its inliers (and their count) at the input size.
+SupportPlane PlaneToInput(const FrameScale& scale, const SupportPlane& plane);
+
 enum class SegmentStop {
   kDone,        // every seed was used
   kMaxObjects,  // options.max_objects objects were emitted
@@ -96,6 +117,9 @@ struct SegmentSummary {
 // Where the results go as they are made. A non-OK status from a sink
 // stops the work and is returned (the caller's client has gone).
 struct SegmentSinks {
+  // The support the scene was prepared on (its inliers at the frame's
+  // size), once, first (may be empty).
+  std::function<absl::Status(const SupportPlane&)> support;
   // The seeds, once, before the first object (may be empty).
   std::function<absl::Status(const std::vector<AttentionPoint>&)> points;
   std::function<absl::Status(SegmentedObject)> object;

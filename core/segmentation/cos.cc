@@ -202,10 +202,11 @@ const std::vector<std::string>& CosFeatureNames() {
 
 absl::StatusOr<CosScene> BuildCosScene(const OrganizedCloud& cloud,
                                        const SupportPlane& plane,
-                                       const CosOptions& options) {
+                                       const CosOptions& options,
+                                       const cv::Mat& region) {
   if (absl::Status s = Validate(options); !s.ok()) return s;
   absl::StatusOr<PlanarPatches> patches =
-      FindPlanarPatches(cloud, cv::Mat(), options.patches);
+      FindPlanarPatches(cloud, region, options.patches);
   if (!patches.ok()) return patches.status();
   CosScene scene;
   scene.patches = *std::move(patches);

@@ -78,10 +78,13 @@ struct CosScene {
 };
 
 // Patches, their colour histograms, point samples, support flags and
-// neighbours. Errors: invalid options.
+// neighbours, of the points in `region` (CV_8UC1 of the cloud's size,
+// non-zero = use: TableScene::region, the support and what stands on it;
+// empty = every point). Errors: invalid options, a region of another size.
 absl::StatusOr<CosScene> BuildCosScene(const OrganizedCloud& cloud,
                                        const SupportPlane& plane,
-                                       const CosOptions& options);
+                                       const CosOptions& options,
+                                       const cv::Mat& region = cv::Mat());
 
 // CV_8UC1 of the labels' size, 255 on the pixels of `patches`.
 cv::Mat PatchesMask(const CosScene& scene, const std::vector<int>& patches);

@@ -73,7 +73,8 @@ absl::Status Validate(const IncOptions& options) {
 absl::StatusOr<IncScene> BuildIncScene(const OrganizedCloud& cloud,
                                        const SupportPlane& plane,
                                        const cv::Mat& saliency_map,
-                                       const IncOptions& options) {
+                                       const IncOptions& options,
+                                       const cv::Mat& region) {
   if (absl::Status s = Validate(options); !s.ok()) return s;
   if (saliency_map.type() != CV_32FC1 ||
       saliency_map.size() != cloud.xyz.size()) {
@@ -81,7 +82,7 @@ absl::StatusOr<IncScene> BuildIncScene(const OrganizedCloud& cloud,
         "saliency map must be CV_32FC1 of the cloud's size");
   }
   absl::StatusOr<CosScene> surfaces =
-      BuildCosScene(cloud, plane, options.surfaces);
+      BuildCosScene(cloud, plane, options.surfaces, region);
   if (!surfaces.ok()) return surfaces.status();
   IncScene scene;
   scene.surfaces = *std::move(surfaces);

@@ -72,13 +72,15 @@ struct IncScene {
   int object_points = 0;  // pixels of non-support surfaces
 };
 
-// Surfaces, their relations' statistics and saliency from `saliency_map`
+// Surfaces (of the points in `region`, as BuildCosScene), their
+// relations' statistics and saliency from `saliency_map`
 // (CV_32FC1 of the cloud's size, [0, 1]; NaN read as 0). Errors: invalid
 // options, a map of another size or type.
 absl::StatusOr<IncScene> BuildIncScene(const OrganizedCloud& cloud,
                                        const SupportPlane& plane,
                                        const cv::Mat& saliency_map,
-                                       const IncOptions& options);
+                                       const IncOptions& options,
+                                       const cv::Mat& region = cv::Mat());
 
 struct IncObject {
   cv::Mat mask;               // CV_8UC1, 255 on the object

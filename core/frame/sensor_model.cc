@@ -1,0 +1,95 @@
+#include "core/frame/sensor_model.h"
+
+#include <algorithm>
+
+#include "absl/strings/str_cat.h"
+#include "core/base/strings.h"
+
+namespace fovea {
+namespace {
+
+// Kinect v1: Khoshelham & Elberink 2012, sigma = 1.43e-3 z^2; OSD's scenes
+// lie within 0.5-2 m, and beyond 3.5 m the quantisation steps exceed 3 cm.
+constexpr float kKinectSigmaPerZ2 = 1.43e-3f;
+constexpr float kKinectMaxRange = 3.5f;
+constexpr float kKinectMinRange = 0.4f;
+// Active stereo (RealSense D4xx-like): RMS error about 2 % at 2 m for a
+// 5 cm baseline, i.e. 2.5e-3 / m, with the millimetre floor measured on the
+// table tops of shared/data/realsense; usable to about 3 m for a table.
+constexpr float kStereoSigma0 = 0.001f;
+constexpr float kStereoSigmaPerZ2 = 2.5e-3f;
+constexpr float kStereoMaxRange = 3.0f;
+constexpr float kStereoMinRange = 0.2f;
+// Generic: the structured-light PrimeSense family (Kinect v1, Xtion,
+// Carmine, Astra) registers depth to a colour camera of 525-580 px focal
+// length at 640 pixels wide; other cameras (RealSense D4xx colour at
+// 600-640, depth streams at 380-430, time of flight) get the active-stereo
+// model, the noisier of the two, with a 3 m range.
+constexpr double kPrimeSenseFx640Min = 500.0;
+constexpr double kPrimeSenseFx640Max = 590.0;
+constexpr float kGenericMaxRange = 3.0f;
+
+struct NamedKind {
+  SensorKind kind;
+  std::string_view name;
+};
+constexpr NamedKind kKinds[] = {
+    {SensorKind::kGeneric, "generic"},
+    {SensorKind::kKinectV1, "kinect_v1"},
+    {SensorKind::kActiveStereo, "active_stereo"},
+};
+
+}  // namespace
+
+std::string_view SensorKindName(SensorKind kind) {
+  for (const NamedKind& k : kKinds) {
+    if (k.kind == kind) return k.name;
+  }
+  return "unknown";
+}
+
+absl::StatusOr<SensorKind> ParseSensorKind(std::string_view text) {
+  for (const NamedKind& k : kKinds) {
+    if (k.name == text) return k.kind;
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat("sensor: unknown model '", AbslView(text),
+                   "' (known: generic kinect_v1 active_stereo)"));
+}
+
+SensorModel SensorModelFor(SensorKind kind, const Intrinsics& intrinsics) {
+  SensorModel model;
+  model.kind = kind;
+  switch (kind) {
+    case SensorKind::kKinectV1:
+      model.sigma0_m = 0.0f;
+      model.sigma_per_z2 = kKinectSigmaPerZ2;
+      model.max_range_m = kKinectMaxRange;
+      model.min_range_m = kKinectMinRange;
+      break;
+    case SensorKind::kActiveStereo:
+      model.sigma0_m = kStereoSigma0;
+      model.sigma_per_z2 = kStereoSigmaPerZ2;
+      model.max_range_m = kStereoMaxRange;
+      model.min_range_m = kStereoMinRange;
+      break;
+    case SensorKind::kGeneric: {
+      // The focal length a 640-pixel-wide frame of this camera would have.
+      const double width = 2.0 * (intrinsics.cx + 0.5);
+      const double fx640 = width > 0.0 && intrinsics.fx > 0.0
+                               ? intrinsics.fx * 640.0 / width
+                               : 0.0;
+      if (fx640 >= kPrimeSenseFx640Min && fx640 <= kPrimeSenseFx640Max) {
+        model = SensorModelFor(SensorKind::kKinectV1, intrinsics);
+      } else {
+        model = SensorModelFor(SensorKind::kActiveStereo, intrinsics);
+        model.max_range_m = kGenericMaxRange;
+      }
+      model.kind = SensorKind::kGeneric;
+      break;
+    }
+  }
+  return model;
+}
+
+}  // namespace fovea

@@ -1,0 +1,64 @@
+#include "core/frame/sensor_model.h"
+
+#include <gtest/gtest.h>
+
+namespace fovea {
+namespace {
+
+TEST(SensorModelTest, NamesRoundTripAndUnknownNamesListTheKnownOnes) {
+  for (const SensorKind kind : {SensorKind::kGeneric, SensorKind::kKinectV1,
+                                SensorKind::kActiveStereo}) {
+    absl::StatusOr<SensorKind> parsed = ParseSensorKind(SensorKindName(kind));
+    ASSERT_TRUE(parsed.ok());
+    EXPECT_EQ(*parsed, kind);
+  }
+  const absl::StatusOr<SensorKind> bad = ParseSensorKind("kinect");
+  EXPECT_EQ(bad.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(bad.status().message().find("active_stereo"), std::string::npos);
+}
+
+TEST(SensorModelTest, KinectNoiseIsKhoshelhamsQuadratic) {
+  const SensorModel k =
+      SensorModelFor(SensorKind::kKinectV1, kKinectV1Intrinsics);
+  EXPECT_NEAR(k.DepthSigma(1.0f), 1.43e-3f, 1e-6f);
+  EXPECT_NEAR(k.DepthSigma(2.0f), 4.0f * 1.43e-3f, 1e-6f);
+}
+
+TEST(SensorModelTest, ActiveStereoIsNoisierThanTheKinectAtEveryRange) {
+  const SensorModel k =
+      SensorModelFor(SensorKind::kKinectV1, kKinectV1Intrinsics);
+  const SensorModel s =
+      SensorModelFor(SensorKind::kActiveStereo, {613.0, 613.0, 322.5, 248.2});
+  for (const float z : {0.3f, 0.7f, 1.0f, 2.0f, 3.0f}) {
+    EXPECT_GT(s.DepthSigma(z), k.DepthSigma(z)) << z;
+  }
+  // A millimetre floor: what the RealSense frames' table tops show at 0.5 m.
+  EXPECT_GT(s.DepthSigma(0.5f), 0.001f);
+}
+
+TEST(SensorModelTest, GenericPicksTheModelFromTheFocalLength) {
+  // OSD's Kinect (525 px at 640), an Xtion (570 px): structured light.
+  for (const Intrinsics& k :
+       {kKinectV1Intrinsics, Intrinsics{570.3, 570.3, 319.5, 239.5},
+        Intrinsics{262.5, 262.5, 159.5, 119.5}}) {
+    const SensorModel g = SensorModelFor(SensorKind::kGeneric, k);
+    EXPECT_EQ(g.kind, SensorKind::kGeneric);
+    EXPECT_EQ(g.sigma_per_z2,
+              SensorModelFor(SensorKind::kKinectV1, k).sigma_per_z2)
+        << k.fx;
+  }
+  // A RealSense colour camera at 640x480 and at 1280x720, a depth stream
+  // (385 px at 640): the active-stereo model, 3 m range.
+  for (const Intrinsics& k : {Intrinsics{612.9, 613.2, 322.5, 248.2},
+                              Intrinsics{920.0, 920.0, 640.0, 360.0},
+                              Intrinsics{385.0, 385.0, 320.0, 240.0}}) {
+    const SensorModel g = SensorModelFor(SensorKind::kGeneric, k);
+    EXPECT_EQ(g.sigma_per_z2,
+              SensorModelFor(SensorKind::kActiveStereo, k).sigma_per_z2)
+        << k.fx;
+    EXPECT_FLOAT_EQ(g.max_range_m, 3.0f);
+  }
+}
+
+}  // namespace
+}  // namespace fovea
