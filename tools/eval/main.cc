@@ -3,6 +3,7 @@
 //   fovea-eval detect --data DIR [--saliency ph|sh|rso|ph+sh+rso]
 //                     [--extract msr] [--json] [--out DIR] [--verbose]
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
@@ -12,11 +13,15 @@
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
+#include "absl/strings/str_split.h"
 #include "core/pipeline/detect.h"
+#include "core/pipeline/models.h"
 #include "tools/eval/detect_eval.h"
 #include "tools/eval/inc_eval.h"
+#include "tools/eval/room_eval.h"
 #include "tools/eval/segment_eval.h"
 #include "tools/eval/sweep.h"
 
@@ -69,6 +74,12 @@ ABSL_FLAG(bool, msr_inhibit_slope, true,
 ABSL_FLAG(bool, fill_holes, false,
           "Fill small depth holes by colour-guided diffusion first "
           "(thesis section 2.2).");
+ABSL_FLAG(std::string, sensor,
+          std::string(fovea::SensorKindName(fovea::SceneOptions().sensor)),
+          "Depth noise model the thresholds follow: generic (from the "
+          "intrinsics), kinect_v1 or active_stereo.");
+ABSL_FLAG(int, processing_width, fovea::SceneOptions().processing_width,
+          "Frames wider than this are processed reduced, pixels.");
 ABSL_FLAG(bool, json, false,
           "Print a last line of JSON: scenes, hit_ratio, distance_to_center, "
           "hit_ratio_at, detect_ms_median.");
@@ -98,6 +109,14 @@ ABSL_FLAG(double, patch_angle, fovea::CosOptions().patches.max_normal_angle_deg,
 ABSL_FLAG(double, patch_distance,
           fovea::CosOptions().patches.max_plane_distance,
           "segment: COS planar patches' plane distance at 0 m, metres.");
+ABSL_FLAG(int, count, 200, "rooms: rooms per sensor and size.");
+ABSL_FLAG(uint64_t, seed, 1, "rooms: the first room's seed.");
+ABSL_FLAG(std::string, room_sensors, "kinect_v1,active_stereo",
+          "rooms: sensor noise models to render with, comma-separated.");
+ABSL_FLAG(std::string, sizes, "640x480",
+          "rooms: resolutions, comma-separated WxH (e.g. 640x480,1280x720).");
+ABSL_FLAG(std::string, models, FOVEA_DEFAULT_MODELS_DIR,
+          "rooms: the trained models, as the server loads them.");
 ABSL_FLAG(std::string, filter, "",
           "sweep: only the rows whose label saliency/pyramid/combine/norm/"
           "extract contains this.");
@@ -193,6 +212,15 @@ std::optional<DetectOptions> DetectOptionsFromFlags() {
                  "--norm lin|nms|nlm, --fusion sum|max\n");
     return std::nullopt;
   }
+  const absl::StatusOr<SensorKind> sensor =
+      ParseSensorKind(absl::GetFlag(FLAGS_sensor));
+  if (!sensor.ok()) {
+    std::fprintf(stderr, "fovea-eval: --%s\n",
+                 sensor.status().ToString().c_str());
+    return std::nullopt;
+  }
+  detect.scene.sensor = *sensor;
+  detect.scene.processing_width = absl::GetFlag(FLAGS_processing_width);
   detect.pyramid = *pyramid;
   detect.level_combination = *combine;
   detect.normalization = *norm;
@@ -419,6 +447,107 @@ int RunSegmentEval() {
   return 0;
 }
 
+void PrintRoomSummary(const RoomSummary& s, bool json) {
+  if (json) {
+    std::printf(
+        "{\"group\": \"%s\", \"rooms\": %d, \"support_correct\": %.4f, "
+        "\"object_recall\": %.4f, \"false_objects_per_frame\": %.4f, "
+        "\"overlap_p\": %.4f, \"overlap_r\": %.4f, \"overlap_f\": %.4f, "
+        "\"boundary_f\": %.4f, \"objects_075\": %.4f, \"whole_scene_f\": "
+        "%.4f, \"first_ms_median\": %.1f, \"total_ms_median\": %.1f}\n",
+        s.group.empty() ? "all" : s.group.c_str(), s.rooms, s.support_correct,
+        s.object_recall, s.false_objects_per_frame, s.overlap_p, s.overlap_r,
+        s.overlap_f, s.boundary_f, s.objects_075, s.whole_scene_f,
+        s.first_ms_median, s.total_ms_median);
+    return;
+  }
+  std::printf(
+      "%-26s %6d %8.3f %8.3f %7.2f %7.3f %7.3f %7.3f %7.3f %7.3f %8.1f %8.1f\n",
+      s.group.empty() ? "all" : s.group.c_str(), s.rooms, s.support_correct,
+      s.object_recall, s.false_objects_per_frame, s.overlap_p, s.overlap_r,
+      s.overlap_f, s.boundary_f, s.objects_075, s.first_ms_median,
+      s.total_ms_median);
+}
+
+int RunRoomsCommand() {
+  RoomEvalOptions options;
+  options.count = absl::GetFlag(FLAGS_count);
+  options.seed = absl::GetFlag(FLAGS_seed);
+  options.sensors.clear();
+  for (absl::string_view name :
+       absl::StrSplit(absl::GetFlag(FLAGS_room_sensors), ',')) {
+    absl::StatusOr<synth::RoomSensor> sensor =
+        synth::ParseRoomSensor(std::string(name));
+    if (!sensor.ok()) {
+      std::fprintf(stderr, "fovea-eval: --room_sensors: %s\n",
+                   sensor.status().ToString().c_str());
+      return kUsageError;
+    }
+    options.sensors.push_back(*sensor);
+  }
+  options.sizes.clear();
+  for (absl::string_view size :
+       absl::StrSplit(absl::GetFlag(FLAGS_sizes), ',')) {
+    const std::vector<std::string> wh = absl::StrSplit(size, 'x');
+    int w = 0, h = 0;
+    if (wh.size() != 2 || !absl::SimpleAtoi(wh[0], &w) ||
+        !absl::SimpleAtoi(wh[1], &h)) {
+      std::fprintf(stderr, "fovea-eval: --sizes: '%s' is not WxH\n",
+                   std::string(size).c_str());
+      return kUsageError;
+    }
+    options.sizes.emplace_back(w, h);
+  }
+  std::optional<DetectOptions> detect = DetectOptionsFromFlags();
+  if (!detect) return kUsageError;
+  options.run.detect = *std::move(detect);
+  absl::StatusOr<SceneMethod> method =
+      ParseSceneMethod(absl::GetFlag(FLAGS_method));
+  if (!method.ok()) {
+    std::fprintf(stderr, "fovea-eval: --method: %s\n",
+                 method.status().ToString().c_str());
+    return kUsageError;
+  }
+  options.run.method = *method;
+  absl::StatusOr<LoadedModels> models = LoadModels(absl::GetFlag(FLAGS_models));
+  if (!models.ok()) {
+    std::fprintf(stderr, "fovea-eval: %s\n",
+                 models.status().ToString().c_str());
+    return kRunError;
+  }
+  options.run.models = models->View();
+  options.out_dir = absl::GetFlag(FLAGS_out);
+  options.verbose = absl::GetFlag(FLAGS_verbose);
+  absl::StatusOr<std::vector<RoomResult>> results = EvaluateRooms(options);
+  if (!results.ok()) {
+    std::fprintf(stderr, "fovea-eval: %s\n",
+                 results.status().ToString().c_str());
+    return kRunError;
+  }
+  const bool json = absl::GetFlag(FLAGS_json);
+  std::printf(
+      "rooms, method %s, models %s (held out: nothing is trained on rooms)\n",
+      absl::GetFlag(FLAGS_method).c_str(), absl::GetFlag(FLAGS_models).c_str());
+  std::printf("%-26s %6s %8s %8s %7s %7s %7s %7s %7s %7s %8s %8s\n", "group",
+              "rooms", "support", "recall", "false/f", "ovl P", "ovl R",
+              "ovl F", "bnd F", "obj.75", "1st ms", "all ms");
+  std::vector<std::string> groups;
+  for (const RoomResult& r : *results) {
+    if (std::find(groups.begin(), groups.end(), r.group) == groups.end()) {
+      groups.push_back(r.group);
+    }
+  }
+  for (const std::string& g : groups)
+    PrintRoomSummary(SummarizeRooms(*results, g), false);
+  PrintRoomSummary(SummarizeRooms(*results, ""), false);
+  if (json) {
+    for (const std::string& g : groups)
+      PrintRoomSummary(SummarizeRooms(*results, g), true);
+    PrintRoomSummary(SummarizeRooms(*results, ""), true);
+  }
+  return 0;
+}
+
 int RunSweepCommand() {
   std::string data = absl::GetFlag(FLAGS_data);
   if (data.empty()) {
@@ -463,7 +592,11 @@ int main(int argc, char** argv) {
       "  fovea-eval segment --method cos|ebs|inc --data DIR [--seeds "
       "tj|wta|msr] "
       "[--inc_saliency sym3d|random-points] "
-      "[--folds 5] [--json] [--out DIR]   (Table 3.1, cross-validated)");
+      "[--folds 5] [--json] [--out DIR]   (Table 3.1, cross-validated)\n"
+      "  fovea-eval rooms [--count 200] [--seed 1] [--room_sensors "
+      "kinect_v1,active_stereo] [--sizes 640x480,1280x720] [--method "
+      "inc|cos|ebs|pcl-lccp|pcl-euclidean] [--models DIR] [--json] [--out "
+      "DIR]   (synthetic rooms, held out: support, recall, false objects)");
   std::vector<char*> args = absl::ParseCommandLine(argc, argv);
   if (args.size() < 2) {
     std::fprintf(stderr, "%s\n",
@@ -474,6 +607,7 @@ int main(int argc, char** argv) {
   if (command == "detect") return fovea::eval::RunDetectEval();
   if (command == "sweep") return fovea::eval::RunSweepCommand();
   if (command == "segment") return fovea::eval::RunSegmentEval();
+  if (command == "rooms") return fovea::eval::RunRoomsCommand();
   std::fprintf(stderr, "fovea-eval: unknown command '%s'\n%s\n",
                command.c_str(),
                std::string(absl::ProgramUsageMessage()).c_str());
