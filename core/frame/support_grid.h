@@ -96,6 +96,17 @@ std::vector<Eigen::Vector2f> HullOfMask(const OrganizedCloud& cloud,
                                         const cv::Mat& mask,
                                         const SupportPlane& plane);
 
+// The connected parts of `plane`'s near inliers (and of the grid points
+// `also`): 8-connected on the grid where neighbours lie within 2.5 grid
+// steps of each other in 3D (the inside of a bowl is not connected to the
+// table past its rim). parts[0] is empty; `labels` (optional) gets each grid
+// point's part (0 none).
+std::vector<std::vector<int>> PlaneParts(const Grid& grid, const Plane& plane,
+                                         const SupportPlaneOptions& options,
+                                         float min_cos,
+                                         const std::vector<int>& also,
+                                         std::vector<int>* labels = nullptr);
+
 // A candidate support surface.
 struct Candidate {
   Plane plane;
@@ -106,9 +117,9 @@ struct Candidate {
   SupportScore score;
 };
 
-// The connected parts (8-connected on the grid) of `plane`'s near inliers
-// with at least options.min_candidate_area_m2, each refitted by least
-// squares when `refit`.
+// The parts (PlaneParts) of `plane`'s near inliers with at least
+// options.min_candidate_area_m2, each refitted by least squares when
+// `refit`.
 std::vector<Candidate> SplitIntoSurfaces(const Grid& grid, const Plane& plane,
                                          const SupportPlaneOptions& options,
                                          float min_cos, bool refit);

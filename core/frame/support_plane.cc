@@ -319,6 +319,7 @@ absl::Status Validate(const SupportPlaneOptions& o) {
       {"under_height", o.under_height},
       {"under_reach", o.under_reach},
       {"max_occlusion_gap", o.max_occlusion_gap},
+      {"max_join_color_distance", o.max_join_color_distance},
   };
   for (const auto& [field, value] : non_negative) {
     if (!(value >= 0.0f) || !std::isfinite(value)) {

@@ -165,12 +165,17 @@ struct SupportPlaneOptions {
   float under_reach = 0.3f;   // metres
 
   // --- Support region ---
-  // Other connected parts of the chosen plane join the support region when
-  // what lies between them and it is hidden by something in front (objects
-  // standing on it split the table's image) rather than seen empty (a gap
-  // to another table, the floor past the edge): at most this far from the
-  // region in the plane, metres.
+  // Other connected parts of the chosen plane, of at least
+  // min_candidate_area_m2, join the support region when inside its hull or
+  // when what lies between them and it is hidden by something in front
+  // (objects standing on it split the table's image) rather than seen empty
+  // (a gap to another table, the floor past the edge): at most this far
+  // from the region in the plane, metres.
   float max_occlusion_gap = 0.4f;
+  // ... and when their colour is within this distance of the region's
+  // (CIE Lab, lightness counted half): a part of another colour is the
+  // inside of something standing on it, a bowl's bottom.
+  float max_join_color_distance = 20.0f;
 
   // Seed for the RANSAC sampler, so results are reproducible.
   uint32_t seed = 1;

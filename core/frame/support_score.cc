@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "core/base/lab.h"
 #include "core/frame/support_grid.h"
 
 namespace fovea::support_internal {
@@ -36,6 +37,10 @@ constexpr int kMaxRegionPairPoints = 200;  // subsamples for the nearest pair
 constexpr int kMaxPartPairPoints = 60;
 // Parts of the plane with fewer grid points are specks, not table.
 constexpr int kMinPartPoints = 4;
+// Plane parts: neighbours at most this many expected grid steps apart.
+constexpr float kPlaneStepFactor = 2.5f;
+// Weight of lightness in a part's colour distance from the region.
+constexpr float kLightnessWeight = 0.5f;
 
 struct Cluster {
   float min_height = std::numeric_limits<float>::infinity();
@@ -110,6 +115,67 @@ int DepthConnectedClusters(const Grid& grid, const std::vector<uint8_t>& mask,
   }
   return next;
 }
+
+}  // namespace
+
+std::vector<std::vector<int>> PlaneParts(const Grid& grid, const Plane& plane,
+                                         const SupportPlaneOptions& options,
+                                         float min_cos,
+                                         const std::vector<int>& also,
+                                         std::vector<int>* labels_out) {
+  std::vector<uint8_t> mask(grid.size(), 0);
+  for (int i = 0; i < grid.size(); ++i) {
+    mask[i] =
+        grid.HasPoint(i) && IsNearInlier(grid, i, plane, options, min_cos);
+  }
+  for (const int i : also) mask[i] = 1;
+  // Neighbours on one surface of the plane are about one grid step apart
+  // in 3D (the step at their depth, stretched by the plane's slant to the
+  // ray); farther apart, something hid the plane between them (a bowl's
+  // bottom and the table beyond its rim).
+  std::vector<int> labels(grid.size(), 0);
+  int n = 1;
+  std::vector<int> stack;
+  const float step_per_z = static_cast<float>(grid.stride / grid.intrinsics.fx);
+  for (int seed = 0; seed < grid.size(); ++seed) {
+    if (!mask[seed] || labels[seed] != 0) continue;
+    labels[seed] = n;
+    stack.assign(1, seed);
+    while (!stack.empty()) {
+      const int i = stack.back();
+      stack.pop_back();
+      const Eigen::Vector3f& p = grid.p[i];
+      const float incidence =
+          std::max(kMinCosIncidence, std::abs(plane.normal.dot(p)) / p.norm());
+      const float reach = kPlaneStepFactor * step_per_z * p.z() / incidence;
+      const int r = i / grid.cols, c = i % grid.cols;
+      for (int dr = -1; dr <= 1; ++dr) {
+        for (int dc = -1; dc <= 1; ++dc) {
+          const int rr = r + dr, cc = c + dc;
+          if ((dr == 0 && dc == 0) || rr < 0 || cc < 0 || rr >= grid.rows ||
+              cc >= grid.cols) {
+            continue;
+          }
+          const int j = rr * grid.cols + cc;
+          if (!mask[j] || labels[j] != 0) continue;
+          const float limit = (dr != 0 && dc != 0) ? reach * 1.4142f : reach;
+          if (!((grid.p[j] - p).squaredNorm() <= limit * limit)) continue;
+          labels[j] = n;
+          stack.push_back(j);
+        }
+      }
+    }
+    ++n;
+  }
+  std::vector<std::vector<int>> parts(n);
+  for (int i = 0; i < grid.size(); ++i) {
+    if (labels[i] > 0) parts[labels[i]].push_back(i);
+  }
+  if (labels_out != nullptr) *labels_out = std::move(labels);
+  return parts;
+}
+
+namespace {
 
 // How many object-sized clusters stand on `c`: clusters (depth-connected)
 // of everything above it, of which most lies inside its hull, that reach
@@ -276,6 +342,37 @@ std::pair<int, int> NearestPair(const Grid& grid, const SupportPlane& frame,
 // the plane are related by a homography, which keeps segments segments, so
 // a row's other points lie between its two ends (up to the noise across
 // the plane).
+// Mean CIE Lab colour (L in [0, 100]) of the grid points' pixels.
+cv::Vec3f MeanLab(const OrganizedCloud& cloud, const Grid& grid,
+                  const std::vector<int>& indices) {
+  cv::Vec3d sum(0, 0, 0);
+  for (const int i : indices) {
+    const cv::Vec3b& c = cloud.color.at<cv::Vec3b>(
+        (i / grid.cols) * grid.stride, (i % grid.cols) * grid.stride);
+    sum += cv::Vec3d(c[0], c[1], c[2]);
+  }
+  const double n = std::max<size_t>(1, indices.size());
+  cv::Mat rgb(
+      1, 1, CV_32FC3,
+      cv::Scalar(sum[0] / n / 255.0, sum[1] / n / 255.0, sum[2] / n / 255.0));
+  cv::Mat lab;
+  RgbToLab(rgb, &lab);
+  return lab.at<cv::Vec3f>(0, 0);
+}
+
+// Distance of the part's mean colour from `reference` (Lab), lightness
+// weighted by kLightnessWeight: shading and shadows change lightness
+// across one table far more than its hue.
+float ColorDistance(const OrganizedCloud& cloud, const Grid& grid,
+                    const cv::Vec3f& reference, const std::vector<int>& part) {
+  if (cloud.color.empty() || cloud.color.size() != cloud.xyz.size())
+    return 0.0f;
+  const cv::Vec3f c = MeanLab(cloud, grid, part);
+  const float dl = kLightnessWeight * (c[0] - reference[0]);
+  const float da = c[1] - reference[1], db = c[2] - reference[2];
+  return std::sqrt(dl * dl + da * da + db * db);
+}
+
 std::vector<Eigen::Vector2f> HullOfIndices(const Grid& grid,
                                            const SupportPlane& frame,
                                            const std::vector<int>& indices) {
@@ -427,19 +524,9 @@ std::vector<Eigen::Vector2f> HullOfMask(const OrganizedCloud& cloud,
 std::vector<Candidate> SplitIntoSurfaces(const Grid& grid, const Plane& plane,
                                          const SupportPlaneOptions& options,
                                          float min_cos, bool refit) {
-  cv::Mat mask(grid.rows, grid.cols, CV_8UC1, cv::Scalar(0));
-  for (int i = 0; i < grid.size(); ++i) {
-    if (grid.HasPoint(i) && IsNearInlier(grid, i, plane, options, min_cos)) {
-      mask.at<uint8_t>(i / grid.cols, i % grid.cols) = 255;
-    }
-  }
-  cv::Mat labels;
-  const int n = cv::connectedComponents(mask, labels, 8, CV_32S);
-  std::vector<std::vector<int>> parts(n);
-  for (int i = 0; i < grid.size(); ++i) {
-    const int l = labels.at<int>(i / grid.cols, i % grid.cols);
-    if (l > 0) parts[l].push_back(i);
-  }
+  const std::vector<std::vector<int>> parts =
+      PlaneParts(grid, plane, options, min_cos, {});
+  const int n = static_cast<int>(parts.size());
   std::vector<Candidate> candidates;
   for (int l = 1; l < n; ++l) {
     float area = 0.0f;
@@ -454,7 +541,7 @@ std::vector<Candidate> SplitIntoSurfaces(const Grid& grid, const Plane& plane,
         c.plane = *fit;
       }
     }
-    c.indices = std::move(parts[l]);
+    c.indices = parts[l];
     c.area_m2 = area;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (const int i : c.indices) sum += grid.p[i].cast<double>();
@@ -513,29 +600,16 @@ absl::StatusOr<SupportPlane> MakeSupportRegion(
     const OrganizedCloud& cloud, const Grid& grid, const Candidate& chosen,
     const SupportPlaneOptions& options, float min_cos) {
   // Every part of the chosen plane, the chosen one among them.
-  cv::Mat mask(grid.rows, grid.cols, CV_8UC1, cv::Scalar(0));
-  for (int i = 0; i < grid.size(); ++i) {
-    if (grid.HasPoint(i) &&
-        IsNearInlier(grid, i, chosen.plane, options, min_cos)) {
-      mask.at<uint8_t>(i / grid.cols, i % grid.cols) = 255;
-    }
-  }
-  for (const int i : chosen.indices) {
-    mask.at<uint8_t>(i / grid.cols, i % grid.cols) = 255;
-  }
-  cv::Mat labels;
-  const int n = cv::connectedComponents(mask, labels, 8, CV_32S);
-  std::vector<std::vector<int>> parts(n);
-  for (int i = 0; i < grid.size(); ++i) {
-    const int l = labels.at<int>(i / grid.cols, i % grid.cols);
-    if (l > 0) parts[l].push_back(i);
-  }
-  const int own = labels.at<int>(chosen.indices[0] / grid.cols,
-                                 chosen.indices[0] % grid.cols);
+  std::vector<int> labels;
+  const std::vector<std::vector<int>> parts =
+      PlaneParts(grid, chosen.plane, options, min_cos, chosen.indices, &labels);
+  const int n = static_cast<int>(parts.size());
+  const int own = labels[chosen.indices[0]];
   std::vector<bool> joined(n, false);
   joined[own] = true;
   std::vector<int> region = parts[own];
   SupportPlane frame = chosen.frame;
+  const cv::Vec3f region_color = MeanLab(cloud, grid, region);
   // Two passes: a part that joins widens the hull for the next.
   for (int pass = 0; pass < 2; ++pass) {
     frame.hull = HullOfIndices(grid, frame, region);
@@ -544,9 +618,21 @@ absl::StatusOr<SupportPlane> MakeSupportRegion(
       if (joined[l] || static_cast<int>(parts[l].size()) < kMinPartPoints) {
         continue;
       }
+      // Smaller parts are the insides of what stands on the table (a
+      // bowl's bottom) as often as the table between objects; left out, the
+      // segmentation treats both as what they touch.
+      float area = 0.0f;
+      for (const int i : parts[l]) area += grid.Area(i, chosen.plane.normal);
+      if (area < options.min_candidate_area_m2) continue;
       int inside = 0;
       for (const int i : parts[l]) {
         inside += InsideHull(frame.hull, frame.ToPlane(grid.p[i]), 0.0f);
+      }
+      // A part of another colour than the region is the inside of
+      // something standing on it (a bowl's bottom), not the table.
+      if (ColorDistance(cloud, grid, region_color, parts[l]) >
+          options.max_join_color_distance) {
+        continue;
       }
       bool join = inside >= kInsideShare * parts[l].size();
       if (!join) {
@@ -585,7 +671,16 @@ absl::StatusOr<SupportPlane> MakeSupportRegion(
   cv::Mat member(grid.rows, grid.cols, CV_8UC1, cv::Scalar(0));
   for (const int i : region)
     member.at<uint8_t>(i / grid.cols, i % grid.cols) = 255;
-  cv::dilate(member, member, cv::Mat());
+  // Cells of no point (holes, edges) take their neighbours' membership;
+  // cells of another surface do not.
+  cv::Mat grown;
+  cv::dilate(member, grown, cv::Mat());
+  for (int i = 0; i < grid.size(); ++i) {
+    if (!grid.HasPoint(i)) {
+      member.at<uint8_t>(i / grid.cols, i % grid.cols) =
+          grown.at<uint8_t>(i / grid.cols, i % grid.cols);
+    }
+  }
   const float min_cos_full = min_cos;
   plane.inliers =
       cv::Mat(cloud.height(), cloud.width(), CV_8UC1, cv::Scalar(0));
@@ -623,7 +718,7 @@ absl::StatusOr<SupportPlane> MakeSupportRegion(
     }
   }
   plane.inlier_count = count;
-  plane.hull = HullOfIndices(grid, plane, region);
+  plane.hull = HullOfMask(cloud, plane.inliers, plane);
   if (plane.hull.size() < 3) {
     return absl::NotFoundError("support plane: the region has no 2D extent");
   }

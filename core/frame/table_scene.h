@@ -1,7 +1,9 @@
 #ifndef FOVEA_CORE_FRAME_TABLE_SCENE_H_
 #define FOVEA_CORE_FRAME_TABLE_SCENE_H_
 
+#include <Eigen/Core>
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "core/frame/organized_cloud.h"
@@ -16,16 +18,29 @@ namespace fovea {
 //              the noise-dependent minimum and its projection inside the
 //              table's convex hull (thesis section 2.3.1), `hull_margin` from
 //              its boundary. Only these get saliency.
+//   standing:  CV_8UC1, 255 where a point stands on the table as a
+//              candidate does, but with no margin inside the hull (the
+//              candidates' superset).
 //   region:    CV_8UC1, 255 on the support region (SupportPlane::inliers)
 //              and on what may stand on it: points below max_object_height
 //              whose projection lies inside the hull. Everything else
 //              (floor, walls, other tables, chairs beside it) is outside
 //              the scene segmentation works on.
+//   structures: large vertical planes that extend beyond what can stand on
+//              the table (walls, cabinet sides, whiteboards rising at its
+//              edge); their points are in neither mask, even where noise
+//              projects them inside the hull.
 struct TableScene {
   cv::Mat height;
   cv::Mat candidate;
   int candidate_count = 0;
+  cv::Mat standing;
   cv::Mat region;
+  struct Plane {
+    Eigen::Vector3f normal = Eigen::Vector3f::UnitZ();  // unit
+    float d = 0.0f;                                     // metres
+  };
+  std::vector<Plane> structures;
 };
 
 struct TableSceneOptions {
@@ -45,6 +60,15 @@ struct TableSceneOptions {
   // the hull's boundary (within sensor noise); objects on the table keep
   // all but their outermost 2 cm.
   float hull_margin = 0.02f;
+  // Structures: vertical planes (normal within structure_tolerance_deg of
+  // perpendicular to the support's) of which at least structure_min_area_m2
+  // lies beyond the table (outside its hull, above max_object_height or
+  // below the table): 0.15 m^2 is larger than the face of any box a robot
+  // handles on a table, and the part beyond means it is not on the table.
+  // At most structure_max_planes are found (0 disables).
+  float structure_tolerance_deg = 15.0f;
+  float structure_min_area_m2 = 0.15f;
+  int structure_max_planes = 3;
 };
 
 absl::Status Validate(const TableSceneOptions& options);

@@ -185,14 +185,16 @@ absl::Status Validate(const SceneOptions& options) {
   if (options.processing_width < kMinProcessingWidth ||
       options.processing_width > kMaxProcessingWidth) {
     return absl::InvalidArgumentError(absl::StrCat(
-        "scene.processing_width must be in [", kMinProcessingWidth, ", ",
-        kMaxProcessingWidth, "], got ", options.processing_width));
+        "options.scene.processing_width must be in [", kMinProcessingWidth,
+        ", ", kMaxProcessingWidth, "], got ", options.processing_width));
   }
   if (absl::Status s = Validate(options.workspace); !s.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat("scene.", s.message()));
+    return absl::InvalidArgumentError(
+        absl::StrCat("options.scene.", s.message()));
   }
   if (absl::Status s = Validate(options.support); !s.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat("scene.", s.message()));
+    return absl::InvalidArgumentError(
+        absl::StrCat("options.scene.", s.message()));
   }
   return absl::OkStatus();
 }

@@ -113,8 +113,10 @@ absl::StatusOr<SegmentSummary> RunUnguarded(const RgbdFrame& frame,
     if (!next.ok()) return next.status();
     summary.timings.push_back({"segment.object", SecondsSince(lap)});
     if (!next->has_value()) break;  // the scene is exhausted
-    if (VisibleArea(scene->cloud, (*next)->mask) < options.min_object_area_m2) {
-      continue;  // a fragment: it left the scene, but is not reported
+    if (VisibleArea(scene->cloud, (*next)->mask) < options.min_object_area_m2 ||
+        StandingShare(scene->table, (*next)->mask) < kMinStandingShare) {
+      continue;  // a fragment, or not on the table: it left the scene, but
+                 // is not reported
     }
     SegmentedObject object;
     object.seed.u = (*next)->seed.x;

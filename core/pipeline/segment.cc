@@ -25,6 +25,21 @@ double SecondsSince(SteadyClock::time_point start) {
 
 }  // namespace
 
+double StandingShare(const TableScene& table, const cv::Mat& mask) {
+  int with_depth = 0, standing = 0;
+  for (int v = 0; v < mask.rows; ++v) {
+    const unsigned char* in = mask.ptr<unsigned char>(v);
+    const float* h = table.height.ptr<float>(v);
+    const unsigned char* c = table.standing.ptr<unsigned char>(v);
+    for (int u = 0; u < mask.cols; ++u) {
+      if (in[u] == 0 || std::isnan(h[u])) continue;
+      ++with_depth;
+      standing += c[u] != 0;
+    }
+  }
+  return with_depth > 0 ? static_cast<double>(standing) / with_depth : 1.0;
+}
+
 double VisibleArea(const OrganizedCloud& cloud, const cv::Mat& mask) {
   const double per_z2 = 1.0 / (cloud.intrinsics.fx * cloud.intrinsics.fy);
   double area = 0.0;
@@ -318,8 +333,9 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
     if (!cut.ok()) return cut.status();
     summary.timings.push_back({"segment.object", SecondsSince(lap)});
     if (!cut->has_value()) continue;
-    if (VisibleArea(scene->cloud, (*cut)->mask) < options.min_object_area_m2) {
-      continue;  // a fragment, not an object
+    if (VisibleArea(scene->cloud, (*cut)->mask) < options.min_object_area_m2 ||
+        StandingShare(scene->table, (*cut)->mask) < kMinStandingShare) {
+      continue;  // a fragment, or not on the table
     }
     SegmentedObject object;
     object.seed = seed;

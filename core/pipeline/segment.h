@@ -28,6 +28,12 @@ enum class SegmentMethod { kCos, kEbs };
 
 // The smallest object reported by default, m^2 (SegmentOptions).
 inline constexpr double kMinObjectAreaM2 = 4e-4;
+// Share of a mask's points with depth that must stand on the table
+// (TableScene::standing: above its noise band, projecting inside its
+// hull) for the mask to be reported: what rises just beyond the hull's edge
+// is a wall or a chair there, what lies within the noise band a remnant of
+// the table.
+inline constexpr double kMinStandingShare = 0.5;
 
 std::string_view SegmentMethodName(SegmentMethod method);  // "cos", "ebs"
 // "cos" or "ebs"; INVALID_ARGUMENT naming the known ones otherwise.
@@ -44,7 +50,8 @@ struct SegmentOptions {
   int max_objects = 0;
   // Masks showing less than this visible area are fragments (a rim, a
   // sliver of an occluded object, sensor noise) and are not reported, m^2:
-  // 4 cm^2 is a 2 x 2 cm face (VisibleArea).
+  // 4 cm^2 is a 2 x 2 cm face (VisibleArea). Nor are masks less than
+  // kMinStandingShare of which stands on the table.
   double min_object_area_m2 = kMinObjectAreaM2;
   CosOptions cos;
   // EBS's contour search at each seed.
@@ -80,6 +87,10 @@ struct SegmentedObject {
 // Fills the object's box, area, centroid and extent from its mask and the
 // cloud's points under it.
 void DescribeObject(const OrganizedCloud& cloud, SegmentedObject& object);
+
+// The share of the mask's pixels with depth that stand on `table`
+// (TableScene::standing), [0, 1] (1 for a mask without depth).
+double StandingShare(const TableScene& table, const cv::Mat& mask);
 
 // The area the mask's points show the camera, m^2: each pixel with depth z
 // covers z^2 / (fx fy) facing the camera (a lower bound of the surface's

@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 
+#include "core/synth/room.h"
 #include "core/synth/synth_scene.h"
 
 namespace fovea {
@@ -220,6 +222,47 @@ TEST(DetectTest, StageNamesCoverEveryStageARunReports) {
   EXPECT_NE(std::find(names.begin(), names.end(), "extract.tj"), names.end());
   EXPECT_NE(std::find(names.begin(), names.end(), "saliency.itti"),
             names.end());
+}
+
+}  // namespace
+}  // namespace fovea
+
+namespace fovea {
+namespace {
+
+TEST(RunDetectWideFrameTest,
+     ReducedProcessingReturnsInputPixelsAndTheirPoints) {
+  synth::RoomOptions room;
+  room.sensor = synth::RoomSensor::kActiveStereo;
+  room.width = 1280;
+  room.height = 720;
+  const synth::SynthScene scene = synth::GenerateRoom(5, room);
+  absl::StatusOr<DetectResult> result =
+      RunDetect(scene.frame.frame, DetectOptions{});
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_EQ(result->master.size(), cv::Size(1280, 720));
+  EXPECT_EQ(result->plane.inliers.size(), cv::Size(1280, 720));
+  ASSERT_FALSE(result->points.empty());
+  EXPECT_EQ(result->timings.front().stage, "reduce");
+  const Intrinsics& k = scene.frame.frame.intrinsics;
+  for (const AttentionPoint& p : result->points) {
+    ASSERT_LT(p.u, 1280);
+    ASSERT_LT(p.v, 720);
+    // The 3D point is where the input pixel looks, within a reduced pixel
+    // and the depth noise.
+    const float z = scene.frame.frame.depth.at<float>(p.v, p.u);
+    if (std::isnan(z) || std::isnan(p.point.z())) continue;
+    const Eigen::Vector3f seen((p.u - k.cx) * z / k.fx, (p.v - k.cy) * z / k.fy,
+                               z);
+    EXPECT_LT((seen - p.point).norm(), 0.03f) << p.u << "," << p.v;
+  }
+  // The same frame at its own resolution finds the same support.
+  DetectOptions full;
+  full.scene.processing_width = 1280;
+  absl::StatusOr<DetectResult> native = RunDetect(scene.frame.frame, full);
+  ASSERT_TRUE(native.ok()) << native.status();
+  EXPECT_GT(native->plane.normal.dot(result->plane.normal), std::cos(0.02f));
+  EXPECT_NEAR(native->plane.d, result->plane.d, 0.01f);
 }
 
 }  // namespace

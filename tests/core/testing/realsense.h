@@ -1,0 +1,107 @@
+#ifndef FOVEA_TESTS_CORE_TESTING_REALSENSE_H_
+#define FOVEA_TESTS_CORE_TESTING_REALSENSE_H_
+
+// The four raw RealSense-like frames of shared/data/realsense: where the
+// tests that need them find them, and their marked pixels.
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/frame/rgbd_frame.h"
+
+namespace fovea::testing {
+
+// $FOVEA_REALSENSE_DIR when it holds points.json, else "" (tests skip).
+inline std::string RealSenseDir() {
+  const char* root = std::getenv("FOVEA_REALSENSE_DIR");
+  if (root == nullptr) return "";
+  if (!std::filesystem::exists(std::filesystem::path(root) / "points.json")) {
+    return "";
+  }
+  return root;
+}
+
+struct RealSenseFrame {
+  std::string name;  // "rs0", ...
+  RgbdFrame frame;
+  std::vector<cv::Point> objects;    // one pixel on each object on the table
+  std::vector<cv::Point> table;      // on the table's top
+  std::vector<cv::Point> off_table;  // floor, chairs, other furniture
+};
+
+inline std::string ReadAll(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// The numbers after `"key":` in `json` (the first occurrence).
+inline double JsonNumber(const std::string& json, const std::string& key) {
+  const std::regex re("\"" + key + "\"\\s*:\\s*([-0-9.eE+]+)");
+  std::smatch m;
+  return std::regex_search(json, m, re)
+             ? std::stod(m[1].str())
+             : std::numeric_limits<double>::quiet_NaN();
+}
+
+// [[u, v], ...] after `"key":` within `block`.
+inline std::vector<cv::Point> JsonPixels(const std::string& block,
+                                         const std::string& key) {
+  std::vector<cv::Point> out;
+  const std::regex list("\"" + key +
+                        "\"\\s*:\\s*\\[((\\s*\\[[^\\]]*\\]\\s*,?)*)\\]");
+  std::smatch m;
+  if (!std::regex_search(block, m, list)) return out;
+  const std::string inner = m[1].str();
+  const std::regex pair("\\[\\s*(-?[0-9]+)\\s*,\\s*(-?[0-9]+)\\s*\\]");
+  for (auto it = std::sregex_iterator(inner.begin(), inner.end(), pair);
+       it != std::sregex_iterator(); ++it) {
+    out.emplace_back(std::stoi((*it)[1].str()), std::stoi((*it)[2].str()));
+  }
+  return out;
+}
+
+// The frames of `dir` (RealSenseDir()), in name order.
+inline std::vector<RealSenseFrame> LoadRealSenseFrames(const std::string& dir) {
+  const std::filesystem::path root(dir);
+  const std::string params = ReadAll(root / "camera_params.json");
+  const Intrinsics k{JsonNumber(params, "fx"), JsonNumber(params, "fy"),
+                     JsonNumber(params, "x_offset"),
+                     JsonNumber(params, "y_offset")};
+  const std::string points = ReadAll(root / "points.json");
+  std::vector<RealSenseFrame> frames;
+  const std::regex entry("\"(rs[0-9]+)\"\\s*:\\s*\\{([^}]*)\\}");
+  for (auto it = std::sregex_iterator(points.begin(), points.end(), entry);
+       it != std::sregex_iterator(); ++it) {
+    RealSenseFrame f;
+    f.name = (*it)[1].str();
+    const std::string block = (*it)[2].str();
+    f.objects = JsonPixels(block, "objects");
+    f.table = JsonPixels(block, "table");
+    f.off_table = JsonPixels(block, "off_table");
+    const cv::Mat bgr = cv::imread((root / (f.name + "_color.png")).string());
+    const cv::Mat mm = cv::imread((root / (f.name + "_depth_mm.png")).string(),
+                                  cv::IMREAD_UNCHANGED);
+    if (bgr.empty() || mm.empty()) continue;
+    cv::cvtColor(bgr, f.frame.color, cv::COLOR_BGR2RGB);
+    mm.convertTo(f.frame.depth, CV_32FC1, 0.001);
+    f.frame.depth.setTo(std::numeric_limits<float>::quiet_NaN(), mm == 0);
+    f.frame.intrinsics = k;
+    frames.push_back(std::move(f));
+  }
+  return frames;
+}
+
+}  // namespace fovea::testing
+
+#endif  // FOVEA_TESTS_CORE_TESTING_REALSENSE_H_
