@@ -207,9 +207,15 @@ void PrintDetectTable(const fovea::v1::DetectResponse& response,
   }
   if (response.has_support_plane()) {
     const fovea::v1::SupportPlane& plane = response.support_plane();
-    out << absl::StrFormat("support plane: n %s, d %.3f m, %d inliers\n",
-                           FormatPoint(plane.normal()), plane.d(),
-                           plane.inlier_count());
+    out << absl::StrFormat(
+        "support plane: n %s, d %.3f m, %d inliers; %s of %d candidates, "
+        "score %.2f (%d objects on it, %.2f m^2, %.2f m away, tilt %.1f "
+        "deg%s)\n",
+        FormatPoint(plane.normal()), plane.d(), plane.inlier_count(),
+        plane.given() ? "given" : "chosen", plane.candidate_count(),
+        plane.score().total(), plane.score().objects(), plane.score().area_m2(),
+        plane.score().distance_m(), plane.score().tilt_deg(),
+        plane.score().under_another() ? ", under another" : "");
   }
   double total = 0.0;
   if (response.timings_size() > 0) out << "timings:\n";
@@ -237,6 +243,15 @@ std::string DescribeSegmentMessage(const fovea::v1::SegmentResponse& message,
     parts.push_back(absl::StrCat("attention points ",
                                  message.attention_points_size(), ": ",
                                  absl::StrJoin(pixels, " ")));
+  }
+  if (message.has_support_plane()) {
+    const fovea::v1::SupportPlane& plane = message.support_plane();
+    parts.push_back(absl::StrFormat(
+        "support plane n %s d %.3f m (%s of %d candidates, %d objects on "
+        "it)",
+        FormatPoint(plane.normal()), plane.d(),
+        plane.given() ? "given" : "chosen", plane.candidate_count(),
+        plane.score().objects()));
   }
   if (message.has_object()) {
     const fovea::v1::ObjectResult& o = message.object();

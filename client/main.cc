@@ -100,6 +100,26 @@ ABSL_FLAG(int32_t, points, 0,
           "number of attention points, 0 = the server's default (10)");
 
 // Segmentation.
+// The scene.
+ABSL_FLAG(std::string, sensor, "",
+          "depth noise model: generic (chosen from the intrinsics, the "
+          "default) | kinect_v1 | active_stereo");
+ABSL_FLAG(int32_t, processing_width, 0,
+          "frames wider than this are processed reduced, pixels (0: the "
+          "server's 640)");
+ABSL_FLAG(std::string, gravity, "",
+          "X,Y,Z: unit vector pointing down in the camera frame");
+ABSL_FLAG(std::string, support_plane, "",
+          "NX,NY,NZ,D: the support plane n . p + d = 0 (camera frame, "
+          "metres), given instead of searched");
+ABSL_FLAG(std::string, workspace_box, "",
+          "MINX,MINY,MINZ,MAXX,MAXY,MAXZ: only points inside this camera-frame "
+          "box, metres");
+ABSL_FLAG(double, min_depth, 0.0,
+          "nearest depth considered, metres (0: the sensor's)");
+ABSL_FLAG(double, max_depth, 0.0,
+          "farthest depth considered, metres (0: the sensor's)");
+
 ABSL_FLAG(std::string, method, "", "segment: cos | ebs");
 ABSL_FLAG(int32_t, max_objects, 0, "segment: most objects, 0 = no limit");
 ABSL_FLAG(std::string, seeds, "",
@@ -196,6 +216,85 @@ absl::StatusOr<LoadedFrame> FrameFromFlags() {
   return LoadFrame(source);
 }
 
+// `count` comma-separated numbers of flag `name`; INVALID_ARGUMENT naming
+// it otherwise.
+absl::StatusOr<std::vector<double>> Numbers(const std::string& name,
+                                            const std::string& text,
+                                            size_t count) {
+  std::vector<double> values;
+  for (absl::string_view part : absl::StrSplit(text, ',')) {
+    double value = 0.0;
+    if (!absl::SimpleAtod(part, &value)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(name, ": '", part, "' is not a number"));
+    }
+    values.push_back(value);
+  }
+  if (values.size() != count) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(name, ": expected ", count,
+                     " comma-separated numbers, got ", values.size()));
+  }
+  return values;
+}
+
+// The scene options of the flags (the server validates the values).
+absl::Status SceneFromFlags(fovea::v1::SceneOptions& scene) {
+  const std::string sensor = absl::GetFlag(FLAGS_sensor);
+  if (sensor == "generic") {
+    scene.set_sensor(fovea::v1::SENSOR_MODEL_GENERIC);
+  } else if (sensor == "kinect_v1") {
+    scene.set_sensor(fovea::v1::SENSOR_MODEL_KINECT_V1);
+  } else if (sensor == "active_stereo") {
+    scene.set_sensor(fovea::v1::SENSOR_MODEL_ACTIVE_STEREO);
+  } else if (!sensor.empty()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("sensor: unknown model '", sensor,
+                     "' (known: generic kinect_v1 active_stereo)"));
+  }
+  if (absl::GetFlag(FLAGS_processing_width) < 0) {
+    return absl::InvalidArgumentError("processing_width: must be >= 0");
+  }
+  scene.set_processing_width(
+      static_cast<uint32_t>(absl::GetFlag(FLAGS_processing_width)));
+  if (const std::string g = absl::GetFlag(FLAGS_gravity); !g.empty()) {
+    absl::StatusOr<std::vector<double>> v = Numbers("gravity", g, 3);
+    if (!v.ok()) return v.status();
+    scene.mutable_gravity()->set_x((*v)[0]);
+    scene.mutable_gravity()->set_y((*v)[1]);
+    scene.mutable_gravity()->set_z((*v)[2]);
+  }
+  if (const std::string p = absl::GetFlag(FLAGS_support_plane); !p.empty()) {
+    absl::StatusOr<std::vector<double>> v = Numbers("support_plane", p, 4);
+    if (!v.ok()) return v.status();
+    fovea::v1::Plane* plane = scene.mutable_support_plane();
+    plane->mutable_normal()->set_x((*v)[0]);
+    plane->mutable_normal()->set_y((*v)[1]);
+    plane->mutable_normal()->set_z((*v)[2]);
+    plane->set_d((*v)[3]);
+  }
+  const std::string box = absl::GetFlag(FLAGS_workspace_box);
+  const double min_depth = absl::GetFlag(FLAGS_min_depth);
+  const double max_depth = absl::GetFlag(FLAGS_max_depth);
+  if (!box.empty() || min_depth != 0.0 || max_depth != 0.0) {
+    fovea::v1::Workspace* w = scene.mutable_workspace();
+    w->set_min_depth_m(min_depth);
+    w->set_max_depth_m(max_depth);
+    if (!box.empty()) {
+      absl::StatusOr<std::vector<double>> v = Numbers("workspace_box", box, 6);
+      if (!v.ok()) return v.status();
+      fovea::v1::Box* b = w->mutable_box();
+      b->mutable_min()->set_x((*v)[0]);
+      b->mutable_min()->set_y((*v)[1]);
+      b->mutable_min()->set_z((*v)[2]);
+      b->mutable_max()->set_x((*v)[3]);
+      b->mutable_max()->set_y((*v)[4]);
+      b->mutable_max()->set_z((*v)[5]);
+    }
+  }
+  return absl::OkStatus();
+}
+
 // Detect options from the flags; INVALID_ARGUMENT naming a bad one.
 absl::StatusOr<fovea::v1::DetectOptions> DetectOptionsFromFlags() {
   fovea::v1::DetectOptions options;
@@ -238,6 +337,10 @@ absl::StatusOr<fovea::v1::DetectOptions> DetectOptionsFromFlags() {
     options.set_split_at_surface_edges(*split);
   }
   options.set_return_saliency_map(!absl::GetFlag(FLAGS_out).empty());
+  if (absl::Status status = SceneFromFlags(*options.mutable_scene());
+      !status.ok()) {
+    return status;
+  }
   return options;
 }
 

@@ -102,6 +102,11 @@ v1::Capabilities BuildCapabilities(
     model->set_version(version);
   }
   out.set_segment_incremental(true);
+  for (const v1::SensorModel model :
+       {v1::SENSOR_MODEL_GENERIC, v1::SENSOR_MODEL_KINECT_V1,
+        v1::SENSOR_MODEL_ACTIVE_STEREO}) {
+    out.add_sensor_models(model);
+  }
   *out.mutable_default_detect_options() = ToProtoDetectOptions(DetectOptions{});
   return out;
 }

@@ -254,6 +254,56 @@ absl::Status ApplyTopDownCues(const v1::DetectOptions& options,
   return absl::OkStatus();
 }
 
+Eigen::Vector3f ToVector3f(double x, double y, double z) {
+  return Eigen::Vector3d(x, y, z).cast<float>();
+}
+
+// The scene options (core validates them, naming options.scene.*).
+absl::Status ApplyScene(const v1::SceneOptions& in, DetectOptions& out) {
+  SceneOptions& scene = out.scene;
+  switch (in.sensor()) {
+    case v1::SENSOR_MODEL_UNSPECIFIED:
+    case v1::SENSOR_MODEL_GENERIC:
+      scene.sensor = SensorKind::kGeneric;
+      break;
+    case v1::SENSOR_MODEL_KINECT_V1:
+      scene.sensor = SensorKind::kKinectV1;
+      break;
+    case v1::SENSOR_MODEL_ACTIVE_STEREO:
+      scene.sensor = SensorKind::kActiveStereo;
+      break;
+    default:
+      return UnknownEnumValue("options.scene.sensor", in.sensor());
+  }
+  if (in.processing_width() != 0) {
+    scene.processing_width =
+        static_cast<int>(std::min<uint32_t>(in.processing_width(), 1u << 20));
+  }
+  if (in.has_gravity()) {
+    scene.support.gravity =
+        ToVector3f(in.gravity().x(), in.gravity().y(), in.gravity().z());
+  }
+  if (in.has_support_plane()) {
+    const v1::Plane& plane = in.support_plane();
+    Eigen::Vector4f p;
+    p.head<3>() =
+        ToVector3f(plane.normal().x(), plane.normal().y(), plane.normal().z());
+    p[3] = static_cast<float>(plane.d());
+    scene.support.plane = p;
+  }
+  if (in.has_workspace()) {
+    const v1::Workspace& w = in.workspace();
+    scene.workspace.min_depth_m = static_cast<float>(w.min_depth_m());
+    scene.workspace.max_depth_m = static_cast<float>(w.max_depth_m());
+    if (w.has_box()) {
+      scene.workspace.box = Workspace::Box{
+          ToVector3f(w.box().min().x(), w.box().min().y(), w.box().min().z()),
+          ToVector3f(w.box().max().x(), w.box().max().y(), w.box().max().z())};
+    }
+  }
+  return absl::OkStatus();
+}
+
 v1::Point3 ToPoint3(const Eigen::Vector3f& p) {
   v1::Point3 out;
   out.set_x(p.x());
@@ -382,6 +432,9 @@ absl::StatusOr<DetectOptions> ToDetectOptions(
   if (absl::Status status = ApplyTopDownCues(options, out); !status.ok()) {
     return status;
   }
+  if (absl::Status status = ApplyScene(options.scene(), out); !status.ok()) {
+    return status;
+  }
 
   // Core names the field itself ("options.saliency: 'ph' is given more
   // than once ...").
@@ -486,6 +539,20 @@ v1::DetectOptions ToProtoDetectOptions(const DetectOptions& options) {
   out.set_max_points(static_cast<uint32_t>(options.max_points));
   out.set_return_channel_maps(options.keep_channel_maps);
   out.set_split_at_surface_edges(options.split_at_surface_edges);
+  v1::SceneOptions* scene = out.mutable_scene();
+  switch (options.scene.sensor) {
+    case SensorKind::kGeneric:
+      scene->set_sensor(v1::SENSOR_MODEL_GENERIC);
+      break;
+    case SensorKind::kKinectV1:
+      scene->set_sensor(v1::SENSOR_MODEL_KINECT_V1);
+      break;
+    case SensorKind::kActiveStereo:
+      scene->set_sensor(v1::SENSOR_MODEL_ACTIVE_STEREO);
+      break;
+  }
+  scene->set_processing_width(
+      static_cast<uint32_t>(options.scene.processing_width));
   return out;
 }
 
@@ -513,6 +580,23 @@ absl::StatusOr<std::string> EncodeSaliencyPng(const cv::Mat& map) {
   }
 }
 
+v1::SupportPlane ToProtoSupportPlane(const SupportPlane& plane) {
+  v1::SupportPlane out;
+  *out.mutable_normal() = ToPoint3(plane.normal);
+  out.set_d(plane.d);
+  out.set_inlier_count(static_cast<uint32_t>(plane.inlier_count));
+  out.set_candidate_count(static_cast<uint32_t>(plane.candidate_count));
+  v1::SupportScore* score = out.mutable_score();
+  score->set_total(plane.score.total);
+  score->set_objects(static_cast<uint32_t>(plane.score.objects));
+  score->set_area_m2(plane.score.area_m2);
+  score->set_distance_m(plane.score.distance_m);
+  score->set_tilt_deg(plane.score.tilt_deg);
+  score->set_under_another(plane.score.under_another);
+  out.set_given(plane.given);
+  return out;
+}
+
 absl::StatusOr<v1::DetectResponse> ToDetectResponse(
     const DetectResult& result, const v1::DetectRequest& request) {
   v1::DetectResponse response;
@@ -530,10 +614,7 @@ absl::StatusOr<v1::DetectResponse> ToDetectResponse(
     out->set_rank(static_cast<uint32_t>(i));
   }
 
-  v1::SupportPlane* plane = response.mutable_support_plane();
-  *plane->mutable_normal() = ToPoint3(result.plane.normal);
-  plane->set_d(result.plane.d);
-  plane->set_inlier_count(static_cast<uint32_t>(result.plane.inlier_count));
+  *response.mutable_support_plane() = ToProtoSupportPlane(result.plane);
 
   if (request.options().return_saliency_map()) {
     if (absl::Status status = AddMap("master", result.master, response);
@@ -646,9 +727,12 @@ v1::RleMask ToRleMask(const cv::Mat& mask) {
 }
 
 v1::SegmentResponse ToPointsMessage(const std::vector<AttentionPoint>& points,
-                                    const std::string& request_id) {
+                                    const std::string& request_id,
+                                    const SupportPlane* plane) {
   v1::SegmentResponse message;
   message.set_request_id(request_id);
+  if (plane != nullptr)
+    *message.mutable_support_plane() = ToProtoSupportPlane(*plane);
   for (size_t i = 0; i < points.size(); ++i) {
     v1::AttentionPoint* out = message.add_attention_points();
     out->set_u(static_cast<uint32_t>(points[i].u));

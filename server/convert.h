@@ -47,6 +47,10 @@ v1::Frame ToProtoFrame(const RgbdFrame& frame, DepthEncoding depth_encoding,
 //     INVALID_ARGUMENT naming "options.max_points";
 //   - target_color_rgb must be empty or 3 values of at most 255, and
 //     location_prior_sigma_px finite and >= 0 (INVALID_ARGUMENT);
+//   - scene: the sensor (UNSPECIFIED = generic), processing_width (0 = 640),
+//     gravity, support_plane and workspace when set, validated by core
+//     (INVALID_ARGUMENT naming "options.scene.gravity", ...: NaN, zero or
+//     non-unit vectors, empty boxes, depths out of order);
 //   - finally core's Validate(DetectOptions): an operator or strategy not
 //     built yet is UNIMPLEMENTED and names it, e.g. "options.saliency:
 //     'sym3d' is not implemented yet".
@@ -96,9 +100,14 @@ absl::StatusOr<IncrementalOptions> ToIncrementalOptions(
 v1::RleMask ToRleMask(const cv::Mat& mask);
 
 // The first message of a segmentation stream: the seeds used, ranked in
-// order.
+// order, and the support plane (when not null).
 v1::SegmentResponse ToPointsMessage(const std::vector<AttentionPoint>& points,
-                                    const std::string& request_id);
+                                    const std::string& request_id,
+                                    const SupportPlane* plane = nullptr);
+
+// The support plane as the wire states it: plane, inlier count, how many
+// candidates there were and the chosen one's score.
+v1::SupportPlane ToProtoSupportPlane(const SupportPlane& plane);
 
 // One object's message.
 v1::SegmentResponse ToObjectMessage(const SegmentedObject& object,

@@ -1,5 +1,6 @@
 #include "server/handle_segment.h"
 
+#include <optional>
 #include <utility>
 
 #include "server/convert.h"
@@ -36,9 +37,15 @@ absl::Status Stream(std::string_view method, const v1::Frame& wire_frame,
     return status;
   }
   int objects = 0;
+  std::optional<SupportPlane> support;
   SegmentSinks sinks;
+  sinks.support = [&](const SupportPlane& plane) {
+    support = plane;
+    return absl::OkStatus();
+  };
   sinks.points = [&](const std::vector<AttentionPoint>& points) {
-    return context.send(ToPointsMessage(points, request_id));
+    return context.send(ToPointsMessage(
+        points, request_id, support.has_value() ? &*support : nullptr));
   };
   sinks.object = [&](SegmentedObject object) {
     if (objects++ == 0) RecordFirstObject(method, object.seconds_since_start);

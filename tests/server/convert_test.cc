@@ -1,6 +1,7 @@
 #include "server/convert.h"
 
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
@@ -166,6 +167,119 @@ TEST(ToDetectOptionsTest, DefaultsSurviveTheWire) {
   EXPECT_EQ(back->extraction, defaults.extraction);
   EXPECT_EQ(back->max_points, defaults.max_points);
   EXPECT_EQ(back->split_at_surface_edges, defaults.split_at_surface_edges);
+}
+
+TEST(ToDetectOptionsTest, SceneOptionsReachCore) {
+  v1::DetectOptions in;
+  v1::SceneOptions* scene = in.mutable_scene();
+  scene->set_sensor(v1::SENSOR_MODEL_ACTIVE_STEREO);
+  scene->set_processing_width(800);
+  scene->mutable_gravity()->set_y(1.0);
+  scene->mutable_support_plane()->mutable_normal()->set_y(-1.0);
+  scene->mutable_support_plane()->set_d(0.7);
+  scene->mutable_workspace()->set_max_depth_m(2.5);
+  scene->mutable_workspace()->mutable_box()->mutable_min()->set_x(-1.0);
+  scene->mutable_workspace()->mutable_box()->mutable_min()->set_y(-1.0);
+  scene->mutable_workspace()->mutable_box()->mutable_max()->set_x(1.0);
+  scene->mutable_workspace()->mutable_box()->mutable_max()->set_y(1.0);
+  scene->mutable_workspace()->mutable_box()->mutable_max()->set_z(2.0);
+  absl::StatusOr<DetectOptions> out = ToDetectOptions(in);
+  ASSERT_TRUE(out.ok()) << out.status();
+  EXPECT_EQ(out->scene.sensor, SensorKind::kActiveStereo);
+  EXPECT_EQ(out->scene.processing_width, 800);
+  ASSERT_TRUE(out->scene.support.gravity.has_value());
+  EXPECT_FLOAT_EQ(out->scene.support.gravity->y(), 1.0f);
+  ASSERT_TRUE(out->scene.support.plane.has_value());
+  EXPECT_FLOAT_EQ((*out->scene.support.plane)[3], 0.7f);
+  EXPECT_FLOAT_EQ(out->scene.workspace.max_depth_m, 2.5f);
+  ASSERT_TRUE(out->scene.workspace.box.has_value());
+  EXPECT_FLOAT_EQ(out->scene.workspace.box->max.z(), 2.0f);
+  // Unset, the scene is the default one.
+  absl::StatusOr<DetectOptions> plain = ToDetectOptions(v1::DetectOptions());
+  ASSERT_TRUE(plain.ok());
+  EXPECT_EQ(plain->scene.sensor, SensorKind::kGeneric);
+  EXPECT_EQ(plain->scene.processing_width, 640);
+  EXPECT_FALSE(plain->scene.support.gravity.has_value());
+  EXPECT_FALSE(plain->scene.workspace.box.has_value());
+}
+
+TEST(ToDetectOptionsTest, BadSceneHintsAreInvalidAndNamed) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  struct Case {
+    std::function<void(v1::SceneOptions&)> set;
+    std::string field;
+  };
+  const std::vector<Case> cases = {
+      {[&](v1::SceneOptions& s) { s.mutable_gravity()->set_x(nan); },
+       "options.scene.gravity: must be finite"},
+      {[](v1::SceneOptions& s) { s.mutable_gravity(); },  // zero vector
+       "options.scene.gravity: must be a unit vector"},
+      {[](v1::SceneOptions& s) { s.mutable_gravity()->set_z(3.0); },
+       "options.scene.gravity: must be a unit vector, got length 3"},
+      {[](v1::SceneOptions& s) {
+         s.mutable_support_plane()->mutable_normal()->set_y(0.5);
+       },
+       "options.scene.support_plane.normal"},
+      {[&](v1::SceneOptions& s) {
+         s.mutable_support_plane()->mutable_normal()->set_y(1.0);
+         s.mutable_support_plane()->set_d(nan);
+       },
+       "options.scene.support_plane.d"},
+      {[](v1::SceneOptions& s) { s.mutable_workspace()->mutable_box(); },
+       "options.scene.workspace.box is empty"},
+      {[](v1::SceneOptions& s) {
+         s.mutable_workspace()->set_min_depth_m(2.0);
+         s.mutable_workspace()->set_max_depth_m(1.0);
+       },
+       "options.scene.workspace.max_depth_m must exceed"},
+      {[](v1::SceneOptions& s) {
+         s.mutable_workspace()->set_max_depth_m(-1.0);
+       },
+       "options.scene.workspace.max_depth_m"},
+      {[](v1::SceneOptions& s) { s.set_processing_width(50); },
+       "options.scene.processing_width"},
+      {[](v1::SceneOptions& s) {
+         s.set_sensor(static_cast<v1::SensorModel>(77));
+       },
+       "options.scene.sensor: unknown value 77"},
+  };
+  for (const Case& c : cases) {
+    v1::DetectOptions in;
+    c.set(*in.mutable_scene());
+    const absl::Status status = ToDetectOptions(in).status();
+    EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument) << c.field;
+    EXPECT_THAT(status.message(), HasSubstr(c.field));
+  }
+  // Segment requests name the nested field.
+  v1::SegmentRequest request;
+  request.mutable_detect_options()->mutable_scene()->mutable_gravity();
+  EXPECT_THAT(ToSegmentOptions(request).status().message(),
+              HasSubstr("detect_options.options.scene.gravity"));
+}
+
+TEST(ToProtoSupportPlaneTest, CarriesTheChoiceAndItsScore) {
+  SupportPlane plane;
+  plane.normal = {0.0f, -0.8f, -0.6f};
+  plane.d = 0.7f;
+  plane.inlier_count = 1234;
+  plane.candidate_count = 4;
+  plane.score.total = 5.5;
+  plane.score.objects = 3;
+  plane.score.area_m2 = 0.5f;
+  plane.score.distance_m = 0.9f;
+  plane.score.tilt_deg = 1.5f;
+  const v1::SupportPlane out = ToProtoSupportPlane(plane);
+  EXPECT_FLOAT_EQ(out.normal().y(), -0.8f);
+  EXPECT_EQ(out.inlier_count(), 1234u);
+  EXPECT_EQ(out.candidate_count(), 4u);
+  EXPECT_DOUBLE_EQ(out.score().total(), 5.5);
+  EXPECT_EQ(out.score().objects(), 3u);
+  EXPECT_FALSE(out.score().under_another());
+  EXPECT_FALSE(out.given());
+  // The first message of a stream carries it.
+  const v1::SegmentResponse first = ToPointsMessage({}, "r", &plane);
+  EXPECT_EQ(first.support_plane().candidate_count(), 4u);
+  EXPECT_FALSE(ToPointsMessage({}, "r").has_support_plane());
 }
 
 TEST(ToRawFrameTest, ViewsPointIntoTheRequest) {

@@ -12,6 +12,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/base/strings.h"
 #include "core/pipeline/detect.h"
+#include "core/synth/room.h"
 #include "core/synth/synth_scene.h"
 #include "fovea/v1/perception.grpc.pb.h"
 #include "gmock/gmock.h"
@@ -138,6 +139,79 @@ TEST_F(ServerTest, RawFrameOf1280x720FitsTheDefaultMessageLimit) {
   v1::DetectResponse response;
   const grpc::Status status = Detect(request, &response);
   EXPECT_TRUE(status.ok()) << status.error_message();
+}
+
+TEST_F(ServerTest,
+       AWholeRoomAt1280x720GivesTheTableAndItsObjectsAtInputPixels) {
+  StartServer();
+  synth::RoomOptions room;
+  room.sensor = synth::RoomSensor::kActiveStereo;
+  room.width = 1280;
+  room.height = 720;
+  const synth::SynthScene scene = synth::GenerateRoom(7, room);
+  v1::SegmentIncrementalRequest request;
+  *request.mutable_frame() =
+      ToProtoFrame(scene.frame.frame, DepthEncoding::k16UC1);
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() +
+                       std::chrono::seconds(60));
+  auto reader = stub_->SegmentIncremental(&context, request);
+  std::vector<v1::SegmentResponse> messages;
+  v1::SegmentResponse response;
+  while (reader->Read(&response)) messages.push_back(response);
+  const grpc::Status status = reader->Finish();
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_GE(messages.size(), 3u);
+  // The first message says which support was chosen and why.
+  const v1::SupportPlane& plane = messages.front().support_plane();
+  EXPECT_GT(plane.normal().x() * scene.table_normal_camera.x() +
+                plane.normal().y() * scene.table_normal_camera.y() +
+                plane.normal().z() * scene.table_normal_camera.z(),
+            std::cos(3.0 * M_PI / 180.0));
+  EXPECT_NEAR(plane.d(), scene.table_d_camera, 0.02);
+  EXPECT_GE(plane.candidate_count(), 1u);
+  EXPECT_GT(plane.score().objects(), 0u);
+  // Masks come back at the input size, on the table's objects.
+  for (size_t i = 1; i + 1 < messages.size(); ++i) {
+    const v1::ObjectResult& object = messages[i].object();
+    EXPECT_EQ(object.mask().width(), 1280u);
+    EXPECT_EQ(object.mask().height(), 720u);
+    EXPECT_LT(object.box().u() + object.box().width(), 1281u);
+    const int label =
+        scene.frame.labels.at<int>(static_cast<int>(object.seed().v()),
+                                   static_cast<int>(object.seed().u()));
+    EXPECT_TRUE(label >= 20 || label == 0)
+        << "object " << i - 1 << "'s seed lies on label " << label;
+  }
+}
+
+TEST_F(ServerTest, BadSceneHintsAreInvalidArgumentNamingTheField) {
+  StartServer();
+  v1::DetectRequest request = MakeSyntheticRequest(1, false).request;
+  request.mutable_options()->mutable_scene()->mutable_gravity()->set_y(2.0);
+  v1::DetectResponse response;
+  grpc::Status status = Detect(request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("options.scene.gravity"));
+  request = MakeSyntheticRequest(1, false).request;
+  request.mutable_options()
+      ->mutable_scene()
+      ->mutable_workspace()
+      ->mutable_box();
+  status = Detect(request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("options.scene.workspace.box"));
+  // A good gravity is used: the table is found with it.
+  request = MakeSyntheticRequest(1, false).request;
+  const synth::SynthScene scene = synth::GenerateScene(1);
+  v1::Vector3* g =
+      request.mutable_options()->mutable_scene()->mutable_gravity();
+  g->set_x(-scene.table_normal_camera.x());
+  g->set_y(-scene.table_normal_camera.y());
+  g->set_z(-scene.table_normal_camera.z());
+  status = Detect(request, &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_LT(response.support_plane().score().tilt_deg(), 3.0);
 }
 
 TEST_F(ServerTest, CueWithoutItsValueAndTooManyPointsAreInvalid) {
