@@ -14,6 +14,7 @@
 #include "core/frame/osd_pcd.h"
 #include "core/pipeline/detect.h"
 #include "core/saliency/rso.h"
+#include "core/synth/room.h"
 #include "core/synth/synth_scene.h"
 
 namespace fovea::bench {
@@ -189,6 +190,18 @@ void AddSyntheticScenes(const std::vector<uint64_t>& seeds, SceneList& scenes) {
   for (const uint64_t seed : seeds) {
     synth::SynthScene synth = synth::GenerateScene(seed);
     AddScene(synth.frame.name, synth.frame.frame, scenes);
+  }
+}
+
+void AddRoomScenes(const std::vector<uint64_t>& seeds, synth::RoomSensor sensor,
+                   int width, int height, SceneList& scenes) {
+  synth::RoomOptions options;
+  options.sensor = sensor;
+  options.width = width;
+  options.height = height;
+  for (const uint64_t seed : seeds) {
+    synth::SynthScene room = synth::GenerateRoom(seed, options);
+    AddScene(room.frame.name, room.frame.frame, scenes);
   }
 }
 

@@ -14,6 +14,7 @@
 #include "core/frame/support_plane.h"
 #include "core/frame/table_scene.h"
 #include "core/segmentation/ebs.h"
+#include "core/synth/room.h"
 
 namespace fovea::bench {
 
@@ -72,6 +73,11 @@ const absl::StatusOr<EbsModel>& BenchEbsModel();
 // Synthetic scenes from core/synth, one per seed. Scenes whose preparation
 // fails are left out with a line on stderr.
 void AddSyntheticScenes(const std::vector<uint64_t>& seeds, SceneList& scenes);
+
+// Synthetic rooms (core/synth/room.h) of one sensor and size, one per
+// seed: uncropped frames with floor, walls and furniture around the table.
+void AddRoomScenes(const std::vector<uint64_t>& seeds, synth::RoomSensor sensor,
+                   int width, int height, SceneList& scenes);
 
 // The OSD learn*.pcd scenes of `osd_dir`/learn (all of them when
 // `max_scenes` <= 0). Scenes whose preparation fails are left out with a

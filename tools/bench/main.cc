@@ -49,6 +49,8 @@ using fovea::bench::SweepOptions;
 
 // Synthetic scenes timed; GenerateScene gives 2-6 objects for 1..20.
 constexpr uint64_t kSynthSeeds[] = {1, 2, 3, 4};
+// Synthetic rooms timed, from an active-stereo camera.
+constexpr uint64_t kRoomSeeds[] = {1, 2, 3, 4, 5, 6, 7, 8};
 
 constexpr const char* kDefaultFlags[] = {
     "--benchmark_repetitions=5",
@@ -209,6 +211,23 @@ int main(int argc, char** argv) {
   benchmark::AddCustomContext("osd_frames", std::to_string(osd.size()));
   benchmark::AddCustomContext("opencv_threads",
                               std::to_string(cv::getNumThreads()));
+
+  // Whole frames of three kinds in one run: uncropped rooms from an
+  // active-stereo camera at 640x480 and at 1280x720 (the same seeds), and
+  // the cropped OSD scenes.
+  static SceneList rooms640;
+  static SceneList rooms1280;
+  const std::vector<uint64_t> room_seeds(std::begin(kRoomSeeds),
+                                         std::end(kRoomSeeds));
+  fovea::bench::AddRoomScenes(
+      room_seeds, fovea::synth::RoomSensor::kActiveStereo, 640, 480, rooms640);
+  fovea::bench::AddRoomScenes(room_seeds,
+                              fovea::synth::RoomSensor::kActiveStereo, 1280,
+                              720, rooms1280);
+  fovea::bench::RegisterFrameCases({{"room-640x480", &rooms640},
+                                    {"room-1280x720", &rooms1280},
+                                    {"osd", &osd}},
+                                   flags.sweep);
 
   // Synthetic cases first, then the OSD ones; in each, the gRPC cases come
   // right after the in-process Detect cases they compare with.

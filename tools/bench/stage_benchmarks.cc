@@ -16,6 +16,7 @@
 #include "core/frame/surface_edges.h"
 #include "core/frame/table_scene.h"
 #include "core/pipeline/detect.h"
+#include "core/pipeline/incremental.h"
 #include "core/pipeline/models.h"
 #include "core/pipeline/segment.h"
 #include "core/saliency/ph.h"
@@ -83,8 +84,9 @@ absl::Status PrepareFrame(const BenchScene& scene,
   return absl::OkStatus();
 }
 
-void RegisterFrameCases(const SceneList* scenes, const std::string& set,
-                        const std::string& suffix, const SweepOptions& sweep) {
+void RegisterFramePrepCases(const SceneList* scenes, const std::string& set,
+                            const std::string& suffix,
+                            const SweepOptions& sweep) {
   const DetectOptions defaults;
   Register("BM_DecodeRaw" + suffix, scenes, set, sweep, kDecodeRawMs,
            [](const BenchScene& scene) {
@@ -464,12 +466,42 @@ void SweepScenes(benchmark::State& state, const SceneList& scenes,
       absl::StrCat(scenes.size(), " ", AbslView(set_name), " frames"));
 }
 
+void RegisterFrameCases(
+    const std::vector<std::pair<std::string, const SceneList*>>& sets,
+    const SweepOptions& sweep) {
+  for (const auto& [name, scenes] : sets) {
+    if (scenes->empty()) continue;
+    Register("BM_Frame/detect/" + name, scenes, name, sweep, kDetectMs,
+             [](const BenchScene& scene) {
+               absl::StatusOr<RgbdFrame> frame =
+                   DecodeFrame(scene.raw_wire, BenchFrameLimits());
+               if (!frame.ok()) return frame.status();
+               absl::StatusOr<DetectResult> result =
+                   RunDetect(*frame, DetectOptions{});
+               benchmark::DoNotOptimize(result);
+               return result.status();
+             });
+    Register("BM_Frame/inc/" + name, scenes, name, sweep, kSegmentMs,
+             [](const BenchScene& scene) {
+               const absl::StatusOr<LoadedModels>& models = BenchModels();
+               if (!models.ok()) return models.status();
+               absl::StatusOr<RgbdFrame> frame =
+                   DecodeFrame(scene.raw_wire, BenchFrameLimits());
+               if (!frame.ok()) return frame.status();
+               absl::StatusOr<SegmentSummary> summary = RunSegmentIncremental(
+                   *frame, IncrementalOptions{}, &*models->inc, SegmentSinks{});
+               benchmark::DoNotOptimize(summary);
+               return summary.status();
+             });
+  }
+}
+
 void RegisterStageBenchmarks(const SceneList* scenes,
                              const std::string& set_name,
                              const std::string& suffix,
                              const SweepOptions& sweep) {
   if (scenes->empty()) return;
-  RegisterFrameCases(scenes, set_name, suffix, sweep);
+  RegisterFramePrepCases(scenes, set_name, suffix, sweep);
   RegisterSaliencyCases(scenes, set_name, suffix, sweep);
   RegisterSurfaceModelCases(scenes, set_name, suffix, sweep);
   RegisterDetectCases(scenes, set_name, suffix, sweep);

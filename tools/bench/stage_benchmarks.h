@@ -7,6 +7,8 @@
 #include <functional>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "tools/bench/bench_inputs.h"
@@ -47,6 +49,15 @@ void RegisterStageBenchmarks(const SceneList* scenes,
                              const std::string& set_name,
                              const std::string& suffix,
                              const SweepOptions& sweep);
+
+// Whole requests from the raw wire frame, as the server runs them in
+// process: decode, then Detect ("BM_Frame/detect/<set>") or
+// SegmentIncremental to the end of the scene ("BM_Frame/inc/<set>"), each
+// with default options. Registered for each set of `sets` (name, scenes)
+// in order, so that frames of different resolutions are timed in one run.
+void RegisterFrameCases(
+    const std::vector<std::pair<std::string, const SceneList*>>& sets,
+    const SweepOptions& sweep);
 
 // The saliency channel sets of the Detect cases: "ph", "sh", "rso",
 // "ph+sh+rso".
