@@ -20,7 +20,10 @@ def detect_options(**options):
     Fields are named as in the proto: max_points=5, extraction="MSR",
     pyramid="SIMPLE", split_at_surface_edges=False, ... Enum values may be
     given by name. `saliency` may be a list of operator names ("rso", "ph")
-    or of (name, weight) pairs. Raises ValueError for an unknown field.
+    or of (name, weight) pairs. Messages may be dicts, e.g. what the robot
+    knows of the scene: scene={"gravity": {"x": 0, "y": 0.7, "z": 0.7},
+    "sensor": "SENSOR_MODEL_ACTIVE_STEREO", "workspace": {"max_depth_m":
+    2.0}}. Raises ValueError for an unknown field.
     """
     saliency = options.pop("saliency", None)
     message = detect_pb2.DetectOptions(**options)

@@ -96,6 +96,29 @@ class ExampleTest(unittest.TestCase):
                 capabilities = client.capabilities(timeout=10)
                 self.assertIn("32FC1", capabilities.depth_encodings)
 
+    def test_scene_hints_go_as_dicts_and_bad_ones_are_named(self):
+        # A table 0.75 m below a camera looking 45 degrees down.
+        h, w, fx = 120, 160, 130.0
+        v, u = numpy.mgrid[0:h, 0:w].astype(numpy.float64)
+        ray_y, ray_z = (v - 59.5) / fx, numpy.ones_like(v)
+        normal = numpy.array([0.0, -numpy.sqrt(0.5), -numpy.sqrt(0.5)])
+        z = 0.75 / -(normal[1] * ray_y + normal[2] * ray_z)
+        depth = numpy.where(z > 0, z, numpy.nan).astype(numpy.float32)
+        rgb = numpy.full((h, w, 3), 128, numpy.uint8)
+        down = {"x": 0.0, "y": numpy.sqrt(0.5), "z": numpy.sqrt(0.5)}
+        with FoveaClient(self.target) as client:
+            response = client.detect(
+                rgb, depth, fx=fx, fy=fx, cx=79.5, cy=59.5, timeout=30,
+                scene={"gravity": down, "sensor": "SENSOR_MODEL_KINECT_V1"})
+            self.assertLess(response.support_plane.score.tilt_deg, 2.0)
+            self.assertAlmostEqual(response.support_plane.d, 0.75, delta=0.01)
+            with self.assertRaises(grpc.RpcError) as caught:
+                client.detect(rgb, depth, fx=fx, fy=fx, cx=79.5, cy=59.5,
+                              timeout=30, scene={"gravity": {"y": 2.0}})
+        self.assertEqual(caught.exception.code(),
+                         grpc.StatusCode.INVALID_ARGUMENT)
+        self.assertIn("options.scene.gravity", caught.exception.details())
+
     def test_bad_frame_is_invalid_argument(self):
         rgb = numpy.zeros((4, 4, 3), numpy.uint8)
         depth = numpy.zeros((4, 4), numpy.float32)
