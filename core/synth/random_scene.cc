@@ -58,6 +58,9 @@ constexpr float kMinSupportHalfSize = 0.025f;   // metres
 // Shape mix (box, cylinder, sphere, cone) and cylinder poses.
 constexpr float kShapeWeights[4] = {0.35f, 0.3f, 0.15f, 0.2f};
 constexpr float kLyingCylinderProbability = 0.3f;
+// Leaning boxes: tilt, radians.
+constexpr float kMinLean = 0.21f;  // 12 degrees
+constexpr float kMaxLean = 0.52f;  // 30 degrees
 
 // Placement, metres.
 constexpr float kTableMargin = 0.03f;  // footprints keep off the edge
@@ -94,13 +97,19 @@ struct Body {
   Shape shape = Shape::kBox;
   Vector3f half_extents = Vector3f::Constant(0.05f);  // box; z for cyl/cone
   float radius = 0.05f;
-  bool lying = false;  // cylinder on its side
+  bool lying = false;        // cylinder on its side
+  float lean = 0.0f;         // box tilted about its local y axis, radians
+  float thickness = 0.005f;  // bowl and cup walls
   Vector3f rgb = Vector3f::Constant(0.5f);
 
   float Height() const {
     switch (shape) {
       case Shape::kBox:
+        return 2.0f * (half_extents.x() * std::sin(lean) +
+                       half_extents.z() * std::cos(lean));
       case Shape::kCone:
+      case Shape::kBowl:
+      case Shape::kCup:
         return 2.0f * half_extents.z();
       case Shape::kCylinder:
         return lying ? 2.0f * radius : 2.0f * half_extents.z();
@@ -126,11 +135,15 @@ Placed Pose(const Body& body, const Vector2f& xy, float base_z, float yaw) {
   p.shape = body.shape;
   p.half_extents = body.half_extents;
   p.radius = body.radius;
+  p.thickness = body.thickness;
   p.rgb = body.rgb;
   Eigen::Matrix3f rotation =
       Eigen::AngleAxisf(yaw, Vector3f::UnitZ()).toRotationMatrix();
   if (body.lying) {  // local z (the axis) along the yawed world x
     rotation = rotation * Eigen::AngleAxisf(kPi / 2.0f, Vector3f::UnitY());
+  }
+  if (body.lean != 0.0f) {  // leaning over towards the yawed world x
+    rotation = rotation * Eigen::AngleAxisf(body.lean, Vector3f::UnitY());
   }
   p.pose = Eigen::Isometry3f::Identity();
   p.pose.linear() = rotation;
@@ -144,6 +157,10 @@ Placed Pose(const Body& body, const Vector2f& xy, float base_z, float yaw) {
   if (body.shape == Shape::kBox) {
     f.is_circle = false;
     f.half = body.half_extents.head<2>();
+    if (body.lean != 0.0f) {  // the tilted box's vertical projection
+      f.half.x() = body.half_extents.x() * std::cos(body.lean) +
+                   body.half_extents.z() * std::sin(body.lean);
+    }
   } else if (body.lying) {
     f.is_circle = false;
     f.half = Vector2f(body.half_extents.z(), body.radius);
@@ -207,6 +224,83 @@ Shape RandomShape(Random& rng) {
   return Shape::kCone;
 }
 
+// The household mix: what a kitchen or office table holds.
+enum class HouseholdKind {
+  kBox,
+  kBook,
+  kCylinder,
+  kBowl,
+  kCup,
+  kSphere,
+  kCone
+};
+constexpr float kHouseholdWeights[7] = {0.25f, 0.12f, 0.2f, 0.13f,
+                                        0.15f, 0.05f, 0.1f};
+
+// Household bodies, metres: books lie flat; bowls are 10-18 cm across and
+// 45-70 % as deep as their radius; cups 6-9 cm across, 8-12 cm tall.
+Body RandomHouseholdBody(const Vector3f& rgb, Random& rng) {
+  float r = static_cast<float>(rng.Uniform());
+  int kind = 0;
+  for (; kind < 6 && r >= kHouseholdWeights[kind]; ++kind) {
+    r -= kHouseholdWeights[kind];
+  }
+  Body body;
+  body.rgb = rgb;
+  switch (static_cast<HouseholdKind>(kind)) {
+    case HouseholdKind::kBook:
+      body.shape = Shape::kBox;
+      body.half_extents = {rng.Uniform(0.06f, 0.11f), rng.Uniform(0.04f, 0.08f),
+                           rng.Uniform(0.008f, 0.02f)};
+      return body;
+    case HouseholdKind::kBowl:
+      body.shape = Shape::kBowl;
+      body.radius = rng.Uniform(0.05f, 0.09f);
+      body.half_extents = {body.radius, body.radius,
+                           body.radius * rng.Uniform(0.45f, 0.7f) / 2.0f};
+      body.thickness = rng.Uniform(0.004f, 0.008f);
+      return body;
+    case HouseholdKind::kCup:
+      body.shape = Shape::kCup;
+      body.radius = rng.Uniform(0.03f, 0.045f);
+      body.half_extents = {body.radius, body.radius, rng.Uniform(0.04f, 0.06f)};
+      body.thickness = rng.Uniform(0.003f, 0.005f);
+      return body;
+    default:
+      break;
+  }
+  // Boxes, cylinders, spheres and cones as RandomBody draws them.
+  static constexpr Shape kRest[] = {Shape::kBox, Shape::kBox, Shape::kCylinder,
+                                    Shape::kBox, Shape::kBox, Shape::kSphere,
+                                    Shape::kCone};
+  body.shape = kRest[kind];
+  switch (body.shape) {
+    case Shape::kBox:
+      body.half_extents = {rng.Uniform(kBoxHalfMin, kBoxHalfMax),
+                           rng.Uniform(kBoxHalfMin, kBoxHalfMax),
+                           rng.Uniform(kBoxHalfMin, kBoxHalfHeightMax)};
+      break;
+    case Shape::kCylinder:
+      body.radius = rng.Uniform(kCylinderRadiusMin, kCylinderRadiusMax);
+      body.half_extents = {
+          body.radius, body.radius,
+          rng.Uniform(kCylinderHalfHeightMin, kCylinderHalfHeightMax)};
+      body.lying = rng.Bernoulli(kLyingCylinderProbability);
+      break;
+    case Shape::kSphere:
+      body.radius = rng.Uniform(kSphereRadiusMin, kSphereRadiusMax);
+      body.half_extents = Vector3f::Constant(body.radius);
+      break;
+    default:
+      body.shape = Shape::kCone;
+      body.radius = rng.Uniform(kConeRadiusMin, kConeRadiusMax);
+      body.half_extents = {body.radius, body.radius,
+                           rng.Uniform(kConeHalfHeightMin, kConeHalfHeightMax)};
+      break;
+  }
+  return body;
+}
+
 Body RandomBody(const Vector3f& rgb, Random& rng) {
   Body body;
   body.shape = RandomShape(rng);
@@ -233,6 +327,9 @@ Body RandomBody(const Vector3f& rgb, Random& rng) {
       body.half_extents = {body.radius, body.radius,
                            rng.Uniform(kConeHalfHeightMin, kConeHalfHeightMax)};
       break;
+    case Shape::kBowl:
+    case Shape::kCup:
+      break;  // only in the household mix
   }
   return body;
 }
@@ -247,10 +344,11 @@ struct Candidate {
 
 // Anywhere in the work area around `target` (the camera's look-at point on
 // the table); Admissible() rejects what is off the table.
-Candidate ProposeFree(const Vector2f& target, const Body& body, Random& rng) {
-  const Vector2f xy =
-      target + Vector2f(rng.Uniform(-kWorkAreaHalf.x(), kWorkAreaHalf.x()),
-                        rng.Uniform(-kWorkAreaHalf.y(), kWorkAreaHalf.y()));
+Candidate ProposeFree(const Vector2f& target, const Body& body, float scale,
+                      Random& rng) {
+  const Vector2f half = kWorkAreaHalf * scale;
+  const Vector2f xy = target + Vector2f(rng.Uniform(-half.x(), half.x()),
+                                        rng.Uniform(-half.y(), half.y()));
   return {Pose(body, xy, 0.0f, rng.Uniform(0.0f, 2.0f * kPi)), kFreeClearance,
           -1};
 }
@@ -359,6 +457,37 @@ std::optional<Candidate> ProposeOccluding(const std::vector<Placed>& placed,
                    kFreeClearance, -1};
 }
 
+// A box leaning over towards an object on the table, its foot beside it:
+// tilted by 12-30 degrees about a horizontal axis, its top reaching over
+// the gap to the other object.
+std::optional<Candidate> ProposeLeaning(const std::vector<Placed>& placed,
+                                        const Vector3f& rgb, Random& rng) {
+  const std::vector<int> targets = OnTable(placed);
+  if (targets.empty()) return std::nullopt;
+  const Footprint& target =
+      placed[targets[rng.UniformInt(0, static_cast<int>(targets.size()) - 1)]]
+          .footprint;
+  Body body;
+  body.shape = Shape::kBox;
+  body.rgb = rgb;
+  body.half_extents = {rng.Uniform(0.008f, 0.025f), rng.Uniform(0.03f, 0.07f),
+                       rng.Uniform(0.05f, 0.09f)};
+  body.lean = rng.Uniform(kMinLean, kMaxLean);
+  const float angle = rng.Uniform(0.0f, 2.0f * kPi);
+  const Vector2f dir(std::cos(angle), std::sin(angle));  // target to box
+  // A tilt about local y takes the top towards local +x: point local x at
+  // the target (-dir from the box).
+  const float yaw = angle + kPi;
+  const Placed at_target = Pose(body, target.centre, 0.0f, yaw);
+  const float distance =
+      ContactDistance(target, at_target.footprint, target.centre, dir);
+  Candidate c{
+      Pose(body, target.centre + (distance + kContactGap) * dir, 0.0f, yaw),
+      kContactGap / 2.0f, -1};
+  c.placed.carries = true;  // nothing stacks on a leaning box
+  return c;
+}
+
 // Whether every footprint point at both heights projects at least
 // kViewMarginPx inside the image.
 bool InView(const Footprint& f, const SceneSpec& spec) {
@@ -455,8 +584,14 @@ std::optional<Candidate> Propose(const std::vector<Placed>& placed,
                                  Random& rng) {
   const Vector3f rgb =
       RandomAlbedo(spec.table_rgb, options.dark_object_probability, rng);
-  const Body body = RandomBody(rgb, rng);
+  const Body body =
+      options.household ? RandomHouseholdBody(rgb, rng) : RandomBody(rgb, rng);
   float r = static_cast<float>(rng.Uniform());
+  if (!placed.empty() && options.lean_probability > 0.0f) {
+    if ((r -= options.lean_probability) < 0.0f) {
+      return ProposeLeaning(placed, rgb, rng);
+    }
+  }
   if (!placed.empty()) {
     if ((r -= options.stack_probability) < 0.0f) {
       return ProposeStacked(placed, rgb, rng);
@@ -468,7 +603,7 @@ std::optional<Candidate> Propose(const std::vector<Placed>& placed,
       return ProposeOccluding(placed, spec, body, rng);
     }
   }
-  return ProposeFree(target, body, rng);
+  return ProposeFree(target, body, options.work_area_scale, rng);
 }
 
 }  // namespace
@@ -492,12 +627,20 @@ absl::Status Validate(const RandomSceneOptions& options) {
           "min_visible_fraction must be in [0, 1]");
     }
   }
+  if (!(options.lean_probability >= 0.0f && options.lean_probability <= 1.0f)) {
+    return absl::InvalidArgumentError(
+        "RandomSceneOptions.lean_probability must be in [0, 1]");
+  }
   if (options.stack_probability + options.touch_probability +
-          options.occlude_probability >
+          options.occlude_probability + options.lean_probability >
       1.0f) {
     return absl::InvalidArgumentError(
         "RandomSceneOptions: stack_probability + touch_probability + "
-        "occlude_probability must be <= 1");
+        "occlude_probability + lean_probability must be <= 1");
+  }
+  if (!(options.work_area_scale > 0.0f && options.work_area_scale <= 1.0f)) {
+    return absl::InvalidArgumentError(
+        "RandomSceneOptions.work_area_scale must be in (0, 1]");
   }
   if (!(options.camera_height > 0.0f) || !(options.camera_distance >= 0.0f) ||
       !(options.camera_jitter >= 0.0f)) {

@@ -161,6 +161,102 @@ std::optional<RayHit> IntersectCone(float r, float h, const Vector3f& o,
   return best;
 }
 
+// The hits of the sphere |p - c| = r whose point satisfies `keep`, with
+// normal (p - c) / r times `sign` (+1 outward, -1 inward).
+template <typename Keep>
+void SphereHits(const Vector3f& c, float r, float sign, const Vector3f& o,
+                const Vector3f& d, float t_min, float t_max, Keep keep,
+                std::optional<RayHit>* best) {
+  const Vector3f oc = o - c;
+  float roots[2];
+  const int n = SolveQuadratic(d.squaredNorm(), oc.dot(d),
+                               oc.squaredNorm() - r * r, roots);
+  for (int i = 0; i < n; ++i) {
+    const Vector3f p = o + roots[i] * d;
+    if (keep(p)) KeepNearest(roots[i], sign * (p - c) / r, t_min, t_max, best);
+  }
+}
+
+// The hits of the vertical cylinder x^2 + y^2 = r^2 with z in [z0, z1].
+void CylinderSideHits(float r, float z0, float z1, float sign,
+                      const Vector3f& o, const Vector3f& d, float t_min,
+                      float t_max, std::optional<RayHit>* best) {
+  float roots[2];
+  const int n = SolveQuadratic(d.x() * d.x() + d.y() * d.y(),
+                               o.x() * d.x() + o.y() * d.y(),
+                               o.x() * o.x() + o.y() * o.y() - r * r, roots);
+  for (int i = 0; i < n; ++i) {
+    const Vector3f p = o + roots[i] * d;
+    if (p.z() >= z0 - kBoundSlack && p.z() <= z1 + kBoundSlack) {
+      KeepNearest(roots[i], sign * Vector3f(p.x(), p.y(), 0.0f).normalized(),
+                  t_min, t_max, best);
+    }
+  }
+}
+
+// The hit of the horizontal annulus at height z with radii in
+// [r_in, r_out], normal +z times `sign`.
+void AnnulusHit(float z, float r_in, float r_out, float sign, const Vector3f& o,
+                const Vector3f& d, float t_min, float t_max,
+                std::optional<RayHit>* best) {
+  if (std::abs(d.z()) < kTiny || !(r_out > 0.0f)) return;
+  const float t = (z - o.z()) / d.z();
+  const Vector3f p = o + t * d;
+  const float rho2 = p.x() * p.x() + p.y() * p.y();
+  if (rho2 >= r_in * r_in - kBoundSlack &&
+      rho2 <= r_out * r_out + kBoundSlack) {
+    KeepNearest(t, Vector3f(0.0f, 0.0f, sign), t_min, t_max, best);
+  }
+}
+
+// Bowl: see synth_scene.h. Outer sphere centre (0, 0, h), radius r; inner
+// radius r - w; foot at z = -h; inside bottom at z = -h + w.
+std::optional<RayHit> IntersectBowl(float r, float h, float w,
+                                    const Vector3f& o, const Vector3f& d,
+                                    float t_min, float t_max) {
+  std::optional<RayHit> best;
+  const Vector3f c(0.0f, 0.0f, h);
+  const float r_in = r - w;
+  const float z_foot = -h;
+  const float z_inner = -h + w;
+  SphereHits(
+      c, r, 1.0f, o, d, t_min, t_max,
+      [&](const Vector3f& p) {
+        return p.z() <= h + kBoundSlack && p.z() >= z_foot - kBoundSlack;
+      },
+      &best);
+  SphereHits(
+      c, r_in, -1.0f, o, d, t_min, t_max,
+      [&](const Vector3f& p) {
+        return p.z() <= h + kBoundSlack && p.z() >= z_inner - kBoundSlack;
+      },
+      &best);
+  AnnulusHit(h, r_in, r, 1.0f, o, d, t_min, t_max, &best);  // the rim
+  const float foot =
+      std::sqrt(std::max(0.0f, r * r - (h - z_foot) * (h - z_foot)));
+  AnnulusHit(z_foot, 0.0f, foot, -1.0f, o, d, t_min, t_max, &best);
+  const float below = h - z_inner;
+  if (r_in > below) {
+    AnnulusHit(z_inner, 0.0f, std::sqrt(r_in * r_in - below * below), 1.0f, o,
+               d, t_min, t_max, &best);
+  }
+  return best;
+}
+
+// Cup: outer radius r, wall and bottom w thick, z in [-h, h], open top.
+std::optional<RayHit> IntersectCup(float r, float h, float w, const Vector3f& o,
+                                   const Vector3f& d, float t_min,
+                                   float t_max) {
+  std::optional<RayHit> best;
+  const float r_in = r - w;
+  CylinderSideHits(r, -h, h, 1.0f, o, d, t_min, t_max, &best);
+  CylinderSideHits(r_in, -h + w, h, -1.0f, o, d, t_min, t_max, &best);
+  AnnulusHit(h, r_in, r, 1.0f, o, d, t_min, t_max, &best);          // rim
+  AnnulusHit(-h, 0.0f, r, -1.0f, o, d, t_min, t_max, &best);        // foot
+  AnnulusHit(-h + w, 0.0f, r_in, 1.0f, o, d, t_min, t_max, &best);  // inside
+  return best;
+}
+
 std::optional<RayHit> IntersectLocal(const Primitive& primitive,
                                      const Vector3f& o, const Vector3f& d,
                                      float t_min, float t_max) {
@@ -174,6 +270,12 @@ std::optional<RayHit> IntersectLocal(const Primitive& primitive,
       return IntersectSphere(primitive.radius, o, d, t_min, t_max);
     case Shape::kCone:
       return IntersectCone(primitive.radius, h.z(), o, d, t_min, t_max);
+    case Shape::kBowl:
+      return IntersectBowl(primitive.radius, h.z(), primitive.thickness, o, d,
+                           t_min, t_max);
+    case Shape::kCup:
+      return IntersectCup(primitive.radius, h.z(), primitive.thickness, o, d,
+                          t_min, t_max);
   }
   return std::nullopt;
 }
@@ -187,9 +289,12 @@ float BoundingRadius(const Primitive& primitive) {
       return h.norm();
     case Shape::kCylinder:
     case Shape::kCone:
+    case Shape::kCup:
       return std::sqrt(r * r + h.z() * h.z());
     case Shape::kSphere:
       return r;
+    case Shape::kBowl:
+      return std::sqrt(r * r + h.z() * h.z());  // rim circle at z = +h
   }
   return h.norm() + r;
 }

@@ -245,6 +245,18 @@ absl::Status Validate(const SceneSpec& spec) {
       return absl::InvalidArgumentError(
           absl::StrCat(field, ".half_extents.z must be > 0"));
     }
+    const bool hollow = p.shape == Shape::kBowl || p.shape == Shape::kCup;
+    if (hollow && !(p.thickness > 0.0f && p.thickness < p.radius &&
+                    p.thickness < 2.0f * p.half_extents.z())) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          field, ".thickness must be > 0 and below the radius and height"));
+    }
+    if (p.shape == Shape::kBowl && !(2.0f * p.half_extents.z() < p.radius)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(field,
+                       ": a bowl's depth (2 half_extents.z) must be "
+                       "below its radius"));
+    }
   }
   return absl::OkStatus();
 }
@@ -435,6 +447,28 @@ SynthScene RenderScene(const SceneSpec& spec, const NoiseOptions& noise,
 SynthScene GenerateScene(uint64_t seed) {
   return RenderScene(RandomSceneSpec(seed, RandomSceneOptions{}),
                      NoiseOptions{}, seed);
+}
+
+RandomSceneOptions PileOptions() {
+  RandomSceneOptions o;
+  o.min_objects = 8;
+  o.max_objects = 16;
+  o.household = true;
+  o.stack_probability = 0.25f;
+  o.touch_probability = 0.4f;
+  o.occlude_probability = 0.1f;
+  o.lean_probability = 0.1f;
+  o.work_area_scale = 0.75f;
+  o.camera_height = 0.7f;
+  o.camera_distance = 0.65f;
+  return o;
+}
+
+SynthScene GeneratePile(uint64_t seed) {
+  SynthScene scene =
+      RenderScene(RandomSceneSpec(seed, PileOptions()), KinectV1Noise(), seed);
+  scene.frame.name = absl::StrCat("pile-", seed);
+  return scene;
 }
 
 }  // namespace fovea::synth

@@ -21,7 +21,7 @@ namespace fovea::synth {
 // gives the same scene with every standard library (floating-point maths
 // such as std::sin may still differ in the last bit between libms).
 
-enum class Shape { kBox, kCylinder, kSphere, kCone };
+enum class Shape { kBox, kCylinder, kSphere, kCone, kBowl, kCup };
 
 // Procedural surface textures, in world coordinates (metres), modulating
 // the albedo: what makes a floor, a table top or a wall look like one to
@@ -41,10 +41,19 @@ struct Primitive {
   //             `half_extents.z()`, with caps;
   //   sphere:   centred, radius `radius`;
   //   cone:     axis local z, base disc (radius `radius`) at local
-  //             z = -half_extents.z(), apex at +half_extents.z().
+  //             z = -half_extents.z(), apex at +half_extents.z();
+  //   bowl:     a spherical shell `thickness` thick, open at the top: the
+  //             outer sphere of radius `radius` is centred at local
+  //             z = +half_extents.z() (the rim, at its equator) and cut
+  //             flat at z = -half_extents.z() (the foot); needs
+  //             2 half_extents.z() < radius;
+  //   cup:      a cylindrical shell `thickness` thick with a bottom as
+  //             thick, open at the top: axis local z, outer radius
+  //             `radius`, half height half_extents.z().
   Eigen::Isometry3f pose = Eigen::Isometry3f::Identity();
   Eigen::Vector3f half_extents = Eigen::Vector3f::Constant(0.05f);
   float radius = 0.05f;
+  float thickness = 0.005f;  // bowl and cup walls, metres, < radius
   Eigen::Vector3f rgb = {0.8f, 0.2f, 0.2f};  // albedo, [0, 1]
   Texture texture = Texture::kFlat;
 };
@@ -185,6 +194,16 @@ struct RandomSceneOptions {
   // Probability that an object has a dark albedo (loses depth under the
   // default NoiseOptions).
   float dark_object_probability = 0.1f;
+  // The household mix instead of geometric primitives: boxes, books lying
+  // flat, cylinders, bowls and cups with real cavities, a few spheres and
+  // cones.
+  bool household = false;
+  // Probability that an object is a box leaning over towards one on the
+  // table (stack + touch + occlude + lean <= 1).
+  float lean_probability = 0.0f;
+  // Free objects go within this share of the work area around the look-at
+  // point (smaller: a pile), (0, 1].
+  float work_area_scale = 1.0f;
   // Camera: height above the table and distance back from its centre,
   // metres, looking at the table centre (a Kinect on a robot's head).
   float camera_height = 0.75f;
@@ -232,6 +251,17 @@ Eigen::Isometry3f LookAt(const Eigen::Vector3f& eye,
 // The demo scene: RandomSceneSpec(seed, {}) rendered with default noise and
 // `seed`. Seeds 1..20 give 2-6 visible objects.
 SynthScene GenerateScene(uint64_t seed);
+
+// Dense clutter: 8-16 household objects (boxes, books lying flat,
+// cylinders, bowls and cups with cavities, a few spheres and cones) in a
+// compact pile, a quarter stacked, 40 % touching, some occluding or
+// leaning, seen by a Kinect from 0.7 m up and 0.65 m back.
+RandomSceneOptions PileOptions();
+
+// RandomSceneSpec(seed, PileOptions()) rendered with KinectV1Noise();
+// frame.name "pile-<seed>". Crowded piles may hold fewer objects than
+// drawn: every object keeps 30 % of its pixels.
+SynthScene GeneratePile(uint64_t seed);
 
 }  // namespace fovea::synth
 
