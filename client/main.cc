@@ -97,7 +97,8 @@ ABSL_FLAG(std::optional<bool>, split_edges, std::nullopt,
           "split the master map at surface edges before extraction "
           "(unset: the server's default; false: the thesis's map)");
 ABSL_FLAG(int32_t, points, 0,
-          "number of attention points, 0 = the server's default (10)");
+          "number of attention points at most, 0 = the server's default "
+          "(one per salient region, at most 100)");
 
 // Segmentation.
 // The scene.

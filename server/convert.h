@@ -43,7 +43,8 @@ v1::Frame ToProtoFrame(const RgbdFrame& frame, DepthEncoding depth_encoding,
 //     is INVALID_ARGUMENT naming "options.saliency[i]...";
 //   - an UNSPECIFIED enum means core's default; a value outside the enum
 //     (proto3 enums are open) is INVALID_ARGUMENT naming the field;
-//   - max_points 0 means 10; above core's kMaxAttentionPoints is
+//   - max_points 0 means core's default (one per region, at most 100);
+//     above core's kMaxAttentionPoints is
 //     INVALID_ARGUMENT naming "options.max_points";
 //   - target_color_rgb must be empty or 3 values of at most 255, and
 //     location_prior_sigma_px finite and >= 0 (INVALID_ARGUMENT);

@@ -59,7 +59,8 @@ std::map<int, ObjectGeometry> MeasureObjects(const cv::Mat& labels,
 }  // namespace
 
 DetectionScore ScoreAttentionPoints(const std::vector<AttentionPoint>& points,
-                                    const cv::Mat& labels, const cv::Mat& xyz) {
+                                    const cv::Mat& labels, const cv::Mat& xyz,
+                                    int considered) {
   DetectionScore score;
   const std::map<int, ObjectGeometry> objects = MeasureObjects(labels, xyz);
   score.objects = static_cast<int>(objects.size());
@@ -113,6 +114,11 @@ DetectionScore ScoreAttentionPoints(const std::vector<AttentionPoint>& points,
       dc_thesis_sum += thesis;
       ++on_object;
     }
+  }
+  // HR over the first max(K, considered) points.
+  for (int i = k; i < std::min<int>(std::max(k, considered), hit_ids.size());
+       ++i) {
+    if (hit_ids[i] != 0 && seen.insert(hit_ids[i]).second) ++score.hits;
   }
   score.hit_ratio = static_cast<double>(score.hits) / k;
   score.distance_to_center = dc_sum / k;

@@ -15,10 +15,11 @@ inline constexpr int kHitRatioAtMax = 10;
 // Detection quality of one scene's attention points (thesis section 2.6.1).
 struct DetectionScore {
   int objects = 0;  // K: ground-truth objects (label / 10) in the scene
-  int hits = 0;     // distinct objects hit by the first K points
-  // Distinct objects hit among the first K points / K. A point on the table
-  // or on nothing, a second point on an already-hit object and a point that
-  // was not returned are all misses. 1 only for a perfect detector.
+  // Distinct objects hit by the first max(K, considered) points.
+  int hits = 0;
+  // hits / K. A point on the table or on nothing, a second point on an
+  // already-hit object and a point that was not returned are all misses. 1
+  // only for a perfect detector.
   double hit_ratio = 0.0;
   // Mean over the K slots of the first K points. A slot whose point hits a
   // new object scores (|p - c| - r_min) / (r_max - r_min), with c the 3D
@@ -41,8 +42,11 @@ struct DetectionScore {
 // labels; objects are label / 10 for labels >= 20) and `xyz` (CV_32FC3 of
 // the same size; NaN where there is no depth). A scene without objects gets
 // objects = 0 and all ratios 0; callers leave such scenes out of averages.
+// HR counts the first max(K, `considered`) points: the number a caller
+// asked for (0: K, the thesis's HR); DC always the first K.
 DetectionScore ScoreAttentionPoints(const std::vector<AttentionPoint>& points,
-                                    const cv::Mat& labels, const cv::Mat& xyz);
+                                    const cv::Mat& labels, const cv::Mat& xyz,
+                                    int considered = 0);
 
 }  // namespace fovea
 

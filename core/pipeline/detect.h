@@ -124,8 +124,12 @@ struct DetectOptions {
   FusionKind fusion = FusionKind::kSum;
   // Attention-point extraction (section 2.5).
   ExtractionKind extraction = ExtractionKind::kTj;
-  // Attention points to return at most, [1, kMaxAttentionPoints].
-  int max_points = 10;
+  // Attention points to return at most, [1, kMaxAttentionPoints]. The
+  // default is every salient region: TJ gives one point per region, so a
+  // pile of fifteen objects gets fifteen points (and no object two, unless
+  // its map falls apart); MSR and WTA stop when the map is exhausted or at
+  // this cap.
+  int max_points = kMaxAttentionPoints;
   // Return each channel's map in DetectResult::channel_maps.
   bool keep_channel_maps = false;
   // Fill small depth holes by colour-guided diffusion before anything else

@@ -23,7 +23,7 @@ TEST(ToDetectOptionsTest, EmptyOptionsAreCoreDefaults) {
   const DetectOptions defaults;
   ASSERT_EQ(options->channels.size(), defaults.channels.size());
   EXPECT_EQ(options->channels[0].op, defaults.channels[0].op);
-  EXPECT_EQ(options->max_points, 10);
+  EXPECT_EQ(options->max_points, kMaxAttentionPoints);  // one per region
   EXPECT_EQ(options->pyramid, defaults.pyramid);
   EXPECT_EQ(options->extraction, defaults.extraction);
   EXPECT_EQ(options->split_at_surface_edges, defaults.split_at_surface_edges);

@@ -642,7 +642,7 @@ TEST_F(ServerTest, CapabilitiesReportWhatCoreImplements) {
               ::testing::StartsWith("ebs-v1-"));
   EXPECT_EQ(capabilities.models(2).name(), "inc_relations");
   EXPECT_TRUE(capabilities.segment_incremental());
-  EXPECT_EQ(capabilities.default_detect_options().max_points(), 10u);
+  EXPECT_EQ(capabilities.default_detect_options().max_points(), 100u);
 }
 
 TEST_F(ServerTest, HealthServingAfterWarmUpThenNotServingOnDrain) {

@@ -161,6 +161,35 @@ TEST(FoveaEvalTest, SegmentCrossValidatesBothMethodsWithAJsonLastLine) {
   }
 }
 
+TEST(FoveaEvalTest, SegmentScoresTheShippedModelsAndPeersSideBySide) {
+  // Without --folds: the models of models/ as the server loads them, every
+  // method on the same two synthetic piles, one JSON line each.
+  const ::fovea::testing::CommandRun run = RunEval(
+      "segment --method inc,cos,pcl-lccp --piles 2 --seed 5 --json");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_THAT(run.out, HasSubstr("as shipped"));
+  int lines = 0;
+  size_t at = 0;
+  while ((at = run.out.find("{\"method\": ", at)) != std::string::npos) {
+    const std::string line = run.out.substr(at, run.out.find('\n', at) - at);
+    EXPECT_THAT(line, HasSubstr("\"evaluation\": \"held-out\""));
+    for (const char* key : {"overlap_p", "overlap_r", "overlap_f", "boundary_f",
+                            "objects_075", "whole_scene_f", "f_all"}) {
+      const double value = JsonNumber(line, key);
+      EXPECT_GE(value, 0.0) << key << " in " << line;
+      EXPECT_LE(value, 1.0) << key << " in " << line;
+    }
+    EXPECT_EQ(JsonNumber(line, "scenes"), 2.0);
+    // Piles of 8-16 objects on a clean table: much of them is found.
+    EXPECT_GT(JsonNumber(line, "overlap_f"), 0.4) << line;
+    ++lines;
+    ++at;
+  }
+  EXPECT_EQ(lines, 3);
+  // --folds 1 is neither held out nor cross-validated.
+  EXPECT_EQ(RunEval("segment --method cos --piles 1 --folds 1").exit_code, 64);
+}
+
 TEST(FoveaTrainTest, WritesModelsTheServerLoads) {
   const std::filesystem::path dir = SegmentationDataDir();
   const std::filesystem::path models =
@@ -206,8 +235,34 @@ TEST(SceneKindTest, FollowsTheOsdLearnNumbering) {
   EXPECT_EQ(eval::SceneKind("learn32"), "occluded");
   EXPECT_EQ(eval::SceneKind("learn44"), "cylindric");
   EXPECT_EQ(eval::SceneKind("learn45"), "other");
-  EXPECT_EQ(eval::SceneKind("test3"), "other");
   EXPECT_EQ(eval::SceneKind("learnx"), "other");
+}
+
+TEST(SceneKindTest, KnowsTheOsdTestNumberingPilesAndAKindsFile) {
+  EXPECT_EQ(eval::SceneKind("test15"), "boxes");
+  EXPECT_EQ(eval::SceneKind("test16"), "stacked");
+  EXPECT_EQ(eval::SceneKind("test30"), "occluded");
+  EXPECT_EQ(eval::SceneKind("test42"), "cylindric");
+  EXPECT_EQ(eval::SceneKind("test54"), "mixed");
+  EXPECT_EQ(eval::SceneKind("test64"), "complex");
+  EXPECT_EQ(eval::SceneKind("test65"), "other");
+  EXPECT_EQ(eval::SceneKind("pile-17"), "pile");
+  const std::filesystem::path file =
+      std::filesystem::path(::testing::TempDir()) / "kinds.txt";
+  {
+    std::ofstream out(file);
+    out << "# my scenes\nshelf 0-4 shelves\nshelf 5-9 drawers  # at the back\n";
+  }
+  ASSERT_TRUE(eval::LoadKinds(file.string()).ok());
+  EXPECT_EQ(eval::SceneKind("shelf3"), "shelves");
+  EXPECT_EQ(eval::SceneKind("shelf9"), "drawers");
+  {
+    std::ofstream out(file);
+    out << "shelf 4-2 backwards\n";
+  }
+  const absl::Status bad = eval::LoadKinds(file.string());
+  EXPECT_EQ(bad.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(bad.message()), HasSubstr("kinds.txt:1"));
 }
 
 }  // namespace

@@ -179,7 +179,8 @@ absl::StatusOr<DetectEvalSummary> EvaluateDetectOn(
     SceneResult r;
     r.name = scene.name;
     r.kind = SceneKind(scene.name);
-    r.score = ScoreAttentionPoints(result->points, scene.labels, cloud.xyz);
+    r.score = ScoreAttentionPoints(result->points, scene.labels, cloud.xyz,
+                                   options.detect.max_points);
     r.points = static_cast<int>(result->points.size());
     r.detect_ms = ms;
     if (options.verbose) {

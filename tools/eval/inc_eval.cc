@@ -43,25 +43,6 @@ std::map<int, std::vector<cv::Point>> ObjectPixels(const LabelledFrame& scene) {
   return pixels;
 }
 
-// The mask's pixel nearest its centroid.
-cv::Point CentralPixelOf(const cv::Mat& mask) {
-  const cv::Moments m = cv::moments(mask, true);
-  const cv::Point2d c(m.m10 / std::max(m.m00, 1.0),
-                      m.m01 / std::max(m.m00, 1.0));
-  std::vector<cv::Point> pixels;
-  cv::findNonZero(mask, pixels);
-  cv::Point best = pixels.empty() ? cv::Point() : pixels[0];
-  double best_d = 1e30;
-  for (const cv::Point& p : pixels) {
-    const double d = (p.x - c.x) * (p.x - c.x) + (p.y - c.y) * (p.y - c.y);
-    if (d < best_d) {
-      best_d = d;
-      best = p;
-    }
-  }
-  return best;
-}
-
 struct WholeRun {
   std::vector<SeededMask> masks;
   cv::Mat segments;  // CV_32S, object index or -1
@@ -336,53 +317,6 @@ absl::StatusOr<IncEvalSummary> EvaluateInc(
     if (absl::Status s = WriteComplexity(results, options.out_dir); !s.ok()) {
       return s;
     }
-  }
-  return SummarizeInc(results, "");
-}
-
-absl::StatusOr<IncEvalSummary> EvaluatePeer(
-    const std::vector<LabelledFrame>& scenes, const std::string& peer,
-    bool verbose) {
-  if (peer != "pcl-euclidean" && peer != "pcl-lccp") {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "unknown peer '", peer, "' (known: pcl-euclidean, pcl-lccp)"));
-  }
-  std::vector<IncSceneResult> results;
-  for (const LabelledFrame& scene : scenes) {
-    const auto start = std::chrono::steady_clock::now();
-    absl::StatusOr<OrganizedCloud> cloud =
-        BuildOrganizedCloud(scene.frame, NormalOptions{});
-    if (!cloud.ok()) return cloud.status();
-    absl::StatusOr<SceneSegmentation> segmentation =
-        peer == "pcl-euclidean"
-            ? SegmentSceneEuclidean(*cloud, EuclideanSceneOptions{})
-            : SegmentSceneLccp(*cloud, LccpSceneOptions{});
-    if (!segmentation.ok()) {
-      return InScene(scene.name, segmentation.status());
-    }
-    const double ms = std::chrono::duration<double, std::milli>(
-                          std::chrono::steady_clock::now() - start)
-                          .count();
-    std::vector<SeededMask> masks;
-    for (int s = 0; s < segmentation->segments; ++s) {
-      cv::Mat mask = segmentation->labels == s;
-      if (cv::countNonZero(mask) == 0) continue;
-      masks.push_back({CentralPixelOf(mask), mask});
-    }
-    IncSceneResult r;
-    r.name = scene.name;
-    r.kind = SceneKind(scene.name);
-    r.score = ScoreSegmentation(scene.labels, masks, kMinObjectPixels);
-    r.whole_scene_f =
-        WholeSceneF(scene.labels, segmentation->labels, kMinObjectPixels);
-    r.first_object_ms = ms;
-    r.whole_scene_ms = ms;
-    r.objects_emitted = static_cast<int>(masks.size());
-    if (verbose) {
-      std::fprintf(stderr, "%-8s whole F %.3f  segments %d  %.0f ms\n",
-                   r.name.c_str(), r.whole_scene_f, r.objects_emitted, ms);
-    }
-    results.push_back(std::move(r));
   }
   return SummarizeInc(results, "");
 }

@@ -11,8 +11,8 @@
 
 namespace fovea::eval {
 
-// INC on labelled scenes (thesis section 3.3.3), cross-validated like
-// EvaluateSegment.
+// INC on labelled scenes by section 3.3.3's protocols, cross-validated
+// (scene i in fold i mod folds, scored by the SVM trained on the others).
 enum class IncSaliency {
   kSym3d,         // Detect's default map; F from the objects of one run
   kRandomPoints,  // per object, 5 sequences of 5 points (first on it)
@@ -53,14 +53,6 @@ struct IncEvalSummary {
 
 absl::StatusOr<IncEvalSummary> EvaluateInc(
     const std::vector<LabelledFrame>& scenes, const IncEvalOptions& options);
-
-// The PCL peers on the same scenes and metric (no training): "pcl-euclidean"
-// or "pcl-lccp". Each segment is an object, largest first, its seed at its
-// central pixel; both times are the frame's (back-projection, normals and
-// the peer).
-absl::StatusOr<IncEvalSummary> EvaluatePeer(
-    const std::vector<LabelledFrame>& scenes, const std::string& peer,
-    bool verbose);
 
 // Means and medians over the scenes of one kind ("" = all).
 IncEvalSummary SummarizeInc(const std::vector<IncSceneResult>& scenes,

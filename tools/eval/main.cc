@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <cstdlib>
 #include <optional>
 #include <string>
@@ -15,15 +16,18 @@
 #include "absl/flags/usage.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "core/pipeline/detect.h"
 #include "core/pipeline/models.h"
 #include "tools/eval/detect_eval.h"
+#include "core/synth/synth_scene.h"
 #include "tools/eval/inc_eval.h"
+#include "tools/eval/methods_eval.h"
+#include "tools/eval/scene_kind.h"
 #include "tools/eval/raw_frame_eval.h"
 #include "tools/eval/room_eval.h"
-#include "tools/eval/segment_eval.h"
 #include "tools/eval/sweep.h"
 
 ABSL_FLAG(std::string, data, "",
@@ -37,7 +41,9 @@ ABSL_FLAG(std::string, saliency,
 ABSL_FLAG(std::string, extract,
           std::string(fovea::ExtractionName(fovea::DetectOptions().extraction)),
           "Attention-point extraction: msr, wta or tj.");
-ABSL_FLAG(int, points, 10, "Attention points per scene (HR uses the first K).");
+ABSL_FLAG(int, points, fovea::DetectOptions().max_points,
+          "Attention points per scene at most; HR counts the first "
+          "max(K, points) of them for a scene of K objects.");
 ABSL_FLAG(std::string, pyramid,
           std::string(fovea::PyramidName(fovea::DetectOptions().pyramid)),
           "Pyramid: none, simple or itti.");
@@ -89,35 +95,32 @@ ABSL_FLAG(std::string, out, "",
           "points numbered) into this folder.");
 ABSL_FLAG(bool, verbose, false, "One line per scene on stderr.");
 ABSL_FLAG(std::string, method, "cos",
-          "segment: cos, ebs, inc, or a peer: pcl-euclidean, pcl-lccp.");
+          "segment: cos, ebs, inc, a peer (pcl-euclidean, pcl-lccp), several "
+          "of them comma-separated (one run, side by side), or all.");
 ABSL_FLAG(std::string, inc_saliency, "sym3d",
           "segment --method inc: sym3d (Detect's map, F from one run) or "
           "random-points (per object 5 sequences of 5 points, section 3.3.3).");
-ABSL_FLAG(double, inc_k, fovea::IncOptions().k,
-          "segment --method inc: the graph segmentation's k.");
 ABSL_FLAG(std::string, seeds, "",
           "segment: where the seeds come from, tj, wta or msr (Detect's "
           "extraction; overrides --extract).");
-ABSL_FLAG(int, folds, 5,
-          "segment: cross-validation folds; scene i is scored with models "
-          "trained on the scenes of the other folds.");
+ABSL_FLAG(int, folds, 0,
+          "segment: 0 scores the models as shipped (--models); K >= 2 "
+          "cross-validates instead: scene i is scored with models trained on "
+          "the scenes of the other K - 1 folds.");
 ABSL_FLAG(double, svm_c, fovea::LinearSvmTrainingOptions().c,
           "segment: the COS SVM's soft-margin penalty C.");
-ABSL_FLAG(double, cos_min_decision, fovea::CosOptions().min_decision,
-          "segment: COS joins a patch when the SVM's decision exceeds this.");
-ABSL_FLAG(double, patch_angle, fovea::CosOptions().patches.max_normal_angle_deg,
-          "segment: COS planar patches' largest normal angle, degrees.");
-ABSL_FLAG(double, patch_distance,
-          fovea::CosOptions().patches.max_plane_distance,
-          "segment: COS planar patches' plane distance at 0 m, metres.");
 ABSL_FLAG(int, count, 200, "rooms: rooms per sensor and size.");
+ABSL_FLAG(int, piles, 0,
+          "detect / segment: evaluate on this many synthetic piles (8-16 "
+          "household objects each, seeds from --seed) instead of --data.");
 ABSL_FLAG(uint64_t, seed, 1, "rooms: the first room's seed.");
 ABSL_FLAG(std::string, room_sensors, "kinect_v1,active_stereo",
           "rooms: sensor noise models to render with, comma-separated.");
 ABSL_FLAG(std::string, sizes, "640x480",
           "rooms: resolutions, comma-separated WxH (e.g. 640x480,1280x720).");
 ABSL_FLAG(std::string, models, FOVEA_DEFAULT_MODELS_DIR,
-          "rooms: the trained models, as the server loads them.");
+          "segment, rooms, raw: the trained models, as the server loads "
+          "them.");
 ABSL_FLAG(std::string, filter, "",
           "sweep: only the rows whose label saliency/pyramid/combine/norm/"
           "extract contains this.");
@@ -128,28 +131,55 @@ namespace {
 constexpr int kUsageError = 64;
 constexpr int kRunError = 1;
 
+// Scenes of `scenes` with at least `objects` objects.
+std::vector<SceneResult> WithObjects(const std::vector<SceneResult>& scenes,
+                                     int objects) {
+  std::vector<SceneResult> out;
+  for (const SceneResult& r : scenes) {
+    if (r.score.objects >= objects) out.push_back(r);
+  }
+  return out;
+}
+
+// Scenes with at least this many objects get a row of their own: what a
+// detector capped at ten points could never cover.
+constexpr int kManyObjects = 10;
+
 void PrintTable(const std::vector<SceneResult>& scenes) {
   std::printf("%-12s %7s %7s %7s %11s %9s\n", "kind", "scenes", "HR", "DC",
               "DC(thesis)", "ms(med)");
-  for (const char* kind :
-       {"boxes", "stacked", "occluded", "cylindric", "other", ""}) {
-    const DetectEvalSummary s = Summarize(scenes, kind);
-    if (s.scenes.empty()) continue;
-    std::printf("%-12s %7zu %7.3f %7.3f %11.3f %9.1f\n", kind[0] ? kind : "all",
+  std::vector<std::string> kinds;
+  for (const SceneResult& r : scenes) {
+    if (std::find(kinds.begin(), kinds.end(), r.kind) == kinds.end()) {
+      kinds.push_back(r.kind);
+    }
+  }
+  kinds.push_back("");
+  auto row = [](const std::string& name, const DetectEvalSummary& s) {
+    std::printf("%-12s %7zu %7.3f %7.3f %11.3f %9.1f\n", name.c_str(),
                 s.scenes.size(), s.hit_ratio, s.distance_to_center,
                 s.distance_to_center_thesis, s.detect_ms_median);
+  };
+  for (const std::string& kind : kinds) {
+    const DetectEvalSummary s = Summarize(scenes, kind);
+    if (!s.scenes.empty()) row(kind.empty() ? "all" : kind, s);
   }
+  const std::vector<SceneResult> many = WithObjects(scenes, kManyObjects);
+  if (!many.empty()) row(absl::StrCat(kManyObjects, "+ objects"), Summarize(many, ""));
 }
 
 std::string Json(const DetectEvalSummary& s) {
   std::vector<std::string> at;
   for (double h : s.hit_ratio_at) at.push_back(absl::StrCat(h));
+  const DetectEvalSummary many = Summarize(WithObjects(s.scenes, kManyObjects), "");
   return absl::StrCat(
       "{\"scenes\": ", s.scenes.size(), ", \"hit_ratio\": ", s.hit_ratio,
       ", \"distance_to_center\": ", s.distance_to_center,
       ", \"distance_to_center_thesis\": ", s.distance_to_center_thesis,
       ", \"hit_ratio_at\": [", absl::StrJoin(at, ", "),
-      "], \"detect_ms_median\": ", s.detect_ms_median, "}");
+      "], \"scenes_10plus\": ", many.scenes.size(),
+      ", \"hit_ratio_10plus\": ", many.hit_ratio,
+      ", \"detect_ms_median\": ", s.detect_ms_median, "}");
 }
 
 // The Detect options of the flags shared by detect and segment; nullopt
@@ -229,17 +259,10 @@ std::optional<DetectOptions> DetectOptionsFromFlags() {
   return detect;
 }
 
+std::optional<std::vector<LabelledFrame>> ScenesFromFlags();
+
 int RunDetectEval() {
   DetectEvalOptions options;
-  options.data_dir = absl::GetFlag(FLAGS_data);
-  if (options.data_dir.empty()) {
-    const char* env = std::getenv("FOVEA_OSD_DIR");
-    if (env != nullptr) options.data_dir = env;
-  }
-  if (options.data_dir.empty()) {
-    std::fprintf(stderr, "fovea-eval: --data (or FOVEA_OSD_DIR) is required\n");
-    return kUsageError;
-  }
   const std::string saliency = absl::GetFlag(FLAGS_saliency);
   options.pcl_clusters = saliency == "pcl-clusters";
   std::optional<DetectOptions> detect = DetectOptionsFromFlags();
@@ -248,7 +271,9 @@ int RunDetectEval() {
   options.out_dir = absl::GetFlag(FLAGS_out);
   options.verbose = absl::GetFlag(FLAGS_verbose);
 
-  absl::StatusOr<DetectEvalSummary> summary = EvaluateDetect(options);
+  const std::optional<std::vector<LabelledFrame>> scenes = ScenesFromFlags();
+  if (!scenes) return kRunError;
+  absl::StatusOr<DetectEvalSummary> summary = EvaluateDetectOn(*scenes, options);
   if (!summary.ok()) {
     std::fprintf(stderr, "fovea-eval: %s\n",
                  summary.status().ToString().c_str());
@@ -268,21 +293,6 @@ int RunDetectEval() {
 namespace fovea::eval {
 namespace {
 
-void PrintSegmentTable(const std::vector<SceneSegmentResult>& scenes) {
-  std::printf("%-12s %7s %7s %7s %7s %8s %8s %10s %10s\n", "kind", "scenes",
-              "F(all)", "F(best)", "F(first)", "recall", "false", "first(ms)",
-              "all(ms)");
-  for (const char* kind :
-       {"boxes", "stacked", "occluded", "cylindric", "other", ""}) {
-    const SegmentEvalSummary s = SummarizeSegment(scenes, kind);
-    if (s.scenes.empty()) continue;
-    std::printf("%-12s %7zu %7.3f %7.3f %7.3f %8.3f %8.3f %10.1f %10.1f\n",
-                kind[0] ? kind : "all", s.scenes.size(), s.f_all, s.f_best,
-                s.f_first, s.object_recall, s.false_masks,
-                s.first_mask_ms_median, s.all_masks_ms_median);
-  }
-}
-
 void PrintIncTable(const std::vector<IncSceneResult>& scenes) {
   std::printf("%-12s %7s %7s %7s %7s %8s %8s %8s %10s %10s\n", "kind", "scenes",
               "F(all)", "F(best)", "F(first)", "recall", "false", "wholeF",
@@ -299,35 +309,15 @@ void PrintIncTable(const std::vector<IncSceneResult>& scenes) {
   }
 }
 
-void PrintIncJson(const IncEvalSummary& summary) {
-  if (!absl::GetFlag(FLAGS_json)) return;
-  std::printf(
-      "{\"scenes\": %zu, \"f_all\": %.4f, \"f_best\": %.4f, "
-      "\"f_first\": %.4f, \"object_recall\": %.4f, \"false_masks\": "
-      "%.4f, \"whole_scene_f\": %.4f, \"first_object_ms_median\": %.1f, "
-      "\"whole_scene_ms_median\": %.1f, \"first_object_slope\": %.4f}\n",
-      summary.scenes.size(), summary.f_all, summary.f_best, summary.f_first,
-      summary.object_recall, summary.false_masks, summary.whole_scene_f,
-      summary.first_object_ms_median, summary.whole_scene_ms_median,
-      summary.first_object_slope);
-}
-
-int RunIncEval(std::optional<DetectOptions> detect,
-               const std::vector<LabelledFrame>& scenes) {
+// Section 3.3.3's random-points protocol (cross-validated INC).
+int RunRandomPointsEval(const DetectOptions& detect,
+                        const std::vector<LabelledFrame>& scenes) {
   IncEvalOptions options;
-  options.incremental.detect = *std::move(detect);
-  const std::string saliency = absl::GetFlag(FLAGS_inc_saliency);
-  if (saliency != "sym3d" && saliency != "random-points") {
-    std::fprintf(stderr,
-                 "fovea-eval: --saliency for inc: sym3d or random-points\n");
-    return kUsageError;
-  }
-  options.saliency =
-      saliency == "sym3d" ? IncSaliency::kSym3d : IncSaliency::kRandomPoints;
-  options.folds = absl::GetFlag(FLAGS_folds);
+  options.incremental.detect = detect;
+  options.saliency = IncSaliency::kRandomPoints;
+  options.folds = std::max(2, absl::GetFlag(FLAGS_folds));
   options.out_dir = absl::GetFlag(FLAGS_out);
   options.verbose = absl::GetFlag(FLAGS_verbose);
-  options.incremental.inc.k = absl::GetFlag(FLAGS_inc_k);
   absl::StatusOr<IncEvalSummary> summary = EvaluateInc(scenes, options);
   if (!summary.ok()) {
     std::fprintf(stderr, "fovea-eval: %s\n",
@@ -335,29 +325,94 @@ int RunIncEval(std::optional<DetectOptions> detect,
     return kRunError;
   }
   std::printf(
-      "segment inc, saliency %s, %zu scenes, %d-fold cross-validated; "
-      "first-object time against whole-scene time: slope %.3f\n",
-      saliency.c_str(), summary->scenes.size(), options.folds,
-      summary->first_object_slope);
+      "segment inc, saliency random-points, %zu scenes, %d-fold "
+      "cross-validated\n",
+      summary->scenes.size(), options.folds);
   PrintIncTable(summary->scenes);
-  PrintIncJson(*summary);
+  if (absl::GetFlag(FLAGS_json)) {
+    std::printf(
+        "{\"scenes\": %zu, \"f_all\": %.4f, \"f_best\": %.4f, "
+        "\"f_first\": %.4f, \"object_recall\": %.4f, \"false_masks\": "
+        "%.4f, \"whole_scene_f\": %.4f}\n",
+        summary->scenes.size(), summary->f_all, summary->f_best,
+        summary->f_first, summary->object_recall, summary->false_masks,
+        summary->whole_scene_f);
+  }
   return 0;
 }
 
-int RunSegmentEval() {
+// The scenes of --data (an OSD-format folder; its kinds.txt, if any, names
+// the kinds) or of --piles (synthetic piles from --seed); nullopt after a
+// message.
+std::optional<std::vector<LabelledFrame>> ScenesFromFlags() {
+  const int piles = absl::GetFlag(FLAGS_piles);
+  if (piles > 0) {
+    std::vector<LabelledFrame> scenes;
+    for (int k = 0; k < piles; ++k) {
+      scenes.push_back(synth::GeneratePile(absl::GetFlag(FLAGS_seed) + k).frame);
+    }
+    return scenes;
+  }
   std::string data = absl::GetFlag(FLAGS_data);
   if (data.empty()) {
     const char* env = std::getenv("FOVEA_OSD_DIR");
     if (env != nullptr) data = env;
   }
   if (data.empty()) {
-    std::fprintf(stderr, "fovea-eval: --data (or FOVEA_OSD_DIR) is required\n");
-    return kUsageError;
+    std::fprintf(stderr,
+                 "fovea-eval: --data (or FOVEA_OSD_DIR) or --piles is "
+                 "required\n");
+    return std::nullopt;
   }
-  SegmentEvalOptions options;
+  for (const std::string& kinds :
+       {data + "/kinds.txt", data + "/learn/kinds.txt"}) {
+    if (std::filesystem::exists(kinds)) {
+      if (absl::Status s = LoadKinds(kinds); !s.ok()) {
+        std::fprintf(stderr, "fovea-eval: %s\n", s.ToString().c_str());
+        return std::nullopt;
+      }
+    }
+  }
+  absl::StatusOr<std::vector<LabelledFrame>> scenes = LoadScenes(data);
+  if (!scenes.ok()) {
+    std::fprintf(stderr, "fovea-eval: %s\n", scenes.status().ToString().c_str());
+    return std::nullopt;
+  }
+  return *std::move(scenes);
+}
+
+// The kinds present among the results, in order of first appearance.
+std::vector<std::string> KindsOf(const MethodResults& results) {
+  std::vector<std::string> kinds;
+  for (const auto& [method, scenes] : results) {
+    for (const MethodSceneResult& r : scenes) {
+      if (std::find(kinds.begin(), kinds.end(), r.kind) == kinds.end()) {
+        kinds.push_back(r.kind);
+      }
+    }
+  }
+  return kinds;
+}
+
+std::string MethodJson(const MethodSummary& s, bool cross_validated, int folds) {
+  return absl::StrFormat(
+      "{\"method\": \"%s\", \"evaluation\": \"%s\", \"folds\": %d, "
+      "\"scenes\": %d, \"f_all\": %.4f, \"f_best\": %.4f, \"f_first\": "
+      "%.4f, \"object_recall\": %.4f, \"false_masks\": %.4f, "
+      "\"whole_scene_f\": %.4f, \"overlap_p\": %.4f, \"overlap_r\": %.4f, "
+      "\"overlap_f\": %.4f, \"boundary_p\": %.4f, \"boundary_r\": %.4f, "
+      "\"boundary_f\": %.4f, \"objects_075\": %.4f, "
+      "\"first_mask_ms_median\": %.1f, \"all_masks_ms_median\": %.1f}",
+      s.method, cross_validated ? "cross-validated" : "held-out",
+      cross_validated ? folds : 0, s.scenes, s.f_all, s.f_best, s.f_first,
+      s.object_recall, s.false_masks, s.whole_scene_f, s.overlap_p,
+      s.overlap_r, s.overlap_f, s.boundary_p, s.boundary_r, s.boundary_f,
+      s.objects_075, s.first_ms_median, s.total_ms_median);
+}
+
+int RunSegmentEval() {
   std::optional<DetectOptions> detect = DetectOptionsFromFlags();
   if (!detect) return kUsageError;
-  options.segment.detect = *std::move(detect);
   const std::string seeds = absl::GetFlag(FLAGS_seeds);
   if (!seeds.empty()) {
     absl::StatusOr<ExtractionKind> kind = ParseExtraction(seeds);
@@ -366,84 +421,89 @@ int RunSegmentEval() {
                    kind.status().ToString().c_str());
       return kUsageError;
     }
-    options.segment.detect.extraction = *kind;
+    detect->extraction = *kind;
   }
-  const std::string method_name = absl::GetFlag(FLAGS_method);
-  if (method_name == "pcl-euclidean" || method_name == "pcl-lccp") {
-    absl::StatusOr<std::vector<LabelledFrame>> scenes = LoadScenes(data);
-    if (!scenes.ok()) {
-      std::fprintf(stderr, "fovea-eval: %s\n",
-                   scenes.status().ToString().c_str());
-      return kRunError;
+  MethodsEvalOptions options;
+  options.detect = *detect;
+  std::string methods = absl::GetFlag(FLAGS_method);
+  if (methods == "all") methods = "inc,cos,ebs,pcl-lccp,pcl-euclidean";
+  for (absl::string_view name : absl::StrSplit(methods, ',')) {
+    absl::StatusOr<SceneMethod> method = ParseSceneMethod(std::string(name));
+    if (!method.ok()) {
+      std::fprintf(stderr, "fovea-eval: --method: %s\n",
+                   method.status().ToString().c_str());
+      return kUsageError;
     }
-    absl::StatusOr<IncEvalSummary> summary =
-        EvaluatePeer(*scenes, method_name, absl::GetFlag(FLAGS_verbose));
-    if (!summary.ok()) {
-      std::fprintf(stderr, "fovea-eval: %s\n",
-                   summary.status().ToString().c_str());
-      return kRunError;
-    }
-    std::printf("segment %s (peer, whole scene), %zu scenes\n",
-                method_name.c_str(), summary->scenes.size());
-    PrintIncTable(summary->scenes);
-    PrintIncJson(*summary);
-    return 0;
+    options.methods.push_back(*method);
   }
-  if (absl::GetFlag(FLAGS_method) == "inc") {
-    absl::StatusOr<std::vector<LabelledFrame>> scenes = LoadScenes(data);
-    if (!scenes.ok()) {
-      std::fprintf(stderr, "fovea-eval: %s\n",
-                   scenes.status().ToString().c_str());
-      return kRunError;
-    }
-    return RunIncEval(options.segment.detect, *scenes);
+  const std::optional<std::vector<LabelledFrame>> scenes = ScenesFromFlags();
+  if (!scenes) return kRunError;
+  if (absl::GetFlag(FLAGS_inc_saliency) == "random-points") {
+    return RunRandomPointsEval(options.detect, *scenes);
   }
-  absl::StatusOr<SegmentMethod> method =
-      ParseSegmentMethod(absl::GetFlag(FLAGS_method));
-  if (!method.ok()) {
-    std::fprintf(stderr, "fovea-eval: --method: %s\n",
-                 method.status().ToString().c_str());
+  options.folds = absl::GetFlag(FLAGS_folds);
+  if (options.folds == 1 || options.folds < 0) {
+    std::fprintf(stderr, "fovea-eval: --folds: 0 (held out) or >= 2\n");
     return kUsageError;
   }
-  options.segment.method = *method;
-  options.folds = absl::GetFlag(FLAGS_folds);
-  options.svm.c = absl::GetFlag(FLAGS_svm_c);
-  options.segment.cos.min_decision = absl::GetFlag(FLAGS_cos_min_decision);
-  options.segment.cos.patches.max_normal_angle_deg =
-      static_cast<float>(absl::GetFlag(FLAGS_patch_angle));
-  options.segment.cos.patches.max_plane_distance =
-      static_cast<float>(absl::GetFlag(FLAGS_patch_distance));
+  const bool cross_validated = options.folds >= 2;
+  std::optional<LoadedModels> models;
+  if (!cross_validated) {
+    absl::StatusOr<LoadedModels> loaded = LoadModels(absl::GetFlag(FLAGS_models));
+    if (!loaded.ok()) {
+      std::fprintf(stderr, "fovea-eval: %s\n", loaded.status().ToString().c_str());
+      return kRunError;
+    }
+    models = *std::move(loaded);
+    options.models = &*models;
+  }
+  options.cos_svm.c = absl::GetFlag(FLAGS_svm_c);
   options.out_dir = absl::GetFlag(FLAGS_out);
   options.verbose = absl::GetFlag(FLAGS_verbose);
-  absl::StatusOr<std::vector<LabelledFrame>> scenes = LoadScenes(data);
-  if (!scenes.ok()) {
-    std::fprintf(stderr, "fovea-eval: %s\n",
-                 scenes.status().ToString().c_str());
+  absl::StatusOr<MethodResults> results = EvaluateMethods(*scenes, options);
+  if (!results.ok()) {
+    std::fprintf(stderr, "fovea-eval: %s\n", results.status().ToString().c_str());
     return kRunError;
   }
-  absl::StatusOr<SegmentEvalSummary> summary =
-      EvaluateSegment(*scenes, options);
-  if (!summary.ok()) {
-    std::fprintf(stderr, "fovea-eval: %s\n",
-                 summary.status().ToString().c_str());
-    return kRunError;
-  }
-  std::printf(
-      "segment %s, seeds %s, %zu scenes, %d-fold cross-validated\n",
-      absl::GetFlag(FLAGS_method).c_str(),
-      std::string(ExtractionName(options.segment.detect.extraction)).c_str(),
-      summary->scenes.size(), options.folds);
-  PrintSegmentTable(summary->scenes);
-  if (absl::GetFlag(FLAGS_json)) {
+  if (cross_validated) {
     std::printf(
-        "{\"scenes\": %zu, \"f_all\": %.4f, \"f_best\": %.4f, "
-        "\"f_first\": %.4f, \"object_recall\": %.4f, \"false_masks\": "
-        "%.4f, \"first_mask_ms_median\": %.1f, \"all_masks_ms_median\": "
-        "%.1f, \"whole_scene_f\": %.4f}\n",
-        summary->scenes.size(), summary->f_all, summary->f_best,
-        summary->f_first, summary->object_recall, summary->false_masks,
-        summary->first_mask_ms_median, summary->all_masks_ms_median,
-        summary->whole_scene_f);
+        "segment %s, seeds %s, %zu scenes, %d-fold cross-validated (each "
+        "scene scored by models trained on the other folds)\n",
+        methods.c_str(), std::string(ExtractionName(options.detect.extraction)).c_str(),
+        scenes->size(), options.folds);
+  } else {
+    std::printf(
+        "segment %s, seeds %s, %zu scenes, models %s as shipped (held out "
+        "unless these scenes trained them)\n",
+        methods.c_str(), std::string(ExtractionName(options.detect.extraction)).c_str(),
+        scenes->size(), absl::GetFlag(FLAGS_models).c_str());
+  }
+  std::printf("%-14s %-10s %6s %6s %6s %6s %6s %6s %6s %6s %6s %6s %6s %6s "
+              "%8s %8s\n",
+              "method", "kind", "scenes", "F all", "F best", "F 1st", "recall",
+              "false", "wholeF", "ovl P", "ovl R", "ovl F", "bnd F", "obj.75",
+              "1st ms", "all ms");
+  std::vector<std::string> kinds = KindsOf(*results);
+  kinds.push_back("");
+  for (const SceneMethod method : options.methods) {
+    for (const std::string& kind : kinds) {
+      const MethodSummary s = SummarizeMethod(method, results->at(method), kind);
+      if (s.scenes == 0) continue;
+      std::printf("%-14s %-10s %6d %6.3f %6.3f %6.3f %6.3f %6.3f %6.3f %6.3f "
+                  "%6.3f %6.3f %6.3f %6.3f %8.1f %8.1f\n",
+                  s.method.c_str(), kind.empty() ? "all" : kind.c_str(),
+                  s.scenes, s.f_all, s.f_best, s.f_first, s.object_recall,
+                  s.false_masks, s.whole_scene_f, s.overlap_p, s.overlap_r,
+                  s.overlap_f, s.boundary_f, s.objects_075, s.first_ms_median,
+                  s.total_ms_median);
+    }
+  }
+  if (absl::GetFlag(FLAGS_json)) {
+    for (const SceneMethod method : options.methods) {
+      std::printf("%s\n", MethodJson(SummarizeMethod(method, results->at(method), ""),
+                                      cross_validated, options.folds)
+                               .c_str());
+    }
   }
   return 0;
 }

@@ -570,6 +570,11 @@ bool InsideLocal(const Primitive& prim, const Vector3f& p, float eps) {
       if (std::abs(p.z()) >= h.z() - eps) return false;
       return p.head<2>().norm() < r * (h.z() - p.z()) / (2 * h.z()) - eps;
     }
+    case Shape::kCup:  // the solid it encloses, cavity included
+      return std::abs(p.z()) < h.z() - eps && p.head<2>().norm() < r - eps;
+    case Shape::kBowl:  // the outer sphere between foot and rim
+      return std::abs(p.z()) < h.z() - eps &&
+             (p - Vector3f(0, 0, h.z())).norm() < r - eps;
   }
   return false;
 }
@@ -620,6 +625,9 @@ float LowestZ(const Primitive& prim) {
       return c.z() - std::abs(axis.z()) * h - r * across;
     case Shape::kSphere:
       return c.z() - r;
+    case Shape::kCup:
+    case Shape::kBowl:  // both stand upright: the foot
+      return c.z() - h;
     case Shape::kCone: {
       const float base = c.z() - axis.z() * h - r * across;
       return std::min(base, c.z() + axis.z() * h);
@@ -696,6 +704,52 @@ TEST(RandomSceneSpecTest, ObjectsRestOnTableOrBoxAndDoNotInterpenetrate) {
   EXPECT_GT(stacked, 0);  // stacking happens
   EXPECT_GT(total, 40 * 3);
   EXPECT_EQ(shapes.size(), 4u);  // all shapes occur
+}
+
+TEST(RandomSceneSpecTest, PilesRestOnTheTableOrABoxAndDoNotInterpenetrate) {
+  constexpr float kTol = 1e-4f;
+  std::set<Shape> shapes;
+  int leaning = 0;
+  for (uint64_t seed = 1; seed <= 12; ++seed) {
+    SCOPED_TRACE(seed);
+    const SceneSpec spec = RandomSceneSpec(seed, PileOptions());
+    ASSERT_TRUE(Validate(spec).ok());
+    EXPECT_GE(spec.objects.size(), 8u);
+    std::vector<std::vector<Vector3f>> interiors;
+    for (const Primitive& p : spec.objects) {
+      interiors.push_back(InteriorPoints(p));
+      shapes.insert(p.shape);
+    }
+    for (size_t i = 0; i < spec.objects.size(); ++i) {
+      const Primitive& p = spec.objects[i];
+      const bool tilted = std::abs(p.pose.linear().col(2).z()) < 0.99f &&
+                          p.shape == Shape::kBox;
+      leaning += tilted;
+      for (const Vector3f& q : interiors[i]) ASSERT_GE(q.z(), -kTol);
+      if (!tilted && std::abs(LowestZ(p)) > kTol) {
+        bool supported = false;
+        for (const Primitive& s : spec.objects) {
+          if (&s == &p || s.shape != Shape::kBox) continue;
+          const bool level = std::abs(s.pose.linear().col(2).z()) > 1 - 1e-5f;
+          const float top = s.pose.translation().z() + s.half_extents.z();
+          supported |= level && std::abs(top - LowestZ(p)) < kTol;
+        }
+        EXPECT_TRUE(supported) << "object " << i << " floats";
+      }
+      for (size_t j = 0; j < spec.objects.size(); ++j) {
+        if (j == i) continue;
+        const Primitive& o = spec.objects[j];
+        const Eigen::Isometry3f to_local = o.pose.inverse();
+        int inside = 0;
+        for (const Vector3f& q : interiors[i]) {
+          inside += InsideLocal(o, to_local * q, 1e-3f);
+        }
+        EXPECT_EQ(inside, 0) << "objects " << i << " and " << j;
+      }
+    }
+  }
+  EXPECT_TRUE(shapes.count(Shape::kBowl) && shapes.count(Shape::kCup));
+  EXPECT_GT(leaning, 0);
 }
 
 TEST(RandomSceneSpecTest, SameSeedSameSpec) {
