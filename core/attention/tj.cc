@@ -336,6 +336,11 @@ absl::Status Validate(const TjOptions& options) {
         absl::StrCat("tj.support_fraction must be in [0, 1), got ",
                      options.support_fraction));
   }
+  if (options.min_component_pixels < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("tj.min_component_pixels must be >= 0, got ",
+                     options.min_component_pixels));
+  }
   if (!(options.min_mean_fraction >= 0.0f &&
         options.min_mean_fraction <= 1.0f)) {
     return absl::InvalidArgumentError(
@@ -390,7 +395,10 @@ absl::StatusOr<std::vector<AttentionPoint>> ExtractTjPoints(
       static_cast<double>(options.min_mean_fraction) * global_max;
   std::vector<const Component*> kept;
   for (const Component& c : components) {
-    if (c.Mean() >= theta) kept.push_back(&c);
+    if (c.Mean() >= theta &&
+        static_cast<int>(c.pixels.size()) >= options.min_component_pixels) {
+      kept.push_back(&c);
+    }
   }
   // Rank first, so that only the components that can yield a point are
   // thinned.

@@ -45,6 +45,9 @@ struct TjOptions {
   float support_fraction = 0.0f;
   TjJunction junction = TjJunction::kCentral;
   TjRanking ranking = TjRanking::kTotalSaliency;
+  // Components of fewer pixels give no point. 0 keeps every component
+  // (the thesis); Detect sets it from DetectOptions::min_region_pixels.
+  int min_component_pixels = 0;
 };
 
 absl::Status Validate(const TjOptions& options);
@@ -55,7 +58,8 @@ absl::Status Validate(const TjOptions& options);
 // background). Steps:
 //  1. 8-connected components of the foreground.
 //  2. Drop components whose mean saliency is below
-//     theta_sal = min_mean_fraction * (global maximum of the map).
+//     theta_sal = min_mean_fraction * (global maximum of the map), and
+//     those smaller than min_component_pixels.
 //  3. Skeleton of each kept component (see ThinToSkeleton).
 //  4. The component's point is a junction of its skeleton, a skeleton pixel
 //     with SkeletonBranchCount >= 3, chosen by `options.junction`; ties go

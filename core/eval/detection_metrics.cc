@@ -115,6 +115,14 @@ DetectionScore ScoreAttentionPoints(const std::vector<AttentionPoint>& points,
       ++on_object;
     }
   }
+  std::set<int> any;
+  for (const int id : hit_ids) {
+    if (id == 0) {
+      ++score.off_object_points;
+    } else if (!any.insert(id).second) {
+      ++score.repeated_points;
+    }
+  }
   // HR over the first max(K, considered) points.
   for (int i = k; i < std::min<int>(std::max(k, considered), hit_ids.size());
        ++i) {

@@ -36,6 +36,10 @@ struct DetectionScore {
   double distance_to_center_thesis = 1.0;
   // hit_ratio_at[N-1] = distinct objects hit among the first N points / N.
   std::array<double, kHitRatioAtMax> hit_ratio_at{};
+  // Of all the points returned: those on an object already hit by an
+  // earlier point (a second point in one object), and those on no object.
+  int repeated_points = 0;
+  int off_object_points = 0;
 };
 
 // Scores `points` (most salient first) against `labels` (CV_32SC1, OSD

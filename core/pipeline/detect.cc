@@ -17,6 +17,8 @@
 namespace fovea {
 namespace {
 
+// Focal length pixel sizes are given at (a Kinect's), pixels.
+constexpr double kReferenceFocalPx = 525.0;
 // Deepest pyramid level SYM3D may be asked to run on (a 640x480 frame has
 // 8 levels, 0..7).
 constexpr int kMaxSym3dLevel = 7;
@@ -231,6 +233,11 @@ absl::Status Validate(const DetectOptions& options) {
     return absl::InvalidArgumentError(
         absl::StrCat("options.max_points must be in [1, ", kMaxAttentionPoints,
                      "], got ", options.max_points));
+  }
+  if (options.min_region_pixels < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("options.min_region_pixels must be >= 0, got ",
+                     options.min_region_pixels));
   }
   if (options.sym3d_level < 0 || options.sym3d_level > kMaxSym3dLevel) {
     return absl::InvalidArgumentError(
@@ -448,8 +455,13 @@ absl::StatusOr<DetectResult> DetectOnSceneUnguarded(
   NormalizeLinear(result.master);
   clock.Lap("fusion");
 
+  // TJ's smallest region is given at a 525 px focal length.
+  DetectOptions extraction = options;
+  const double focal_ratio = cloud.intrinsics.fx / kReferenceFocalPx;
+  extraction.tj.min_component_pixels = static_cast<int>(
+      std::lround(options.min_region_pixels * focal_ratio * focal_ratio));
   absl::StatusOr<std::vector<AttentionPoint>> points =
-      ExtractAttentionPoints(result.master, options);
+      ExtractAttentionPoints(result.master, extraction);
   if (!points.ok()) return points.status();
   result.points = *std::move(points);
   FillPoints(cloud, result.points);

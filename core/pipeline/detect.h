@@ -130,6 +130,13 @@ struct DetectOptions {
   // its map falls apart); MSR and WTA stop when the map is exhausted or at
   // this cap.
   int max_points = kMaxAttentionPoints;
+  // Regions of the master map smaller than this give no point: specks that
+  // noise and the surface-edge split leave of an object's faces, not
+  // objects. Given at a 525 px focal length (a Kinect's) and scaled by
+  // (fx / 525)^2, so 150 px is about 3 x 3 cm seen from 1.2 m with any
+  // sensor. Used by TJ (it overrides tj.min_component_pixels); 0 keeps
+  // every region.
+  int min_region_pixels = 150;
   // Return each channel's map in DetectResult::channel_maps.
   bool keep_channel_maps = false;
   // Fill small depth holes by colour-guided diffusion before anything else

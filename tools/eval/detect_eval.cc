@@ -118,6 +118,8 @@ DetectEvalSummary Summarize(const std::vector<SceneResult>& scenes,
     if (!kind.empty() && r.kind != kind) continue;
     s.scenes.push_back(r);
     s.hit_ratio += r.score.hit_ratio;
+    s.repeated_points += r.score.repeated_points;
+    s.off_object_points += r.score.off_object_points;
     s.distance_to_center += r.score.distance_to_center;
     s.distance_to_center_thesis += r.score.distance_to_center_thesis;
     for (int i = 0; i < kHitRatioAtMax; ++i) {
@@ -128,6 +130,8 @@ DetectEvalSummary Summarize(const std::vector<SceneResult>& scenes,
   const double n = static_cast<double>(s.scenes.size());
   if (n > 0) {
     s.hit_ratio /= n;
+    s.repeated_points /= n;
+    s.off_object_points /= n;
     s.distance_to_center /= n;
     s.distance_to_center_thesis /= n;
     for (double& h : s.hit_ratio_at) h /= n;

@@ -27,6 +27,10 @@ struct DetectEvalSummary {
   double distance_to_center = 0.0;  // mean over scenes
   double distance_to_center_thesis = 0.0;
   std::array<double, kHitRatioAtMax> hit_ratio_at{};
+  // Means per scene: points on an object an earlier point hit, points on
+  // no object (DetectionScore).
+  double repeated_points = 0.0;
+  double off_object_points = 0.0;
   double detect_ms_median = 0.0;
 };
 

@@ -146,8 +146,8 @@ std::vector<SceneResult> WithObjects(const std::vector<SceneResult>& scenes,
 constexpr int kManyObjects = 10;
 
 void PrintTable(const std::vector<SceneResult>& scenes) {
-  std::printf("%-12s %7s %7s %7s %11s %9s\n", "kind", "scenes", "HR", "DC",
-              "DC(thesis)", "ms(med)");
+  std::printf("%-12s %7s %7s %7s %11s %9s %9s %9s\n", "kind", "scenes", "HR",
+              "DC", "DC(thesis)", "repeats", "off", "ms(med)");
   std::vector<std::string> kinds;
   for (const SceneResult& r : scenes) {
     if (std::find(kinds.begin(), kinds.end(), r.kind) == kinds.end()) {
@@ -156,9 +156,10 @@ void PrintTable(const std::vector<SceneResult>& scenes) {
   }
   kinds.push_back("");
   auto row = [](const std::string& name, const DetectEvalSummary& s) {
-    std::printf("%-12s %7zu %7.3f %7.3f %11.3f %9.1f\n", name.c_str(),
-                s.scenes.size(), s.hit_ratio, s.distance_to_center,
-                s.distance_to_center_thesis, s.detect_ms_median);
+    std::printf("%-12s %7zu %7.3f %7.3f %11.3f %9.2f %9.2f %9.1f\n",
+                name.c_str(), s.scenes.size(), s.hit_ratio,
+                s.distance_to_center, s.distance_to_center_thesis,
+                s.repeated_points, s.off_object_points, s.detect_ms_median);
   };
   for (const std::string& kind : kinds) {
     const DetectEvalSummary s = Summarize(scenes, kind);
@@ -179,6 +180,8 @@ std::string Json(const DetectEvalSummary& s) {
       ", \"hit_ratio_at\": [", absl::StrJoin(at, ", "),
       "], \"scenes_10plus\": ", many.scenes.size(),
       ", \"hit_ratio_10plus\": ", many.hit_ratio,
+      ", \"repeated_points\": ", s.repeated_points,
+      ", \"off_object_points\": ", s.off_object_points,
       ", \"detect_ms_median\": ", s.detect_ms_median, "}");
 }
 

@@ -381,6 +381,28 @@ TEST(TjTest, RejectsBadInputNamingTheField) {
             absl::StatusCode::kInvalidArgument);
 }
 
+// A 20 x 20 block (400 px) and a 5 x 5 speck (25 px), equally salient: with
+// a 100 px floor only the block yields a point; with none, both do.
+TEST(TjTest, ComponentsSmallerThanTheFloorGiveNoPoint) {
+  cv::Mat map = Zeros(60, 60);
+  map(cv::Rect(5, 5, 20, 20)).setTo(0.8f);
+  map(cv::Rect(45, 45, 5, 5)).setTo(0.8f);
+  TjOptions options;
+  options.min_component_pixels = 100;
+  absl::StatusOr<std::vector<AttentionPoint>> points =
+      ExtractTjPoints(map, 10, options);
+  ASSERT_TRUE(points.ok()) << points.status();
+  ASSERT_EQ(points->size(), 1u);
+  EXPECT_LT((*points)[0].u, 25);
+  EXPECT_EQ(ExtractTjPoints(map, 10, {})->size(), 2u);
+  options.min_component_pixels = -1;
+  EXPECT_NE(ExtractTjPoints(map, 10, options)
+                .status()
+                .message()
+                .find("tj.min_component_pixels"),
+            std::string::npos);
+}
+
 // A 640x480 map like a table scene's (blobs cut at 5 % of their peak, as a
 // normalised saliency map is zero away from objects, plus a thin bar):
 // seven components, seven points (its time is fovea-bench's BM_Tj).

@@ -148,6 +148,10 @@ TEST(DetectTest, BadOptionsNameTheField) {
   EXPECT_NE(Validate(options).message().find("options.max_points"),
             std::string::npos);
   options = {};
+  options.min_region_pixels = -1;
+  EXPECT_NE(Validate(options).message().find("options.min_region_pixels"),
+            std::string::npos);
+  options = {};
   options.channels = {{SaliencyOp::kRso, -1.0f}};
   EXPECT_EQ(Validate(options).code(), absl::StatusCode::kInvalidArgument);
 }
