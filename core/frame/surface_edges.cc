@@ -32,6 +32,12 @@ absl::Status Validate(const SurfaceEdgeOptions& options) {
         absl::StrCat("surface_edges.concave_curvature must be in [0, 2], got ",
                      options.concave_curvature));
   }
+  if (!(options.concave_min_curvature >= 0.0f &&
+        options.concave_min_curvature <= 1000.0f)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "surface_edges.concave_min_curvature must be in [0, 1000] 1/m, got ",
+        options.concave_min_curvature));
+  }
   return absl::OkStatus();
 }
 
@@ -74,7 +80,8 @@ cv::Mat FindSurfaceEdges(const OrganizedCloud& cloud,
           const float len2 = d.dot(d);
           const float dn = (q_nrm[u] - p_nrm[u]).dot(d);
           // dn / |d| < -c without the square root: dn < 0 and dn^2 > c^2 |d|^2.
-          edge = dn < 0.0f && dn * dn > concave2 * len2;
+          edge = dn < 0.0f && dn * dn > concave2 * len2 &&
+                 -dn > options.concave_min_curvature * len2;
         }
         if (edge) {
           p_edge[u] = 255;

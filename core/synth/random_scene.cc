@@ -100,6 +100,7 @@ struct Body {
   bool lying = false;        // cylinder on its side
   float lean = 0.0f;         // box tilted about its local y axis, radians
   float thickness = 0.005f;  // bowl and cup walls
+  float floor_height = 0.0f;  // a bowl's inner floor above its foot
   Vector3f rgb = Vector3f::Constant(0.5f);
 
   float Height() const {
@@ -136,6 +137,7 @@ Placed Pose(const Body& body, const Vector2f& xy, float base_z, float yaw) {
   p.half_extents = body.half_extents;
   p.radius = body.radius;
   p.thickness = body.thickness;
+  p.floor_height = body.floor_height;
   p.rgb = body.rgb;
   Eigen::Matrix3f rotation =
       Eigen::AngleAxisf(yaw, Vector3f::UnitZ()).toRotationMatrix();
@@ -255,10 +257,12 @@ Body RandomHouseholdBody(const Vector3f& rgb, Random& rng) {
       return body;
     case HouseholdKind::kBowl:
       body.shape = Shape::kBowl;
+      // A cereal or salad bowl: 4-9 cm deep, its floor on a foot ring.
       body.radius = rng.Uniform(0.05f, 0.09f);
       body.half_extents = {body.radius, body.radius,
-                           body.radius * rng.Uniform(0.45f, 0.7f) / 2.0f};
+                           body.radius * rng.Uniform(0.6f, 0.9f) / 2.0f};
       body.thickness = rng.Uniform(0.004f, 0.008f);
+      body.floor_height = rng.Uniform(0.01f, 0.018f);
       return body;
     case HouseholdKind::kCup:
       body.shape = Shape::kCup;

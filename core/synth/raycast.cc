@@ -209,37 +209,34 @@ void AnnulusHit(float z, float r_in, float r_out, float sign, const Vector3f& o,
   }
 }
 
-// Bowl: see synth_scene.h. Outer sphere centre (0, 0, h), radius r; inner
-// radius r - w; foot at z = -h; inside bottom at z = -h + w.
-std::optional<RayHit> IntersectBowl(float r, float h, float w,
+// Bowl: see synth_scene.h. Outer sphere centre (0, 0, h), radius r, cut at
+// the foot z = -h. The inside is the sphere through the rim's inner circle
+// (radius r - w at z = h) whose lowest point is the floor,
+// z_floor = -h + max(w, floor): with depth D = h - z_floor its radius is
+// ((r - w)^2 + D^2) / (2 D), so the inside curves smoothly down to the
+// floor as a real bowl's does.
+std::optional<RayHit> IntersectBowl(float r, float h, float w, float floor,
                                     const Vector3f& o, const Vector3f& d,
                                     float t_min, float t_max) {
   std::optional<RayHit> best;
-  const Vector3f c(0.0f, 0.0f, h);
-  const float r_in = r - w;
+  const float r_rim = r - w;
   const float z_foot = -h;
-  const float z_inner = -h + w;
+  const float z_floor = -h + std::max(w, floor);
+  const float depth = h - z_floor;
+  const float r_in = (r_rim * r_rim + depth * depth) / (2.0f * depth);
   SphereHits(
-      c, r, 1.0f, o, d, t_min, t_max,
+      Vector3f(0.0f, 0.0f, h), r, 1.0f, o, d, t_min, t_max,
       [&](const Vector3f& p) {
         return p.z() <= h + kBoundSlack && p.z() >= z_foot - kBoundSlack;
       },
       &best);
   SphereHits(
-      c, r_in, -1.0f, o, d, t_min, t_max,
-      [&](const Vector3f& p) {
-        return p.z() <= h + kBoundSlack && p.z() >= z_inner - kBoundSlack;
-      },
-      &best);
-  AnnulusHit(h, r_in, r, 1.0f, o, d, t_min, t_max, &best);  // the rim
+      Vector3f(0.0f, 0.0f, z_floor + r_in), r_in, -1.0f, o, d, t_min, t_max,
+      [&](const Vector3f& p) { return p.z() <= h + kBoundSlack; }, &best);
+  AnnulusHit(h, r_rim, r, 1.0f, o, d, t_min, t_max, &best);  // the rim
   const float foot =
       std::sqrt(std::max(0.0f, r * r - (h - z_foot) * (h - z_foot)));
   AnnulusHit(z_foot, 0.0f, foot, -1.0f, o, d, t_min, t_max, &best);
-  const float below = h - z_inner;
-  if (r_in > below) {
-    AnnulusHit(z_inner, 0.0f, std::sqrt(r_in * r_in - below * below), 1.0f, o,
-               d, t_min, t_max, &best);
-  }
   return best;
 }
 
@@ -271,7 +268,8 @@ std::optional<RayHit> IntersectLocal(const Primitive& primitive,
     case Shape::kCone:
       return IntersectCone(primitive.radius, h.z(), o, d, t_min, t_max);
     case Shape::kBowl:
-      return IntersectBowl(primitive.radius, h.z(), primitive.thickness, o, d,
+      return IntersectBowl(primitive.radius, h.z(), primitive.thickness,
+                           primitive.floor_height, o, d,
                            t_min, t_max);
     case Shape::kCup:
       return IntersectCup(primitive.radius, h.z(), primitive.thickness, o, d,

@@ -257,6 +257,12 @@ absl::Status Validate(const SceneSpec& spec) {
                        ": a bowl's depth (2 half_extents.z) must be "
                        "below its radius"));
     }
+    if (p.shape == Shape::kBowl &&
+        !(p.floor_height >= 0.0f &&
+          p.floor_height < 2.0f * p.half_extents.z())) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          field, ".floor_height must be in [0, the bowl's depth)"));
+    }
   }
   return absl::OkStatus();
 }

@@ -45,7 +45,10 @@ struct Primitive {
   //   bowl:     a spherical shell `thickness` thick, open at the top: the
   //             outer sphere of radius `radius` is centred at local
   //             z = +half_extents.z() (the rim, at its equator) and cut
-  //             flat at z = -half_extents.z() (the foot); needs
+  //             flat at z = -half_extents.z() (the foot); its inside is
+  //             the sphere through the rim's inner circle (radius -
+  //             thickness) whose lowest point, the floor, is
+  //             max(thickness, floor_height) above the foot; needs
   //             2 half_extents.z() < radius;
   //   cup:      a cylindrical shell `thickness` thick with a bottom as
   //             thick, open at the top: axis local z, outer radius
@@ -54,6 +57,10 @@ struct Primitive {
   Eigen::Vector3f half_extents = Eigen::Vector3f::Constant(0.05f);
   float radius = 0.05f;
   float thickness = 0.005f;  // bowl and cup walls, metres, < radius
+  // Bowl: height of the inner floor above the foot, metres (a real bowl's
+  // foot ring and bottom, 1-2 cm); below `thickness` the floor is
+  // `thickness` up.
+  float floor_height = 0.0f;
   Eigen::Vector3f rgb = {0.8f, 0.2f, 0.2f};  // albedo, [0, 1]
   Texture texture = Texture::kFlat;
 };

@@ -73,6 +73,9 @@ ABSL_FLAG(double, edge_jump,
 ABSL_FLAG(double, edge_concave,
           fovea::DetectOptions().surface_edges.concave_curvature,
           "Surface edges: concave crease threshold (0: off).");
+ABSL_FLAG(double, edge_concave_sharpness,
+          fovea::DetectOptions().surface_edges.concave_min_curvature,
+          "Surface edges: a crease's least curvature, 1/m (0: any fold).");
 ABSL_FLAG(int, edge_radius, fovea::DetectOptions().surface_edges.radius_px,
           "Surface edges: neighbour distance, pixels at f = 525 px.");
 ABSL_FLAG(bool, msr_inhibit_slope, true,
@@ -231,6 +234,8 @@ std::optional<DetectOptions> DetectOptionsFromFlags() {
       static_cast<float>(absl::GetFlag(FLAGS_edge_jump));
   detect.surface_edges.concave_curvature =
       static_cast<float>(absl::GetFlag(FLAGS_edge_concave));
+  detect.surface_edges.concave_min_curvature =
+      static_cast<float>(absl::GetFlag(FLAGS_edge_concave_sharpness));
   detect.surface_edges.radius_px = absl::GetFlag(FLAGS_edge_radius);
   const absl::StatusOr<PyramidKind> pyramid =
       ParsePyramid(absl::GetFlag(FLAGS_pyramid));

@@ -132,6 +132,47 @@ TEST(SurfaceEdgesTest, StackedAndOccludingBoxesFallApart) {
       MostLabelsInOneComponent(labels, FindSurfaceEdges(cloud, folds_only)), 1);
 }
 
+// Share of `mask` that is surface edge.
+double EdgeShare(const cv::Mat& mask, const cv::Mat& edges) {
+  return static_cast<double>(cv::countNonZero(mask & edges)) /
+         std::max(1, cv::countNonZero(mask));
+}
+
+TEST(SurfaceEdgesTest, ABowlsInsideIsOneSurfaceButAStackedBoxIsCut) {
+  // A 7 cm bowl, 5 cm deep, its floor 15 mm up: its inside bends by
+  // 1 / 6.5 cm = 15 / m, below the 20 / m a crease needs; the fold between
+  // a box and the box it stands on is sharp.
+  synth::Primitive bowl;
+  bowl.shape = synth::Shape::kBowl;
+  bowl.radius = 0.07f;
+  bowl.half_extents = Eigen::Vector3f(0.07f, 0.07f, 0.025f);
+  bowl.thickness = 0.005f;
+  bowl.floor_height = 0.015f;
+  bowl.pose.translation() = Eigen::Vector3f(-0.1f, 0.0f, 0.025f);
+  const synth::SynthScene scene = Render({
+      bowl,
+      Box({0.12f, 0.0f, 0.05f}, {0.06f, 0.06f, 0.05f}),
+      Box({0.12f, 0.0f, 0.13f}, {0.03f, 0.03f, 0.03f}),
+  });
+  const OrganizedCloud cloud = CloudOf(scene);
+  const cv::Mat& labels = scene.frame.labels;
+  // The bowl's inside: its pixels below the rim, away from its outline
+  // and from the rim's occluding edge (marked radius_px wide).
+  cv::Mat inside = (labels == 20) & (testing::HeightAboveTable(scene) < 0.045f);
+  cv::erode(inside, inside, cv::Mat::ones(15, 15, CV_8UC1));
+  ASSERT_GT(cv::countNonZero(inside), 500);
+  const cv::Mat edges = FindSurfaceEdges(cloud, {});
+  EXPECT_LT(EdgeShare(inside, edges), 0.1);
+  // Any fold is a crease without the sharpness test: most of it.
+  SurfaceEdgeOptions any_fold;
+  any_fold.concave_min_curvature = 0.0f;
+  EXPECT_GT(EdgeShare(inside, FindSurfaceEdges(cloud, any_fold)), 0.3);
+  // The stacked box still comes off the one below.
+  cv::Mat boxes = labels.clone();
+  boxes.setTo(0, labels == 20);
+  EXPECT_EQ(MostLabelsInOneComponent(boxes, edges), 1);
+}
+
 TEST(SurfaceEdgesTest, AFlatTableHasNoEdges) {
   const RgbdFrame frame = testing::PlaneFrame({0.0f, -0.6f, -0.8f}, 0.9f);
   absl::StatusOr<OrganizedCloud> cloud = BuildOrganizedCloud(frame, {});
@@ -150,6 +191,10 @@ TEST(SurfaceEdgesTest, RejectsBadOptionsNamingTheField) {
   o = {};
   o.concave_curvature = std::numeric_limits<float>::quiet_NaN();
   EXPECT_NE(Validate(o).message().find("concave_curvature"), std::string::npos);
+  o = {};
+  o.concave_min_curvature = -1.0f;
+  EXPECT_NE(Validate(o).message().find("concave_min_curvature"),
+            std::string::npos);
   EXPECT_TRUE(Validate(SurfaceEdgeOptions{}).ok());
 }
 

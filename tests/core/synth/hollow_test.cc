@@ -58,21 +58,37 @@ TEST(HollowTest, ARayDownAtAnAngleMeetsTheFarInsideWall) {
   EXPECT_GT(hit->normal.x(), 0.99f);  // the inner wall faces the axis
 }
 
+// Height above the foot of a bowl's inside at `rho` from its axis: the
+// sphere through the rim's inner circle (rim_radius at depth below the
+// rim) and the floor (depth below the rim), as synth_scene.h describes it.
+float InsideHeight(float rim_radius, float depth, float floor, float rho) {
+  const float r_in = (rim_radius * rim_radius + depth * depth) / (2 * depth);
+  return floor + r_in - std::sqrt(r_in * r_in - rho * rho);
+}
+
 TEST(HollowTest, ABowlIsASphericalShellCutFlatWithAFoot) {
-  // Radius 8 cm, 5 cm deep, 5 mm wall; the rim is the sphere's equator.
+  // Radius 8 cm, 5 cm deep, 5 mm wall; the rim is the outer sphere's
+  // equator. The inside meets the rim 75 mm out and the floor 5 mm up.
   const Primitive bowl = Hollow(Shape::kBowl, 0.08f, 0.025f, 0.005f);
-  // Straight down the axis: the inside bottom, flat at 5 mm.
+  // Straight down the axis: the floor, at 5 mm, facing up.
   const std::optional<RayHit> down = IntersectPrimitive(
       bowl, Vector3f(0, 0, 1), Vector3f(0, 0, -1), 0.0f, 10.0f);
   ASSERT_TRUE(down.has_value());
   EXPECT_NEAR(1.0f - down->t, 0.005f, 1e-5f);
-  // 6 cm off the axis the ray meets the inside of the sphere (radius 75 mm
-  // about the rim's centre at z = 5 cm): z = 0.05 - sqrt(0.075^2 - 0.06^2).
+  EXPECT_GT(down->normal.z(), 0.99f);
+  // 6 cm off the axis the inside rises smoothly towards the rim; its normal
+  // leans towards the axis.
   const std::optional<RayHit> inside = IntersectPrimitive(
       bowl, Vector3f(0.06f, 0, 1), Vector3f(0, 0, -1), 0.0f, 10.0f);
   ASSERT_TRUE(inside.has_value());
-  EXPECT_NEAR(1.0f - inside->t,
-              0.05f - std::sqrt(0.075f * 0.075f - 0.06f * 0.06f), 1e-4f);
+  EXPECT_NEAR(1.0f - inside->t, InsideHeight(0.075f, 0.045f, 0.005f, 0.06f),
+              1e-4f);
+  EXPECT_LT(inside->normal.x(), -0.5f);
+  // Just inside the rim's inner circle the inside is at the rim's height.
+  const std::optional<RayHit> top = IntersectPrimitive(
+      bowl, Vector3f(0.0749f, 0, 1), Vector3f(0, 0, -1), 0.0f, 10.0f);
+  ASSERT_TRUE(top.has_value());
+  EXPECT_NEAR(1.0f - top->t, 0.05f, 2e-3f);
   // From below, the flat foot of radius sqrt(0.08^2 - 0.05^2).
   const std::optional<RayHit> foot = IntersectPrimitive(
       bowl, Vector3f(0.05f, 0, -1), Vector3f(0, 0, 1), 0.0f, 10.0f);
@@ -85,6 +101,26 @@ TEST(HollowTest, ABowlIsASphericalShellCutFlatWithAFoot) {
   ASSERT_TRUE(wall.has_value());
   EXPECT_NEAR(wall->t - 1.0f,
               0.05f - std::sqrt(0.08f * 0.08f - 0.065f * 0.065f), 1e-4f);
+}
+
+TEST(HollowTest, ABowlOnAFootRingHasItsFloorAtTheFloorHeight) {
+  Primitive bowl = Hollow(Shape::kBowl, 0.08f, 0.025f, 0.005f);
+  bowl.floor_height = 0.015f;
+  // Straight down the axis: the floor 15 mm up, not the wall's 5 mm.
+  const std::optional<RayHit> down = IntersectPrimitive(
+      bowl, Vector3f(0, 0, 1), Vector3f(0, 0, -1), 0.0f, 10.0f);
+  ASSERT_TRUE(down.has_value());
+  EXPECT_NEAR(1.0f - down->t, 0.015f, 1e-5f);
+  // 4 cm out, the shallower inside (35 mm deep) as InsideHeight has it.
+  const std::optional<RayHit> inside = IntersectPrimitive(
+      bowl, Vector3f(0.04f, 0, 1), Vector3f(0, 0, -1), 0.0f, 10.0f);
+  ASSERT_TRUE(inside.has_value());
+  EXPECT_NEAR(1.0f - inside->t, InsideHeight(0.075f, 0.035f, 0.015f, 0.04f),
+              1e-4f);
+  SceneSpec spec;
+  bowl.floor_height = 0.06f;  // above the 5 cm rim
+  spec.objects = {bowl};
+  EXPECT_NE(Validate(spec).message().find("floor_height"), std::string::npos);
 }
 
 TEST(HollowTest, ValidateRefusesAWallThickerThanTheRadiusAndADeepBowl) {
