@@ -679,6 +679,7 @@ absl::StatusOr<SegmentOptions> ToSegmentOptions(
   options.seeds = *std::move(seeds);
   options.max_objects =
       static_cast<int>(std::min<uint32_t>(request.max_objects(), 1u << 20));
+  if (request.has_cover_scene()) options.cover_scene = request.cover_scene();
   return options;
 }
 

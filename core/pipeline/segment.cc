@@ -108,6 +108,36 @@ void DescribeObject(const OrganizedCloud& cloud, SegmentedObject& object) {
   }
 }
 
+std::optional<cv::Point> CoverSeed(const OrganizedCloud& cloud,
+                                   const cv::Mat& free, double min_area_m2,
+                                   cv::Mat& piece) {
+  cv::Mat labels;
+  const int n = cv::connectedComponents(free, labels, 8, CV_32S);
+  if (n <= 1) return std::nullopt;
+  std::vector<double> area(n, 0.0);
+  const double per_z2 = 1.0 / (cloud.intrinsics.fx * cloud.intrinsics.fy);
+  for (int v = 0; v < labels.rows; ++v) {
+    const int* l = labels.ptr<int>(v);
+    const cv::Vec3f* xyz = cloud.xyz.ptr<cv::Vec3f>(v);
+    for (int u = 0; u < labels.cols; ++u) {
+      if (l[u] == 0 || std::isnan(xyz[u][2])) continue;
+      area[l[u]] += per_z2 * xyz[u][2] * xyz[u][2];
+    }
+  }
+  const int best = static_cast<int>(
+      std::max_element(area.begin() + 1, area.end()) - area.begin());
+  if (area[best] < min_area_m2 || area[best] <= 0.0) return std::nullopt;
+  piece = labels == best;
+  // The piece's innermost pixel; the frame's border counts as a border.
+  cv::Mat framed;
+  cv::copyMakeBorder(piece, framed, 1, 1, 1, 1, cv::BORDER_CONSTANT, 0);
+  cv::Mat distance;
+  cv::distanceTransform(framed, distance, cv::DIST_L2, 3);
+  cv::Point at;
+  cv::minMaxLoc(distance, nullptr, nullptr, nullptr, &at);
+  return cv::Point(at.x - 1, at.y - 1);
+}
+
 namespace {
 
 // Pixels standing on the table: what scene_coverage is a fraction of.
@@ -321,21 +351,20 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
   const cv::Mat region =
       ObjectRegion(scene->table, options.detect.table_scene.min_object_height);
   cv::Mat covered(region.size(), CV_8UC1, cv::Scalar(0));
-  for (const AttentionPoint& seed : *seeds) {
-    if (options.max_objects > 0 && summary.objects >= options.max_objects) {
-      summary.stop = SegmentStop::kMaxObjects;
-      break;
-    }
-    if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
-    lap = SteadyClock::now();
+  // Cuts the object at `seed`; false when it yields none to report. A cover
+  // seed's object is what no earlier mask holds.
+  const auto cut_and_send = [&](const AttentionPoint& seed, bool cover,
+                                const char* stage) -> absl::StatusOr<bool> {
+    const SteadyClock::time_point at = SteadyClock::now();
     absl::StatusOr<std::optional<CutObject>> cut =
         cutter->Cut({seed.u, seed.v}, interrupt);
     if (!cut.ok()) return cut.status();
-    summary.timings.push_back({"segment.object", SecondsSince(lap)});
-    if (!cut->has_value()) continue;
+    summary.timings.push_back({stage, SecondsSince(at)});
+    if (!cut->has_value()) return false;
+    if (cover) (*cut)->mask.setTo(0, covered);
     if (VisibleArea(scene->cloud, (*cut)->mask) < options.min_object_area_m2 ||
         StandingShare(scene->table, (*cut)->mask) < kMinStandingShare) {
-      continue;  // a fragment, or not on the table
+      return false;  // a fragment, or not on the table
     }
     SegmentedObject object;
     object.seed = seed;
@@ -349,7 +378,46 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
     if (sinks.object) {
       if (absl::Status s = sinks.object(std::move(object)); !s.ok()) return s;
     }
+    return true;
+  };
+  const auto full = [&] {
+    return options.max_objects > 0 && summary.objects >= options.max_objects;
+  };
+  for (const AttentionPoint& seed : *seeds) {
+    if (full()) break;
+    if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
+    if (absl::StatusOr<bool> sent = cut_and_send(seed, false, "segment.object");
+        !sent.ok()) {
+      return sent.status();
+    }
   }
+  if (options.cover_scene.value_or(options.seeds.empty())) {
+    // Standing pixels off surface edges; each cover seed's piece is tried
+    // once, so this ends after at most one seed per piece.
+    cv::Mat tried = FindSurfaceEdges(scene->cloud, options.detect.surface_edges);
+    tried.setTo(255, scene->table.standing == 0);
+    int cover_seeds = 0;
+    while (!full() && cover_seeds < kMaxAttentionPoints) {
+      if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
+      cv::Mat piece;
+      const std::optional<cv::Point> at =
+          CoverSeed(scene->cloud, ~(tried | covered),
+                    options.min_object_area_m2, piece);
+      if (!at.has_value()) break;
+      ++cover_seeds;
+      tried.setTo(255, piece);
+      AttentionPoint seed;
+      seed.u = at->x;
+      seed.v = at->y;
+      const cv::Vec3f& q = scene->cloud.xyz.at<cv::Vec3f>(*at);
+      seed.point = {q[0], q[1], q[2]};
+      if (absl::StatusOr<bool> sent = cut_and_send(seed, true, "segment.cover");
+          !sent.ok()) {
+        return sent.status();
+      }
+    }
+  }
+  if (full()) summary.stop = SegmentStop::kMaxObjects;
   const int region_pixels = cv::countNonZero(region);
   summary.scene_coverage =
       region_pixels > 0

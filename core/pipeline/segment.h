@@ -5,6 +5,7 @@
 #include <chrono>
 #include <functional>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string_view>
 #include <vector>
 
@@ -46,8 +47,14 @@ struct SegmentOptions {
   // also prepares the scene (normals, support plane) either way.
   std::vector<cv::Point> seeds;
   DetectOptions detect;
-  // Objects to cut out at most; 0 = one per seed.
+  // Objects to cut out at most; 0 = one per seed (and per cover seed).
   int max_objects = 0;
+  // After the seeds, surfaces standing on the table that no mask holds yet
+  // get seeds too (CoverSeed), until every one is in a mask or has yielded
+  // no object, so that running to the end segments the whole scene as INC
+  // does. Unset: on when the seeds come from Detect (all objects), off when
+  // the caller gives them (just those objects).
+  std::optional<bool> cover_scene;
   // Masks showing less than this visible area are fragments (a rim, a
   // sliver of an occluded object, sensor noise) and are not reported, m^2:
   // 4 cm^2 is a 2 x 2 cm face (VisibleArea). Nor are masks less than
@@ -92,6 +99,15 @@ void DescribeObject(const OrganizedCloud& cloud, SegmentedObject& object);
 // (TableScene::standing), [0, 1] (1 for a mask without depth).
 double StandingShare(const TableScene& table, const cv::Mat& mask);
 
+// Where to seed the next object of a scene whose `covered` pixels are in
+// masks already: on the largest piece (by VisibleArea) of `free` (pixels
+// standing on the table, off surface edges, not covered, not tried) of at
+// least `min_area_m2`, the pixel farthest from the piece's border. nullopt
+// when there is none. `piece` receives the piece's pixels (CV_8UC1, 255).
+std::optional<cv::Point> CoverSeed(const OrganizedCloud& cloud,
+                                   const cv::Mat& free, double min_area_m2,
+                                   cv::Mat& piece);
+
 // The area the mask's points show the camera, m^2: each pixel with depth z
 // covers z^2 / (fx fy) facing the camera (a lower bound of the surface's
 // area, exact for a face seen head-on).
@@ -119,8 +135,8 @@ struct SegmentSummary {
   // detect.table_scene.min_object_height) inside an emitted mask, [0, 1].
   double scene_coverage = 0.0;
   // "cloud", "normals", "support_plane", Detect's stages when it ran,
-  // "segment.prepare" (the method's per-frame work) and one
-  // "segment.object" per seed.
+  // "segment.prepare" (the method's per-frame work), one
+  // "segment.object" per seed and one "segment.cover" per cover seed.
   std::vector<StageTiming> timings;
   double total_seconds = 0.0;
 };
@@ -137,7 +153,9 @@ struct SegmentSinks {
 };
 
 // Prepares the scene, takes the seeds, and for each seed in order cuts out
-// its object and hands it to `sinks.object` at once. A seed whose object
+// its object and hands it to `sinks.object` at once; then, with
+// cover_scene, the same for each cover seed (its object less what earlier
+// masks hold). A seed whose object
 // was already cut out, or that lies on the table or on nothing, yields no
 // object. COS: see CosSegmenter (objects are disjoint patch sets). EBS:
 // the inside of the minimum-cost contour around the seed on the model's

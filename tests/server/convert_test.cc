@@ -257,6 +257,17 @@ TEST(ToDetectOptionsTest, BadSceneHintsAreInvalidAndNamed) {
               HasSubstr("detect_options.options.scene.gravity"));
 }
 
+TEST(ToSegmentOptionsTest, CoverSceneIsLeftToCoreUnlessSet) {
+  v1::SegmentRequest request;
+  absl::StatusOr<SegmentOptions> unset = ToSegmentOptions(request);
+  ASSERT_TRUE(unset.ok()) << unset.status();
+  EXPECT_FALSE(unset->cover_scene.has_value());
+  request.set_cover_scene(false);
+  absl::StatusOr<SegmentOptions> off = ToSegmentOptions(request);
+  ASSERT_TRUE(off.ok()) << off.status();
+  EXPECT_EQ(off->cover_scene, std::optional<bool>(false));
+}
+
 TEST(ToProtoSupportPlaneTest, CarriesTheChoiceAndItsScore) {
   SupportPlane plane;
   plane.normal = {0.0f, -0.8f, -0.6f};

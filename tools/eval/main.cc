@@ -110,6 +110,10 @@ ABSL_FLAG(int, folds, 0,
           "segment: 0 scores the models as shipped (--models); K >= 2 "
           "cross-validates instead: scene i is scored with models trained on "
           "the scenes of the other K - 1 folds.");
+ABSL_FLAG(bool, cover_scene, true,
+          "segment --method cos / ebs: after the attention points, seed the "
+          "surfaces no mask holds yet (the server's default for all "
+          "objects); false: the attention points' objects only.");
 ABSL_FLAG(double, svm_c, fovea::LinearSvmTrainingOptions().c,
           "segment: the COS SVM's soft-margin penalty C.");
 ABSL_FLAG(int, count, 200, "rooms: rooms per sensor and size.");
@@ -450,6 +454,7 @@ int RunSegmentEval() {
     return RunRandomPointsEval(options.detect, *scenes);
   }
   options.folds = absl::GetFlag(FLAGS_folds);
+  options.cover_scene = absl::GetFlag(FLAGS_cover_scene);
   if (options.folds == 1 || options.folds < 0) {
     std::fprintf(stderr, "fovea-eval: --folds: 0 (held out) or >= 2\n");
     return kUsageError;

@@ -163,6 +163,7 @@ absl::StatusOr<MethodResults> EvaluateMethods(
         run_options.method = method;
         run_options.detect = options.detect;
         run_options.models = models;
+        run_options.cover_scene = options.cover_scene;
         absl::StatusOr<SceneRun> run = RunOnScene(scene, run_options);
         if (!run.ok()) {
           return InScene(absl::StrCat(scene.name, " (",

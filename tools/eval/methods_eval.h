@@ -2,6 +2,7 @@
 #define FOVEA_TOOLS_EVAL_METHODS_EVAL_H_
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,7 @@ struct MethodsEvalOptions {
   DetectOptions detect;
   const LoadedModels* models = nullptr;  // not owned; used when folds < 2
   int folds = 0;
+  std::optional<bool> cover_scene;  // SceneRunOptions::cover_scene
   LinearSvmTrainingOptions cos_svm;
   RbfSvmTrainingOptions inc_svm;
   std::string out_dir;  // <scene>_<method>.png: masks beside the truth

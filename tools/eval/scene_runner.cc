@@ -128,6 +128,7 @@ absl::StatusOr<SceneRun> RunOnScene(const LabelledFrame& scene,
     segment.method = options.method == SceneMethod::kCos ? SegmentMethod::kCos
                                                          : SegmentMethod::kEbs;
     segment.detect = options.detect;
+    segment.cover_scene = options.cover_scene;
     summary = RunSegment(scene.frame, segment, options.models, sinks);
   }
   if (!summary.ok()) return summary.status();

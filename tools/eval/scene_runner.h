@@ -28,6 +28,8 @@ struct SceneRunOptions {
   SceneMethod method = SceneMethod::kInc;
   DetectOptions detect;  // seeds / saliency, scene (sensor, hints)
   SegmentModels models;  // not owned; those the method needs
+  // COS / EBS: SegmentOptions::cover_scene (unset: on, as for all objects).
+  std::optional<bool> cover_scene;
 };
 
 struct SceneRun {

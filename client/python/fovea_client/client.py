@@ -106,13 +106,15 @@ class FoveaClient:
 
     def segment(self, color_rgb, depth_m, fx, fy, cx, cy, method="COS",
                 max_objects=0, seeds=(), timeout=None, request_id="",
-                **options):
+                cover_scene=None, **options):
         """Object masks for one frame, as a generator of SegmentResponse.
 
         Messages are yielded as they arrive: first the attention points,
         then one per object (`response.object`, mask as COCO RLE; see
         decode_rle), then one with `last` set and a summary. method: "COS"
         or "EBS". seeds: (u, v) pixels to use instead of attention points.
+        cover_scene: after the seeds, seed what no mask holds yet (None:
+        the server's default, on without seeds, off with them).
         `options` are DetectOptions fields for the attention points.
         Breaking out of the loop early cancels the call.
         """
@@ -122,6 +124,8 @@ class FoveaClient:
             method=method, max_objects=max_objects,
             seeds=[detect_pb2.AttentionPixel(u=u, v=v) for u, v in seeds],
             detect_options=detect_options(**options))
+        if cover_scene is not None:
+            request.cover_scene = cover_scene
         return self.segment_request(request, timeout=timeout)
 
     def segment_request(self, request, timeout=None):

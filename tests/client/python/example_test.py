@@ -119,6 +119,25 @@ class ExampleTest(unittest.TestCase):
                          grpc.StatusCode.INVALID_ARGUMENT)
         self.assertIn("options.scene.gravity", caught.exception.details())
 
+    def test_cover_scene_adds_the_box_without_a_seed(self):
+        sys.path.insert(0, os.path.dirname(os.path.abspath(ARGS.example)))
+        from example import CX, CY, FX, FY, render_table_scene
+        rgb, depth = render_table_scene()
+        # A seed on the red box only (the left one, nearer the bottom).
+        rows, cols = numpy.nonzero((rgb[..., 0] > 170) & (rgb[..., 1] < 80))
+        seed = (int(numpy.median(cols)), int(numpy.median(rows)))
+
+        def objects(**kwargs):
+            with FoveaClient(self.target) as client:
+                return [m.object for m in client.segment(
+                    rgb, depth, FX, FY, CX, CY, seeds=[seed], timeout=60,
+                    **kwargs) if m.HasField("object")]
+
+        self.assertEqual(len(objects()), 1)  # seeds given: just theirs
+        covered = objects(cover_scene=True)
+        self.assertEqual(len(covered), 2)
+        self.assertEqual((covered[0].seed.u, covered[0].seed.v), seed)
+
     def test_bad_frame_is_invalid_argument(self):
         rgb = numpy.zeros((4, 4, 3), numpy.uint8)
         depth = numpy.zeros((4, 4), numpy.float32)

@@ -86,6 +86,55 @@ TEST(RunSegmentTest, StopsAtMaxObjects) {
   EXPECT_EQ(run.summary->stop, SegmentStop::kMaxObjects);
 }
 
+TEST(RunSegmentTest, CoverSceneSeedsTheBoxNoSeedHeld) {
+  const synth::SynthScene scene = testing::TwoBoxesOnTable();
+  const cv::Point red = testing::CentreOfLabel(scene.frame.labels, 20);
+  SegmentOptions options;
+  options.seeds = {red};
+  // Given seeds: just their objects.
+  const SegmentRun given = RunOn(scene, options);
+  ASSERT_TRUE(given.summary.ok()) << given.summary.status();
+  ASSERT_EQ(given.objects.size(), 1u);
+  // Covering the scene: the blue box too, from a seed on it, and nothing
+  // else (the table is not standing, the red box is held).
+  options.cover_scene = true;
+  const SegmentRun covered = RunOn(scene, options);
+  ASSERT_TRUE(covered.summary.ok()) << covered.summary.status();
+  ASSERT_EQ(covered.objects.size(), 2u);
+  const SegmentedObject& blue = covered.objects[1];
+  EXPECT_EQ(scene.frame.labels.at<int>(blue.seed.v, blue.seed.u), 30);
+  EXPECT_EQ(cv::countNonZero(blue.mask & covered.objects[0].mask), 0);
+  EXPECT_GT(covered.summary->scene_coverage,
+            given.summary->scene_coverage + 0.2);
+  int cover_stages = 0;
+  for (const StageTiming& t : covered.summary->timings) {
+    cover_stages += t.stage == "segment.cover";
+  }
+  EXPECT_GE(cover_stages, 1);
+  // max_objects still bounds it.
+  options.max_objects = 1;
+  EXPECT_EQ(RunOn(scene, options).objects.size(), 1u);
+}
+
+TEST(CoverSeedTest, SeedsTheLargestPieceAtItsInnermostPixel) {
+  OrganizedCloud cloud;
+  cloud.intrinsics = {525.0, 525.0, 20.0, 15.0};
+  cloud.xyz = cv::Mat(30, 40, CV_32FC3, cv::Scalar(0.0f, 0.0f, 1.0f));
+  cv::Mat free(30, 40, CV_8UC1, cv::Scalar(0));
+  free(cv::Rect(2, 2, 5, 5)).setTo(255);     // 25 px
+  free(cv::Rect(20, 10, 11, 11)).setTo(255);  // 121 px, centre (25, 15)
+  cv::Mat piece;
+  const std::optional<cv::Point> at = CoverSeed(cloud, free, 0.0, piece);
+  ASSERT_TRUE(at.has_value());
+  EXPECT_EQ(*at, cv::Point(25, 15));
+  EXPECT_EQ(cv::countNonZero(piece), 121);
+  // 121 px at 1 m and 525 px focal: 4.4e-4 m^2.
+  EXPECT_TRUE(CoverSeed(cloud, free, 4e-4, piece).has_value());
+  EXPECT_FALSE(CoverSeed(cloud, free, 5e-4, piece).has_value());
+  EXPECT_FALSE(CoverSeed(cloud, cv::Mat::zeros(30, 40, CV_8UC1), 0.0, piece)
+                   .has_value());
+}
+
 TEST(RunSegmentTest, SeedsFromDetectFindBothBoxes) {
   const synth::SynthScene scene = testing::TwoBoxesOnTable();
   const SegmentRun run = RunOn(scene, SegmentOptions{});
