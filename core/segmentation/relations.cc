@@ -155,6 +155,15 @@ absl::Status Validate(const RelationOptions& options) {
   if (!(options.touch_depth_fraction > 0)) {
     return absl::InvalidArgumentError("touch_depth_fraction must be positive");
   }
+  if (options.convexity_offset_px < 1 || options.convexity_offset_px > 32) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("convexity_offset_px must be in [1, 32], got ",
+                     options.convexity_offset_px));
+  }
+  if (!(options.sharp_concave > 0.0f && options.sharp_concave <= 2.0f)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "sharp_concave must be in (0, 2], got ", options.sharp_concave));
+  }
   return absl::OkStatus();
 }
 
@@ -166,7 +175,9 @@ const std::vector<std::string>& RelationFeatureNames() {
           "border_color_mean",  "border_color_variation",
           "border_depth_mean",  "border_depth_variation",
           "border_angle_mean",  "border_angle_variation",
-          "border_3d_fraction", "curvature_similarity"};
+          "border_3d_fraction", "curvature_similarity",
+          "border_convexity",   "border_sharp_concave_fraction",
+          "uprightness_difference"};
   return *names;
 }
 
@@ -177,8 +188,12 @@ uint64_t RelationComputer::Key(int a, int b) {
 
 RelationComputer::RelationComputer(const OrganizedCloud& cloud,
                                    const cv::Mat& labels, int count,
+                                   const Eigen::Vector3f& up,
                                    const RelationOptions& options)
-    : options_(options), points_(count, 0), curvature_(count, 0.0) {
+    : options_(options),
+      points_(count, 0),
+      curvature_(count, 0.0),
+      uprightness_(count, 0.0) {
   histograms_ = LabelColorHistograms(cloud.color, labels, count, options.color);
   cv::Mat grey, grey_half, labels_half;
   cv::cvtColor(cloud.color, grey, cv::COLOR_RGB2GRAY);
@@ -217,9 +232,14 @@ RelationComputer::RelationComputer(const OrganizedCloud& cloud,
       ++with_normal[l];
     }
   }
+  const Eigen::Vector3d up_d = up.cast<double>().normalized();
   for (int l = 0; l < count; ++l) {
     if (with_normal[l] > 0) curvature_[l] /= with_normal[l];
+    if (mean_normal[l].norm() > 0.0) {
+      uprightness_[l] = std::abs(mean_normal[l].normalized().dot(up_d));
+    }
   }
+  const int offset = options.convexity_offset_px;
 
   // Borders: every 4-adjacent pixel pair of two surfaces.
   for (int v = 0; v < labels.rows; ++v) {
@@ -242,6 +262,9 @@ RelationComputer::RelationComputer(const OrganizedCloud& cloud,
           border.depth_sq += step * step;
           if (step <= options.touch_depth_fraction) ++border.touching;
         }
+        const bool touching =
+            !std::isnan(za) && !std::isnan(zb) &&
+            std::abs(za - zb) / std::max(za, zb) <= options.touch_depth_fraction;
         const cv::Vec3f& la = lab.at<cv::Vec3f>(v, u);
         const cv::Vec3f& lb = lab.at<cv::Vec3f>(y, x);
         const double color = cv::norm(la - lb);
@@ -257,6 +280,30 @@ RelationComputer::RelationComputer(const OrganizedCloud& cloud,
           border.angle_sum += angle;
           border.angle_sq += angle * angle;
         }
+        // Convexity from points `offset` pixels inside either surface,
+        // where the two touch (across a depth jump they need not meet).
+        if (!touching) continue;
+        const int pu = u - offset * d.x, pv = v - offset * d.y;
+        const int qu = x + offset * d.x, qv = y + offset * d.y;
+        if (pu < 0 || pv < 0 || qu >= labels.cols || qv >= labels.rows ||
+            labels.at<int>(pv, pu) != a || labels.at<int>(qv, qu) != b) {
+          continue;
+        }
+        const cv::Vec3f& pp = cloud.xyz.at<cv::Vec3f>(pv, pu);
+        const cv::Vec3f& qq = cloud.xyz.at<cv::Vec3f>(qv, qu);
+        const cv::Vec3f& np = cloud.normals.at<cv::Vec3f>(pv, pu);
+        const cv::Vec3f& nq = cloud.normals.at<cv::Vec3f>(qv, qu);
+        if (std::isnan(pp[2]) || std::isnan(qq[2]) || std::isnan(np[2]) ||
+            std::isnan(nq[2])) {
+          continue;
+        }
+        const cv::Vec3f pq = qq - pp;
+        const double length = cv::norm(pq);
+        if (length <= 0.0) continue;
+        const double convexity = (nq - np).dot(pq) / length;
+        ++border.folds;
+        border.convexity_sum += convexity;
+        border.sharp_concave += convexity < -options.sharp_concave;
       }
     }
   }
@@ -295,6 +342,15 @@ std::vector<double> RelationComputer::Relate(int a, int b) const {
     f[10] = border.touching / n;
   }
   f[11] = Clamp01(1.0 - std::abs(curvature_[a] - curvature_[b]) * 10.0);
+  if (found != borders_.end() && found->second.folds > 0) {
+    const Border& border = found->second;
+    // Mean convexity, in [-2, 2], mapped to [0, 1]: 0.5 is flat.
+    f[12] = Clamp01(0.5 + 0.25 * border.convexity_sum / border.folds);
+    f[13] = static_cast<double>(border.sharp_concave) / border.folds;
+  } else {
+    f[12] = 0.5;
+  }
+  f[14] = std::abs(uprightness_[a] - uprightness_[b]);
   return f;
 }
 

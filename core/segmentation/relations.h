@@ -1,6 +1,7 @@
 #ifndef FOVEA_CORE_SEGMENTATION_RELATIONS_H_
 #define FOVEA_CORE_SEGMENTATION_RELATIONS_H_
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <opencv2/core.hpp>
 #include <string>
@@ -34,6 +35,17 @@ struct RelationOptions {
   // Two 4-neighbours across a border are a 3D border (the surfaces touch in
   // space) when their depths differ by at most this fraction of depth.
   float touch_depth_fraction = 0.02f;
+  // Convexity across a border (after Stein et al. 2014, LCCP): for each
+  // 4-adjacent pixel pair across it that touches (touch_depth_fraction), the points this many pixels inside
+  // either surface, p and q, and their normals give
+  // c = (n_q - n_p) . (q - p) / |q - p|: > 0 where the surfaces fold away
+  // from each other (the faces of one box), < 0 where they fold towards
+  // each other (a tin standing on a box, a can in a bowl), about 0 on one
+  // smooth surface. 3 px is 6 mm at 1 m, beyond the pixels whose normals
+  // straddle the border.
+  int convexity_offset_px = 3;
+  // c below minus this is a sharp concave fold: 0.25 is about 15 degrees.
+  float sharp_concave = 0.25f;
 };
 
 absl::Status Validate(const RelationOptions& options);
@@ -46,8 +58,11 @@ const std::vector<std::string>& RelationFeatureNames();
 // every 4-adjacent pair, the statistics along their shared border.
 class RelationComputer {
  public:
+  // `up`: the support's normal (unit, pointing away from the support, into
+  // the half space the objects stand in), for the relations to gravity.
   RelationComputer(const OrganizedCloud& cloud, const cv::Mat& labels,
-                   int count, const RelationOptions& options);
+                   int count, const Eigen::Vector3f& up,
+                   const RelationOptions& options);
 
   // The features of the pair (a, b), RelationFeatureNames() order. A pair
   // that shares no border gets border features of 0.
@@ -65,6 +80,9 @@ class RelationComputer {
     double color_sum = 0, color_sq = 0;
     double depth_sum = 0, depth_sq = 0;
     double angle_sum = 0, angle_sq = 0;
+    int folds = 0;     // pairs whose convexity could be measured
+    double convexity_sum = 0;
+    int sharp_concave = 0;
   };
   static uint64_t Key(int a, int b);
 
@@ -74,6 +92,7 @@ class RelationComputer {
   std::vector<std::vector<double>> fourier_;
   std::vector<int> points_;
   std::vector<double> curvature_;  // mean 1 - n . (mean normal)
+  std::vector<double> uprightness_;  // |mean normal . up|, [0, 1]
   std::unordered_map<uint64_t, Border> borders_;
   std::vector<std::pair<int, int>> pairs_;
 };

@@ -3,6 +3,7 @@
 //   fovea-train cos --data DIR --out models/cos_svm.txt [--folds 5] [--c 1]
 //   fovea-train ebs --data DIR --out models/ebs_edges.txt [--folds 5]
 //   fovea-train inc --data DIR --out models/inc_relations.txt [--grid]
+//                   [--piles N [--pile_seed S]]
 //
 // Prints the k-fold cross-validated accuracy (folds by scene) and writes
 // the model trained on every scene, with that accuracy in its provenance.
@@ -22,6 +23,7 @@
 #include "core/segmentation/cos.h"
 #include "core/segmentation/ebs.h"
 #include "core/segmentation/linear_svm.h"
+#include "core/synth/synth_scene.h"
 #include "tools/eval/detect_eval.h"
 
 ABSL_FLAG(std::string, data, "",
@@ -35,6 +37,12 @@ ABSL_FLAG(std::string, samples_csv, "",
 ABSL_FLAG(bool, grid, false,
           "inc: search C and gamma by cross-validation (2, 32, 512 x 0.5, "
           "2, 8) instead of using the defaults.");
+ABSL_FLAG(int, piles, 0,
+          "inc: also train on this many synthetic piles (core/synth "
+          "GeneratePile), seeds from --pile_seed.");
+ABSL_FLAG(uint64_t, pile_seed, 1000001,
+          "inc: the first training pile's seed; far from fovea-eval's "
+          "--seed 1 so that its piles stay held out.");
 ABSL_FLAG(double, c, fovea::LinearSvmTrainingOptions().c,
           "cos: the SVM's soft-margin penalty C.");
 
@@ -235,6 +243,16 @@ int TrainInc() {
   const std::string out = absl::GetFlag(FLAGS_out);
   absl::StatusOr<std::vector<LabelledFrame>> scenes;
   if (const int code = LoadScenesOrExit("inc", scenes); code != 0) return code;
+  const int learn_scenes = static_cast<int>(scenes->size());
+  const int piles = absl::GetFlag(FLAGS_piles);
+  if (piles < 0) {
+    std::fprintf(stderr, "fovea-train: --piles must not be negative\n");
+    return kUsageError;
+  }
+  for (int k = 0; k < piles; ++k) {
+    scenes->push_back(
+        synth::GeneratePile(absl::GetFlag(FLAGS_pile_seed) + k).frame);
+  }
   const IncrementalOptions options;
   std::vector<SvmSample> samples;
   for (size_t i = 0; i < scenes->size(); ++i) {
@@ -297,9 +315,11 @@ int TrainInc() {
       model->Serialize(), "inc");  // round trip: what the server will load
   std::string text = trained.Serialize();
   const std::string provenance = absl::StrFormat(
-      "fovea-train inc, %zu scenes, %zu samples, C %g gamma %g; %d-fold "
+      "fovea-train inc, %d scenes and %d synthetic piles (seeds from %u), "
+      "%zu samples, C %g gamma %g; %d-fold "
       "cross-validated accuracy %.3f (balanced %.3f)",
-      scenes->size(), samples.size(), best.c, best.gamma, best_cv.folds,
+      learn_scenes, piles,
+      static_cast<unsigned>(absl::GetFlag(FLAGS_pile_seed)), samples.size(), best.c, best.gamma, best_cv.folds,
       best_cv.accuracy, best_cv.balanced_accuracy);
   const size_t at = text.find("\nprovenance ");
   const size_t end = text.find('\n', at + 1);

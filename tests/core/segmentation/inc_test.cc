@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "core/pipeline/detect.h"
 #include "core/pipeline/incremental.h"
 #include "core/synth/synth_scene.h"
@@ -10,12 +12,15 @@
 namespace fovea {
 namespace {
 
-// A relation SVM trained on random synthetic scenes (not the test scenes).
+// A relation SVM trained on random synthetic scenes and piles (not the
+// test scenes).
 const RbfSvm& TrainedSvm() {
   static const RbfSvm* svm = [] {
     std::vector<SvmSample> samples;
-    for (uint64_t seed = 21; seed < 29; ++seed) {
-      const synth::SynthScene scene = synth::GenerateScene(seed);
+    for (uint64_t seed = 21; seed < 33; ++seed) {
+      const synth::SynthScene scene = seed % 2 == 0
+                                          ? synth::GenerateScene(seed)
+                                          : synth::GeneratePile(seed);
       absl::StatusOr<std::vector<SvmSample>> s = CollectIncSamples(
           scene.frame, static_cast<int>(seed), DetectOptions{}, IncOptions{});
       if (s.ok()) samples.insert(samples.end(), s->begin(), s->end());
@@ -52,8 +57,10 @@ TEST(RelationsTest, FacesOfOneBoxRelateMoreThanFacesOfTwo) {
       BuildCosScene(scene.prepared.cloud, scene.prepared.plane, CosOptions{});
   ASSERT_TRUE(surfaces.ok());
   const int n = static_cast<int>(surfaces->patches.patches.size());
-  const RelationComputer relations(
-      scene.prepared.cloud, surfaces->patches.labels, n, RelationOptions{});
+  const RelationComputer relations(scene.prepared.cloud,
+                                   surfaces->patches.labels, n,
+                                   scene.prepared.plane.normal,
+                                   RelationOptions{});
   const std::vector<int> object =
       PatchObjectIds(*surfaces, scene.synth.frame.labels);
   double same_color = 0, other_color = 0;
@@ -76,6 +83,66 @@ TEST(RelationsTest, FacesOfOneBoxRelateMoreThanFacesOfTwo) {
   ASSERT_GT(other, 0);
   // Red faces with red faces; red against blue.
   EXPECT_GT(same_color / same, other_color / other + 0.2);
+}
+
+// A 6 cm cube standing on a 20 x 14 x 5 cm box (a tin on a cake box):
+// their border is a concave fold, the cube's faces meet in convex ones, and
+// the box's top is level where the cube's front face is upright.
+TEST(RelationsTest, AStackedBoxFoldsInwardsWhereItsFacesFoldOutwards) {
+  synth::SceneSpec spec;
+  spec.camera_pose = synth::LookAt({0.2f, -0.7f, 0.7f}, {0.0f, 0.0f, 0.05f});
+  synth::Primitive cake;
+  cake.shape = synth::Shape::kBox;
+  cake.half_extents = {0.10f, 0.07f, 0.025f};
+  cake.pose.translation() = Eigen::Vector3f(0.0f, 0.0f, 0.025f);
+  cake.rgb = {0.8f, 0.7f, 0.3f};
+  synth::Primitive tin = cake;
+  tin.half_extents = {0.03f, 0.03f, 0.03f};
+  tin.pose.translation() = Eigen::Vector3f(0.0f, 0.0f, 0.08f);
+  tin.rgb = {0.8f, 0.7f, 0.3f};  // the same colour: geometry must tell
+  spec.objects = {cake, tin};
+  synth::NoiseOptions noise;
+  noise.enabled = false;
+  const Scene scene = Prepare(synth::RenderScene(spec, noise, 1));
+  absl::StatusOr<CosScene> surfaces =
+      BuildCosScene(scene.prepared.cloud, scene.prepared.plane, CosOptions{});
+  ASSERT_TRUE(surfaces.ok());
+  const int n = static_cast<int>(surfaces->patches.patches.size());
+  const RelationComputer relations(scene.prepared.cloud,
+                                   surfaces->patches.labels, n,
+                                   scene.prepared.plane.normal,
+                                   RelationOptions{});
+  const std::vector<int> object =
+      PatchObjectIds(*surfaces, scene.synth.frame.labels);
+  const std::vector<std::string>& names = RelationFeatureNames();
+  const auto index = [&](const std::string& name) {
+    return std::find(names.begin(), names.end(), name) - names.begin();
+  };
+  const size_t convexity = index("border_convexity");
+  const size_t sharp = index("border_sharp_concave_fraction");
+  const size_t upright = index("uprightness_difference");
+  ASSERT_LT(upright, names.size());
+  double tin_faces = 1.0, across = 0.0, across_sharp = 0.0, across_upright = 0;
+  int tin_pairs = 0, across_pairs = 0;
+  for (const auto& [a, b] : relations.adjacent_pairs()) {
+    if (surfaces->support[a] || surfaces->support[b]) continue;
+    const std::vector<double> f = relations.Relate(a, b);
+    if (object[a] == 3 && object[b] == 3) {  // two faces of the tin
+      tin_faces = std::min(tin_faces, f[convexity]);
+      ++tin_pairs;
+    } else if (object[a] + object[b] == 5) {  // the tin and the cake box
+      across = std::max(across, 1.0 - f[convexity]);
+      across_sharp = std::max(across_sharp, f[sharp]);
+      across_upright = std::max(across_upright, f[upright]);
+      ++across_pairs;
+    }
+  }
+  ASSERT_GT(tin_pairs, 0);
+  ASSERT_GT(across_pairs, 0);
+  EXPECT_GT(tin_faces, 0.6);  // convex: above the flat 0.5
+  EXPECT_GT(across, 0.6);     // concave: below 0.5
+  EXPECT_GT(across_sharp, 0.5);
+  EXPECT_GT(across_upright, 0.8);  // the level top against an upright face
 }
 
 TEST(IncTest, MostSalientBoxFirstThenTheOtherThenNothing) {
