@@ -1,6 +1,7 @@
 #include "core/segmentation/rbf_svm.h"
 
 #include <cmath>
+#include <cstdlib>
 #include <memory>
 #include <utility>
 
@@ -36,6 +37,11 @@ RbfSvm TrainModel(const std::vector<SvmSample>& samples,
   param.C = options.c;
   param.shrinking = 1;
   param.probability = 1;
+  // libsvm's Platt scaling shuffles its internal folds with rand(): seeded
+  // here, a model depends on its samples and options only, not on what
+  // trained before it in the process (fovea-train --grid or not). Training
+  // is offline and single-threaded.
+  std::srand(1);
   const std::unique_ptr<svm_internal::TrainedModel> trained =
       svm_internal::Train(samples, param, options.balance_classes);
   const svm_model& model = *trained->model;

@@ -205,6 +205,22 @@ void AddRoomScenes(const std::vector<uint64_t>& seeds, synth::RoomSensor sensor,
   }
 }
 
+void AddPileScenes(int objects, int count, uint64_t first_seed,
+                   SceneList& scenes) {
+  int added = 0;
+  for (uint64_t seed = first_seed; seed < first_seed + 400 && added < count;
+       ++seed) {
+    synth::SynthScene pile = synth::GeneratePile(seed);
+    int visible = 0;
+    for (const synth::ObjectTruth& o : pile.objects) {
+      visible += o.visible_pixels > 0 ? 1 : 0;
+    }
+    if (visible != objects) continue;
+    AddScene(pile.frame.name, pile.frame.frame, scenes);
+    ++added;
+  }
+}
+
 absl::Status AddOsdScenes(const std::string& osd_dir, int max_scenes,
                           SceneList& scenes) {
   absl::StatusOr<std::vector<std::string>> files =

@@ -79,6 +79,12 @@ void AddSyntheticScenes(const std::vector<uint64_t>& seeds, SceneList& scenes);
 void AddRoomScenes(const std::vector<uint64_t>& seeds, synth::RoomSensor sensor,
                    int width, int height, SceneList& scenes);
 
+// Synthetic piles (core/synth GeneratePile) of exactly `objects` visible
+// objects: the first `count` such piles from seed `first_seed` upwards
+// (at most 400 seeds tried).
+void AddPileScenes(int objects, int count, uint64_t first_seed,
+                   SceneList& scenes);
+
 // The OSD learn*.pcd scenes of `osd_dir`/learn (all of them when
 // `max_scenes` <= 0). Scenes whose preparation fails are left out with a
 // line on stderr; an error when the folder cannot be listed.

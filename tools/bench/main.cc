@@ -212,7 +212,7 @@ int main(int argc, char** argv) {
   benchmark::AddCustomContext("opencv_threads",
                               std::to_string(cv::getNumThreads()));
 
-  // Whole frames of three kinds in one run: uncropped rooms from an
+  // Whole frames of four kinds in one run: uncropped rooms from an
   // active-stereo camera at 640x480 and at 1280x720 (the same seeds), and
   // the cropped OSD scenes.
   static SceneList rooms640;
@@ -224,9 +224,14 @@ int main(int argc, char** argv) {
   fovea::bench::AddRoomScenes(room_seeds,
                               fovea::synth::RoomSensor::kActiveStereo, 1280,
                               720, rooms1280);
+  // ... and dense piles of 15 objects (seeds from 1, fovea-eval's held-out
+  // piles), Detect and INC to the last object.
+  static SceneList piles15;
+  fovea::bench::AddPileScenes(15, 8, 1, piles15);
   fovea::bench::RegisterFrameCases({{"room-640x480", &rooms640},
                                     {"room-1280x720", &rooms1280},
-                                    {"osd", &osd}},
+                                    {"osd", &osd},
+                                    {"pile-15", &piles15}},
                                    flags.sweep);
 
   // Synthetic cases first, then the OSD ones; in each, the gRPC cases come

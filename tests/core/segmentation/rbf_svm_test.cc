@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <random>
 
 namespace fovea {
@@ -52,6 +53,20 @@ TEST(RbfSvmTest, SerializeAndParseGiveTheSameDecisions) {
   for (const SvmSample& s : Disc(20, 5)) {
     EXPECT_DOUBLE_EQ(back->Probability(s.x), svm->Probability(s.x));
   }
+}
+
+TEST(RbfSvmTest, TheSameSamplesGiveTheSameModelWhateverTrainedBefore) {
+  const std::vector<SvmSample> samples = Disc(120, 7);
+  absl::StatusOr<RbfSvm> first =
+      TrainRbfSvm(samples, {"x", "y"}, "inc", RbfSvmTrainingOptions{});
+  ASSERT_TRUE(first.ok());
+  // Other training in between draws from libsvm's random numbers.
+  ASSERT_TRUE(CrossValidateRbfSvm(Disc(100, 8), 5, RbfSvmTrainingOptions{}).ok());
+  std::rand();
+  absl::StatusOr<RbfSvm> second =
+      TrainRbfSvm(samples, {"x", "y"}, "inc", RbfSvmTrainingOptions{});
+  ASSERT_TRUE(second.ok());
+  EXPECT_EQ(first->Serialize(), second->Serialize());
 }
 
 TEST(RbfSvmTest, ParseRejectsCorruptText) {
