@@ -61,7 +61,8 @@ TEST(RbfSvmTest, TheSameSamplesGiveTheSameModelWhateverTrainedBefore) {
       TrainRbfSvm(samples, {"x", "y"}, "inc", RbfSvmTrainingOptions{});
   ASSERT_TRUE(first.ok());
   // Other training in between draws from libsvm's random numbers.
-  ASSERT_TRUE(CrossValidateRbfSvm(Disc(100, 8), 5, RbfSvmTrainingOptions{}).ok());
+  ASSERT_TRUE(
+      CrossValidateRbfSvm(Disc(100, 8), 5, RbfSvmTrainingOptions{}).ok());
   std::rand();
   absl::StatusOr<RbfSvm> second =
       TrainRbfSvm(samples, {"x", "y"}, "inc", RbfSvmTrainingOptions{});
