@@ -394,15 +394,15 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
   if (options.cover_scene.value_or(options.seeds.empty())) {
     // Standing pixels off surface edges; each cover seed's piece is tried
     // once, so this ends after at most one seed per piece.
-    cv::Mat tried = FindSurfaceEdges(scene->cloud, options.detect.surface_edges);
+    cv::Mat tried =
+        FindSurfaceEdges(scene->cloud, options.detect.surface_edges);
     tried.setTo(255, scene->table.standing == 0);
     int cover_seeds = 0;
     while (!full() && cover_seeds < kMaxAttentionPoints) {
       if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
       cv::Mat piece;
-      const std::optional<cv::Point> at =
-          CoverSeed(scene->cloud, ~(tried | covered),
-                    options.min_object_area_m2, piece);
+      const std::optional<cv::Point> at = CoverSeed(
+          scene->cloud, ~(tried | covered), options.min_object_area_m2, piece);
       if (!at.has_value()) break;
       ++cover_seeds;
       tried.setTo(255, piece);

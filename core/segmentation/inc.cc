@@ -88,9 +88,8 @@ absl::StatusOr<IncScene> BuildIncScene(const OrganizedCloud& cloud,
   scene.surfaces = *std::move(surfaces);
   const cv::Mat& labels = scene.surfaces.patches.labels;
   const int n = static_cast<int>(scene.surfaces.patches.patches.size());
-  scene.relations =
-      std::make_unique<RelationComputer>(cloud, labels, n, plane.normal,
-                                         options.relations);
+  scene.relations = std::make_unique<RelationComputer>(
+      cloud, labels, n, plane.normal, options.relations);
   // Eq. 3.6: a surface's saliency is the mean saliency of its points.
   std::vector<double> sum(n, 0.0);
   std::vector<int> count(n, 0);

@@ -170,13 +170,13 @@ absl::Status Validate(const RelationOptions& options) {
 const std::vector<std::string>& RelationFeatureNames() {
   static const std::vector<std::string>* const names =
       new std::vector<std::string>{
-          "color_similarity",   "gabor_similarity",
-          "fourier_similarity", "relative_size",
-          "border_color_mean",  "border_color_variation",
-          "border_depth_mean",  "border_depth_variation",
-          "border_angle_mean",  "border_angle_variation",
-          "border_3d_fraction", "curvature_similarity",
-          "border_convexity",   "border_sharp_concave_fraction",
+          "color_similarity",      "gabor_similarity",
+          "fourier_similarity",    "relative_size",
+          "border_color_mean",     "border_color_variation",
+          "border_depth_mean",     "border_depth_variation",
+          "border_angle_mean",     "border_angle_variation",
+          "border_3d_fraction",    "curvature_similarity",
+          "border_convexity",      "border_sharp_concave_fraction",
           "uprightness_difference"};
   return *names;
 }
@@ -262,9 +262,9 @@ RelationComputer::RelationComputer(const OrganizedCloud& cloud,
           border.depth_sq += step * step;
           if (step <= options.touch_depth_fraction) ++border.touching;
         }
-        const bool touching =
-            !std::isnan(za) && !std::isnan(zb) &&
-            std::abs(za - zb) / std::max(za, zb) <= options.touch_depth_fraction;
+        const bool touching = !std::isnan(za) && !std::isnan(zb) &&
+                              std::abs(za - zb) / std::max(za, zb) <=
+                                  options.touch_depth_fraction;
         const cv::Vec3f& la = lab.at<cv::Vec3f>(v, u);
         const cv::Vec3f& lb = lab.at<cv::Vec3f>(y, x);
         const double color = cv::norm(la - lb);

@@ -36,9 +36,9 @@ struct RelationOptions {
   // space) when their depths differ by at most this fraction of depth.
   float touch_depth_fraction = 0.02f;
   // Convexity across a border (after Stein et al. 2014, LCCP): for each
-  // 4-adjacent pixel pair across it that touches (touch_depth_fraction), the points this many pixels inside
-  // either surface, p and q, and their normals give
-  // c = (n_q - n_p) . (q - p) / |q - p|: > 0 where the surfaces fold away
+  // 4-adjacent pixel pair across it that touches (touch_depth_fraction), the
+  // points this many pixels inside either surface, p and q, and their normals
+  // give c = (n_q - n_p) . (q - p) / |q - p|: > 0 where the surfaces fold away
   // from each other (the faces of one box), < 0 where they fold towards
   // each other (a tin standing on a box, a can in a bowl), about 0 on one
   // smooth surface. 3 px is 6 mm at 1 m, beyond the pixels whose normals
@@ -80,7 +80,7 @@ class RelationComputer {
     double color_sum = 0, color_sq = 0;
     double depth_sum = 0, depth_sq = 0;
     double angle_sum = 0, angle_sq = 0;
-    int folds = 0;     // pairs whose convexity could be measured
+    int folds = 0;  // pairs whose convexity could be measured
     double convexity_sum = 0;
     int sharp_concave = 0;
   };
@@ -91,7 +91,7 @@ class RelationComputer {
   std::vector<std::vector<double>> gabor_;
   std::vector<std::vector<double>> fourier_;
   std::vector<int> points_;
-  std::vector<double> curvature_;  // mean 1 - n . (mean normal)
+  std::vector<double> curvature_;    // mean 1 - n . (mean normal)
   std::vector<double> uprightness_;  // |mean normal . up|, [0, 1]
   std::unordered_map<uint64_t, Border> borders_;
   std::vector<std::pair<int, int>> pairs_;

@@ -97,9 +97,9 @@ struct Body {
   Shape shape = Shape::kBox;
   Vector3f half_extents = Vector3f::Constant(0.05f);  // box; z for cyl/cone
   float radius = 0.05f;
-  bool lying = false;        // cylinder on its side
-  float lean = 0.0f;         // box tilted about its local y axis, radians
-  float thickness = 0.005f;  // bowl and cup walls
+  bool lying = false;         // cylinder on its side
+  float lean = 0.0f;          // box tilted about its local y axis, radians
+  float thickness = 0.005f;   // bowl and cup walls
   float floor_height = 0.0f;  // a bowl's inner floor above its foot
   Vector3f rgb = Vector3f::Constant(0.5f);
 

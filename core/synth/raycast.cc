@@ -269,8 +269,7 @@ std::optional<RayHit> IntersectLocal(const Primitive& primitive,
       return IntersectCone(primitive.radius, h.z(), o, d, t_min, t_max);
     case Shape::kBowl:
       return IntersectBowl(primitive.radius, h.z(), primitive.thickness,
-                           primitive.floor_height, o, d,
-                           t_min, t_max);
+                           primitive.floor_height, o, d, t_min, t_max);
     case Shape::kCup:
       return IntersectCup(primitive.radius, h.z(), primitive.thickness, o, d,
                           t_min, t_max);

@@ -164,8 +164,8 @@ TEST(FoveaEvalTest, SegmentCrossValidatesBothMethodsWithAJsonLastLine) {
 TEST(FoveaEvalTest, SegmentScoresTheShippedModelsAndPeersSideBySide) {
   // Without --folds: the models of models/ as the server loads them, every
   // method on the same two synthetic piles, one JSON line each.
-  const ::fovea::testing::CommandRun run = RunEval(
-      "segment --method inc,cos,pcl-lccp --piles 2 --seed 5 --json");
+  const ::fovea::testing::CommandRun run =
+      RunEval("segment --method inc,cos,pcl-lccp --piles 2 --seed 5 --json");
   ASSERT_EQ(run.exit_code, 0) << run.out;
   EXPECT_THAT(run.out, HasSubstr("as shipped"));
   int lines = 0;

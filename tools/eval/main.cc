@@ -5,8 +5,8 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <filesystem>
 #include <cstdlib>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,13 +21,13 @@
 #include "absl/strings/str_split.h"
 #include "core/pipeline/detect.h"
 #include "core/pipeline/models.h"
-#include "tools/eval/detect_eval.h"
 #include "core/synth/synth_scene.h"
+#include "tools/eval/detect_eval.h"
 #include "tools/eval/inc_eval.h"
 #include "tools/eval/methods_eval.h"
-#include "tools/eval/scene_kind.h"
 #include "tools/eval/raw_frame_eval.h"
 #include "tools/eval/room_eval.h"
+#include "tools/eval/scene_kind.h"
 #include "tools/eval/sweep.h"
 
 ABSL_FLAG(std::string, data, "",
@@ -173,13 +173,15 @@ void PrintTable(const std::vector<SceneResult>& scenes) {
     if (!s.scenes.empty()) row(kind.empty() ? "all" : kind, s);
   }
   const std::vector<SceneResult> many = WithObjects(scenes, kManyObjects);
-  if (!many.empty()) row(absl::StrCat(kManyObjects, "+ objects"), Summarize(many, ""));
+  if (!many.empty())
+    row(absl::StrCat(kManyObjects, "+ objects"), Summarize(many, ""));
 }
 
 std::string Json(const DetectEvalSummary& s) {
   std::vector<std::string> at;
   for (double h : s.hit_ratio_at) at.push_back(absl::StrCat(h));
-  const DetectEvalSummary many = Summarize(WithObjects(s.scenes, kManyObjects), "");
+  const DetectEvalSummary many =
+      Summarize(WithObjects(s.scenes, kManyObjects), "");
   return absl::StrCat(
       "{\"scenes\": ", s.scenes.size(), ", \"hit_ratio\": ", s.hit_ratio,
       ", \"distance_to_center\": ", s.distance_to_center,
@@ -285,7 +287,8 @@ int RunDetectEval() {
 
   const std::optional<std::vector<LabelledFrame>> scenes = ScenesFromFlags();
   if (!scenes) return kRunError;
-  absl::StatusOr<DetectEvalSummary> summary = EvaluateDetectOn(*scenes, options);
+  absl::StatusOr<DetectEvalSummary> summary =
+      EvaluateDetectOn(*scenes, options);
   if (!summary.ok()) {
     std::fprintf(stderr, "fovea-eval: %s\n",
                  summary.status().ToString().c_str());
@@ -361,7 +364,8 @@ std::optional<std::vector<LabelledFrame>> ScenesFromFlags() {
   if (piles > 0) {
     std::vector<LabelledFrame> scenes;
     for (int k = 0; k < piles; ++k) {
-      scenes.push_back(synth::GeneratePile(absl::GetFlag(FLAGS_seed) + k).frame);
+      scenes.push_back(
+          synth::GeneratePile(absl::GetFlag(FLAGS_seed) + k).frame);
     }
     return scenes;
   }
@@ -387,7 +391,8 @@ std::optional<std::vector<LabelledFrame>> ScenesFromFlags() {
   }
   absl::StatusOr<std::vector<LabelledFrame>> scenes = LoadScenes(data);
   if (!scenes.ok()) {
-    std::fprintf(stderr, "fovea-eval: %s\n", scenes.status().ToString().c_str());
+    std::fprintf(stderr, "fovea-eval: %s\n",
+                 scenes.status().ToString().c_str());
     return std::nullopt;
   }
   return *std::move(scenes);
@@ -406,7 +411,8 @@ std::vector<std::string> KindsOf(const MethodResults& results) {
   return kinds;
 }
 
-std::string MethodJson(const MethodSummary& s, bool cross_validated, int folds) {
+std::string MethodJson(const MethodSummary& s, bool cross_validated,
+                       int folds) {
   return absl::StrFormat(
       "{\"method\": \"%s\", \"evaluation\": \"%s\", \"folds\": %d, "
       "\"scenes\": %d, \"f_all\": %.4f, \"f_best\": %.4f, \"f_first\": "
@@ -417,9 +423,9 @@ std::string MethodJson(const MethodSummary& s, bool cross_validated, int folds) 
       "\"first_mask_ms_median\": %.1f, \"all_masks_ms_median\": %.1f}",
       s.method, cross_validated ? "cross-validated" : "held-out",
       cross_validated ? folds : 0, s.scenes, s.f_all, s.f_best, s.f_first,
-      s.object_recall, s.false_masks, s.whole_scene_f, s.overlap_p,
-      s.overlap_r, s.overlap_f, s.boundary_p, s.boundary_r, s.boundary_f,
-      s.objects_075, s.first_ms_median, s.total_ms_median);
+      s.object_recall, s.false_masks, s.whole_scene_f, s.overlap_p, s.overlap_r,
+      s.overlap_f, s.boundary_p, s.boundary_r, s.boundary_f, s.objects_075,
+      s.first_ms_median, s.total_ms_median);
 }
 
 int RunSegmentEval() {
@@ -462,9 +468,11 @@ int RunSegmentEval() {
   const bool cross_validated = options.folds >= 2;
   std::optional<LoadedModels> models;
   if (!cross_validated) {
-    absl::StatusOr<LoadedModels> loaded = LoadModels(absl::GetFlag(FLAGS_models));
+    absl::StatusOr<LoadedModels> loaded =
+        LoadModels(absl::GetFlag(FLAGS_models));
     if (!loaded.ok()) {
-      std::fprintf(stderr, "fovea-eval: %s\n", loaded.status().ToString().c_str());
+      std::fprintf(stderr, "fovea-eval: %s\n",
+                   loaded.status().ToString().c_str());
       return kRunError;
     }
     models = *std::move(loaded);
@@ -475,47 +483,53 @@ int RunSegmentEval() {
   options.verbose = absl::GetFlag(FLAGS_verbose);
   absl::StatusOr<MethodResults> results = EvaluateMethods(*scenes, options);
   if (!results.ok()) {
-    std::fprintf(stderr, "fovea-eval: %s\n", results.status().ToString().c_str());
+    std::fprintf(stderr, "fovea-eval: %s\n",
+                 results.status().ToString().c_str());
     return kRunError;
   }
   if (cross_validated) {
     std::printf(
         "segment %s, seeds %s, %zu scenes, %d-fold cross-validated (each "
         "scene scored by models trained on the other folds)\n",
-        methods.c_str(), std::string(ExtractionName(options.detect.extraction)).c_str(),
+        methods.c_str(),
+        std::string(ExtractionName(options.detect.extraction)).c_str(),
         scenes->size(), options.folds);
   } else {
     std::printf(
         "segment %s, seeds %s, %zu scenes, models %s as shipped (held out "
         "unless these scenes trained them)\n",
-        methods.c_str(), std::string(ExtractionName(options.detect.extraction)).c_str(),
+        methods.c_str(),
+        std::string(ExtractionName(options.detect.extraction)).c_str(),
         scenes->size(), absl::GetFlag(FLAGS_models).c_str());
   }
-  std::printf("%-14s %-10s %6s %6s %6s %6s %6s %6s %6s %6s %6s %6s %6s %6s "
-              "%8s %8s\n",
-              "method", "kind", "scenes", "F all", "F best", "F 1st", "recall",
-              "false", "wholeF", "ovl P", "ovl R", "ovl F", "bnd F", "obj.75",
-              "1st ms", "all ms");
+  std::printf(
+      "%-14s %-10s %6s %6s %6s %6s %6s %6s %6s %6s %6s %6s %6s %6s "
+      "%8s %8s\n",
+      "method", "kind", "scenes", "F all", "F best", "F 1st", "recall", "false",
+      "wholeF", "ovl P", "ovl R", "ovl F", "bnd F", "obj.75", "1st ms",
+      "all ms");
   std::vector<std::string> kinds = KindsOf(*results);
   kinds.push_back("");
   for (const SceneMethod method : options.methods) {
     for (const std::string& kind : kinds) {
-      const MethodSummary s = SummarizeMethod(method, results->at(method), kind);
+      const MethodSummary s =
+          SummarizeMethod(method, results->at(method), kind);
       if (s.scenes == 0) continue;
-      std::printf("%-14s %-10s %6d %6.3f %6.3f %6.3f %6.3f %6.3f %6.3f %6.3f "
-                  "%6.3f %6.3f %6.3f %6.3f %8.1f %8.1f\n",
-                  s.method.c_str(), kind.empty() ? "all" : kind.c_str(),
-                  s.scenes, s.f_all, s.f_best, s.f_first, s.object_recall,
-                  s.false_masks, s.whole_scene_f, s.overlap_p, s.overlap_r,
-                  s.overlap_f, s.boundary_f, s.objects_075, s.first_ms_median,
-                  s.total_ms_median);
+      std::printf(
+          "%-14s %-10s %6d %6.3f %6.3f %6.3f %6.3f %6.3f %6.3f %6.3f "
+          "%6.3f %6.3f %6.3f %6.3f %8.1f %8.1f\n",
+          s.method.c_str(), kind.empty() ? "all" : kind.c_str(), s.scenes,
+          s.f_all, s.f_best, s.f_first, s.object_recall, s.false_masks,
+          s.whole_scene_f, s.overlap_p, s.overlap_r, s.overlap_f, s.boundary_f,
+          s.objects_075, s.first_ms_median, s.total_ms_median);
     }
   }
   if (absl::GetFlag(FLAGS_json)) {
     for (const SceneMethod method : options.methods) {
-      std::printf("%s\n", MethodJson(SummarizeMethod(method, results->at(method), ""),
-                                      cross_validated, options.folds)
-                               .c_str());
+      std::printf("%s\n",
+                  MethodJson(SummarizeMethod(method, results->at(method), ""),
+                             cross_validated, options.folds)
+                      .c_str());
     }
   }
   return 0;

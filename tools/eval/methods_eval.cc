@@ -42,7 +42,8 @@ void WritePng(const std::string& dir, const LabelledFrame& scene,
         cv::Scalar((i * 67) % 256, (80 + i * 151) % 256, (160 + i * 97) % 256),
         run.masks[i].mask);
   }
-  cv::addWeighted(overlay, kOverlayAlpha, bgr, 1.0 - kOverlayAlpha, 0.0, overlay);
+  cv::addWeighted(overlay, kOverlayAlpha, bgr, 1.0 - kOverlayAlpha, 0.0,
+                  overlay);
   for (size_t i = 0; i < run.masks.size(); ++i) {
     cv::putText(overlay, std::to_string(i + 1), run.masks[i].seed,
                 cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1);
@@ -55,11 +56,11 @@ void WritePng(const std::string& dir, const LabelledFrame& scene,
   truth.setTo(cv::Scalar(0, 255, 0), edges);
   cv::Mat both;
   cv::hconcat(overlay, truth, both);
-  cv::imwrite((std::filesystem::path(dir) /
-               absl::StrCat(scene.name, "_", AbslView(SceneMethodName(method)),
-                            ".png"))
-                  .string(),
-              both);
+  cv::imwrite(
+      (std::filesystem::path(dir) /
+       absl::StrCat(scene.name, "_", AbslView(SceneMethodName(method)), ".png"))
+          .string(),
+      both);
 }
 
 // Models trained on the scenes of `train` (indices into `scenes`) for the
@@ -87,7 +88,8 @@ bool Uses(const MethodsEvalOptions& o, SceneMethod m) {
 }  // namespace
 
 absl::StatusOr<MethodResults> EvaluateMethods(
-    const std::vector<LabelledFrame>& scenes, const MethodsEvalOptions& options) {
+    const std::vector<LabelledFrame>& scenes,
+    const MethodsEvalOptions& options) {
   if (options.methods.empty()) {
     return absl::InvalidArgumentError("methods: none given");
   }
@@ -95,7 +97,8 @@ absl::StatusOr<MethodResults> EvaluateMethods(
   if (!cross_validate && options.models == nullptr) {
     return absl::FailedPreconditionError("no models and no cross-validation");
   }
-  if (!options.out_dir.empty()) std::filesystem::create_directories(options.out_dir);
+  if (!options.out_dir.empty())
+    std::filesystem::create_directories(options.out_dir);
 
   // Training examples of every scene, once (cross-validation only).
   std::vector<std::vector<SvmSample>> cos_samples(scenes.size());
@@ -127,24 +130,27 @@ absl::StatusOr<MethodResults> EvaluateMethods(
       std::vector<const LabelledFrame*> frames;
       for (size_t i = 0; i < scenes.size(); ++i) {
         if (static_cast<int>(i) % folds == fold) continue;
-        cos_train.insert(cos_train.end(), cos_samples[i].begin(), cos_samples[i].end());
-        inc_train.insert(inc_train.end(), inc_samples[i].begin(), inc_samples[i].end());
+        cos_train.insert(cos_train.end(), cos_samples[i].begin(),
+                         cos_samples[i].end());
+        inc_train.insert(inc_train.end(), inc_samples[i].begin(),
+                         inc_samples[i].end());
         frames.push_back(&scenes[i]);
       }
       if (Uses(options, SceneMethod::kCos)) {
-        absl::StatusOr<LinearSvm> svm =
-            TrainLinearSvm(cos_train, CosFeatureNames(), "cos", options.cos_svm);
+        absl::StatusOr<LinearSvm> svm = TrainLinearSvm(
+            cos_train, CosFeatureNames(), "cos", options.cos_svm);
         if (!svm.ok()) return svm.status();
         trained.cos = *std::move(svm);
       }
       if (Uses(options, SceneMethod::kEbs)) {
-        absl::StatusOr<EbsModel> ebs = EbsModel::Train(frames, EbsTrainOptions{});
+        absl::StatusOr<EbsModel> ebs =
+            EbsModel::Train(frames, EbsTrainOptions{});
         if (!ebs.ok()) return ebs.status();
         trained.ebs = *std::move(ebs);
       }
       if (Uses(options, SceneMethod::kInc)) {
-        absl::StatusOr<RbfSvm> svm =
-            TrainRbfSvm(inc_train, RelationFeatureNames(), "inc", options.inc_svm);
+        absl::StatusOr<RbfSvm> svm = TrainRbfSvm(
+            inc_train, RelationFeatureNames(), "inc", options.inc_svm);
         if (!svm.ok()) return svm.status();
         trained.inc = *std::move(svm);
       }
@@ -154,9 +160,9 @@ absl::StatusOr<MethodResults> EvaluateMethods(
     }
     for (size_t i = fold; i < scenes.size(); i += folds) {
       const LabelledFrame& scene = scenes[i];
-      const int min_pixels = std::max(
-          1, static_cast<int>(kEvalMinObjectPixels * scene.labels.total() /
-                              (640.0 * 480.0)));
+      const int min_pixels =
+          std::max(1, static_cast<int>(kEvalMinObjectPixels *
+                                       scene.labels.total() / (640.0 * 480.0)));
       const cv::Mat ids = ObjectIds(scene.labels);
       for (const SceneMethod method : options.methods) {
         SceneRunOptions run_options;
@@ -179,16 +185,17 @@ absl::StatusOr<MethodResults> EvaluateMethods(
         r.first_ms = run->first_ms;
         r.total_ms = run->total_ms;
         if (options.verbose) {
-          std::fprintf(stderr,
-                       "%-10s %-13s objects %2d/%2d masks %2d  F all %.3f  "
-                       "whole F %.3f  overlap F %.3f  boundary F %.3f  %.0f ms\n",
-                       r.name.c_str(),
-                       std::string(SceneMethodName(method)).c_str(),
-                       r.seeded.objects_with_mask, r.seeded.objects,
-                       r.seeded.masks, r.seeded.f_all, r.whole_scene_f,
-                       r.uois.overlap_f, r.uois.boundary_f, r.total_ms);
+          std::fprintf(
+              stderr,
+              "%-10s %-13s objects %2d/%2d masks %2d  F all %.3f  "
+              "whole F %.3f  overlap F %.3f  boundary F %.3f  %.0f ms\n",
+              r.name.c_str(), std::string(SceneMethodName(method)).c_str(),
+              r.seeded.objects_with_mask, r.seeded.objects, r.seeded.masks,
+              r.seeded.f_all, r.whole_scene_f, r.uois.overlap_f,
+              r.uois.boundary_f, r.total_ms);
         }
-        if (!options.out_dir.empty()) WritePng(options.out_dir, scene, method, *run);
+        if (!options.out_dir.empty())
+          WritePng(options.out_dir, scene, method, *run);
         results[method].push_back(std::move(r));
       }
     }
@@ -234,12 +241,14 @@ MethodSummary SummarizeMethod(SceneMethod method,
   }
   if (s.scenes > 0) {
     const double n = s.scenes;
-    for (double* x : {&s.whole_scene_f, &s.overlap_p, &s.overlap_r, &s.overlap_f,
-                      &s.boundary_p, &s.boundary_r, &s.boundary_f, &s.objects_075}) {
+    for (double* x :
+         {&s.whole_scene_f, &s.overlap_p, &s.overlap_r, &s.overlap_f,
+          &s.boundary_p, &s.boundary_r, &s.boundary_f, &s.objects_075}) {
       *x /= n;
     }
   }
-  s.object_recall = objects > 0 ? static_cast<double>(with_mask) / objects : 0.0;
+  s.object_recall =
+      objects > 0 ? static_cast<double>(with_mask) / objects : 0.0;
   s.false_masks = masks > 0 ? static_cast<double>(false_masks) / masks : 0.0;
   s.first_ms_median = Median(first);
   s.total_ms_median = Median(total);

@@ -67,7 +67,8 @@ struct MethodSummary {
 using MethodResults = std::map<SceneMethod, std::vector<MethodSceneResult>>;
 
 absl::StatusOr<MethodResults> EvaluateMethods(
-    const std::vector<LabelledFrame>& scenes, const MethodsEvalOptions& options);
+    const std::vector<LabelledFrame>& scenes,
+    const MethodsEvalOptions& options);
 
 // Over the scenes of one kind ("" = all).
 MethodSummary SummarizeMethod(SceneMethod method,

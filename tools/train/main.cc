@@ -319,8 +319,9 @@ int TrainInc() {
       "%zu samples, C %g gamma %g; %d-fold "
       "cross-validated accuracy %.3f (balanced %.3f)",
       learn_scenes, piles,
-      static_cast<unsigned>(absl::GetFlag(FLAGS_pile_seed)), samples.size(), best.c, best.gamma, best_cv.folds,
-      best_cv.accuracy, best_cv.balanced_accuracy);
+      static_cast<unsigned>(absl::GetFlag(FLAGS_pile_seed)), samples.size(),
+      best.c, best.gamma, best_cv.folds, best_cv.accuracy,
+      best_cv.balanced_accuracy);
   const size_t at = text.find("\nprovenance ");
   const size_t end = text.find('\n', at + 1);
   text.replace(at + 12, end - at - 12, provenance);

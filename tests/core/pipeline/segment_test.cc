@@ -121,7 +121,7 @@ TEST(CoverSeedTest, SeedsTheLargestPieceAtItsInnermostPixel) {
   cloud.intrinsics = {525.0, 525.0, 20.0, 15.0};
   cloud.xyz = cv::Mat(30, 40, CV_32FC3, cv::Scalar(0.0f, 0.0f, 1.0f));
   cv::Mat free(30, 40, CV_8UC1, cv::Scalar(0));
-  free(cv::Rect(2, 2, 5, 5)).setTo(255);     // 25 px
+  free(cv::Rect(2, 2, 5, 5)).setTo(255);      // 25 px
   free(cv::Rect(20, 10, 11, 11)).setTo(255);  // 121 px, centre (25, 15)
   cv::Mat piece;
   const std::optional<cv::Point> at = CoverSeed(cloud, free, 0.0, piece);

@@ -18,9 +18,8 @@ const RbfSvm& TrainedSvm() {
   static const RbfSvm* svm = [] {
     std::vector<SvmSample> samples;
     for (uint64_t seed = 21; seed < 33; ++seed) {
-      const synth::SynthScene scene = seed % 2 == 0
-                                          ? synth::GenerateScene(seed)
-                                          : synth::GeneratePile(seed);
+      const synth::SynthScene scene = seed % 2 == 0 ? synth::GenerateScene(seed)
+                                                    : synth::GeneratePile(seed);
       absl::StatusOr<std::vector<SvmSample>> s = CollectIncSamples(
           scene.frame, static_cast<int>(seed), DetectOptions{}, IncOptions{});
       if (s.ok()) samples.insert(samples.end(), s->begin(), s->end());
@@ -57,10 +56,9 @@ TEST(RelationsTest, FacesOfOneBoxRelateMoreThanFacesOfTwo) {
       BuildCosScene(scene.prepared.cloud, scene.prepared.plane, CosOptions{});
   ASSERT_TRUE(surfaces.ok());
   const int n = static_cast<int>(surfaces->patches.patches.size());
-  const RelationComputer relations(scene.prepared.cloud,
-                                   surfaces->patches.labels, n,
-                                   scene.prepared.plane.normal,
-                                   RelationOptions{});
+  const RelationComputer relations(
+      scene.prepared.cloud, surfaces->patches.labels, n,
+      scene.prepared.plane.normal, RelationOptions{});
   const std::vector<int> object =
       PatchObjectIds(*surfaces, scene.synth.frame.labels);
   double same_color = 0, other_color = 0;
@@ -108,10 +106,9 @@ TEST(RelationsTest, AStackedBoxFoldsInwardsWhereItsFacesFoldOutwards) {
       BuildCosScene(scene.prepared.cloud, scene.prepared.plane, CosOptions{});
   ASSERT_TRUE(surfaces.ok());
   const int n = static_cast<int>(surfaces->patches.patches.size());
-  const RelationComputer relations(scene.prepared.cloud,
-                                   surfaces->patches.labels, n,
-                                   scene.prepared.plane.normal,
-                                   RelationOptions{});
+  const RelationComputer relations(
+      scene.prepared.cloud, surfaces->patches.labels, n,
+      scene.prepared.plane.normal, RelationOptions{});
   const std::vector<int> object =
       PatchObjectIds(*surfaces, scene.synth.frame.labels);
   const std::vector<std::string>& names = RelationFeatureNames();
