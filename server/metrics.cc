@@ -98,6 +98,10 @@ class Metrics {
                               {"reason", std::string(reason)}});
   }
 
+  prometheus::Counter& Shed(std::string_view reason) {
+    return shed_family_.Add({{"reason", std::string(reason)}});
+  }
+
   prometheus::Gauge& inflight() { return inflight_; }
   prometheus::Histogram& queue_wait() { return queue_wait_; }
 
@@ -155,6 +159,14 @@ class Metrics {
                           .Help("Segmentation calls by the reason they "
                                 "stopped.")
                           .Register(*registry_)),
+        shed_family_(prometheus::BuildCounter()
+                         .Name("fovea_calls_shed_total")
+                         .Help("Calls the server ended on its own to protect "
+                               "the others: abandoned_in_queue (the client "
+                               "left or its deadline passed before a worker "
+                               "took the call), stalled_stream (the client "
+                               "stopped reading a stream).")
+                         .Register(*registry_)),
         inflight_(prometheus::BuildGauge()
                       .Name("fovea_inflight_requests")
                       .Help("Calls started and not yet finished, queued "
@@ -189,6 +201,9 @@ class Metrics {
           Stops(kMethods[i].name, reason);
         }
       }
+      for (const char* reason : {"abandoned_in_queue", "stalled_stream"}) {
+        Shed(reason);
+      }
       for (size_t c = 0; c < kAllStatusCodes.size(); ++c) {
         prometheus::Labels with_code = labels;
         with_code["grpc_code"] = std::string(GrpcCodeName(kAllStatusCodes[c]));
@@ -207,6 +222,7 @@ class Metrics {
   prometheus::Family<prometheus::Histogram>& first_object_family_;
   prometheus::Family<prometheus::Histogram>& objects_family_;
   prometheus::Family<prometheus::Counter>& stops_family_;
+  prometheus::Family<prometheus::Counter>& shed_family_;
   prometheus::Gauge& inflight_;
   prometheus::Histogram& queue_wait_;
   prometheus::Family<prometheus::Gauge>& build_info_family_;
@@ -269,6 +285,14 @@ void RecordObjectsPerRequest(std::string_view method, int objects) {
 
 void RecordStopReason(std::string_view method, std::string_view reason) {
   Metrics::Get().Stops(method, reason).Increment();
+}
+
+void RecordAbandonedInQueue() {
+  Metrics::Get().Shed("abandoned_in_queue").Increment();
+}
+
+void RecordStalledStream() {
+  Metrics::Get().Shed("stalled_stream").Increment();
 }
 
 void IncrementInflight() { Metrics::Get().inflight().Increment(); }

@@ -42,6 +42,9 @@ namespace fovea::server {
 //                                        segmentation call stopped (done,
 //                                        max_objects, time_budget, deadline,
 //                                        cancelled, error)
+//   fovea_calls_shed_total{reason}       counter: calls the server ended
+//                                        itself (abandoned_in_queue,
+//                                        stalled_stream)
 //   fovea_inflight_requests              gauge: calls started, not finished
 //   fovea_queue_wait_seconds             histogram: submit to start of work
 //   fovea_build_info{version}            gauge, always 1
@@ -75,6 +78,10 @@ void RecordObjectsPerRequest(std::string_view method, int objects);
 // Why a segmentation call stopped: "done", "max_objects", "time_budget",
 // "deadline", "cancelled" or "error".
 void RecordStopReason(std::string_view method, std::string_view reason);
+// fovea_calls_shed_total{reason}: a call abandoned while it waited for a
+// worker; a stream cancelled because its client stopped reading.
+void RecordAbandonedInQueue();
+void RecordStalledStream();
 void IncrementInflight();
 void DecrementInflight();
 

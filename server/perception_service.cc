@@ -1,9 +1,11 @@
 #include "server/perception_service.h"
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <exception>
+#include <memory>
 #include <mutex>
 #include <new>
 #include <optional>
@@ -87,6 +89,47 @@ absl::Status CheckInterrupt(const grpc::CallbackServerContext& context) {
   return absl::OkStatus();
 }
 
+// Who finishes a call whose job waits for a worker: the worker, once it
+// starts the job, or the reaction to the client leaving (its deadline
+// passed, it cancelled), if that comes first. Whichever wins the exchange
+// finishes the call; an abandoned job never runs and frees its queue slot
+// (WorkQueue::TrySubmit). Shared by the reactor and its job, so the job
+// can look at it after the reactor is gone.
+class JobGate {
+ public:
+  // Before submitting.
+  void Submitted() { state_.store(kWaiting); }
+  // The worker: true when it may run the job (and touch the reactor).
+  bool Start() { return Exchange(kStarted); }
+  // A reaction: true when it must finish the call itself.
+  bool Abandon() { return Exchange(kAbandoned); }
+  bool abandoned() const { return state_.load() == kAbandoned; }
+
+ private:
+  static constexpr int kIdle = 0;  // not submitted (or refused)
+  static constexpr int kWaiting = 1;
+  static constexpr int kStarted = 2;
+  static constexpr int kAbandoned = 3;
+  bool Exchange(int to) {
+    int expected = kWaiting;
+    return state_.compare_exchange_strong(expected, to);
+  }
+  std::atomic<int> state_{kIdle};
+};
+
+// Submits `run` for the call that `gate` guards (see JobGate).
+bool SubmitGated(WorkQueue& work, const std::shared_ptr<JobGate>& gate,
+                 absl::AnyInvocable<void() &&> run) {
+  gate->Submitted();
+  const bool accepted = work.TrySubmit(
+      [gate, run = std::move(run)]() mutable {
+        if (gate->Start()) std::move(run)();
+      },
+      [gate] { return gate->abandoned(); });
+  if (!accepted) gate->Start();  // refused: nobody may abandon it now
+  return accepted;
+}
+
 // One Detect call. Converts the options at once, then runs on a worker;
 // finishes exactly once and deletes itself in OnDone.
 class DetectReactor final : public grpc::ServerUnaryReactor {
@@ -107,11 +150,26 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
     options_ = *std::move(options);
     submitted_ = Clock::now();
     // The worker sees all of this through the queue's lock.
-    if (!work.TrySubmit([this] { Run(); })) {
+    if (!SubmitGated(work, gate_, [this] { Run(); })) {
       Complete(absl::ResourceExhaustedError(
           absl::StrCat("server busy: ", work.workers(), " frames in work and ",
                        work.queue_capacity(), " queued; retry later")));
     }
+  }
+
+  // The client left (or its deadline passed): a job still waiting for a
+  // worker is abandoned and the call ends now; a running one stops at its
+  // next stage boundary.
+  void OnCancel() override {
+    TsanHappensAfter(this);
+    if (gate_->Abandon()) {
+      absl::Status status = CheckInterrupt(*context_);
+      if (status.ok()) status = absl::CancelledError("the call was cancelled");
+      RecordAbandonedInQueue();
+      Complete(status);
+      return;
+    }
+    TsanHappensBefore(this);
   }
 
   // gRPC calls OnDone after Finish, on any of its threads; the request and
@@ -184,6 +242,7 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
   CallRecord call_;
   DetectOptions options_;
   Clock::time_point submitted_;
+  const std::shared_ptr<JobGate> gate_ = std::make_shared<JobGate>();
 };
 
 // One Segment call: options converted at once, the work on a worker, the
@@ -220,7 +279,7 @@ class StreamReactor final
     }
     options_ = *std::move(options);
     TsanHappensBefore(this);  // before the reactions (OnCancel, ...)
-    if (!work.TrySubmit([this] { Run(); })) {
+    if (!SubmitGated(work, gate_, [this] { Run(); })) {
       FinishOnce(absl::ResourceExhaustedError(
           absl::StrCat("server busy: ", work.workers(), " frames in work and ",
                        work.queue_capacity(), " queued; retry later")));
@@ -265,6 +324,11 @@ class StreamReactor final
     }
     changed_.notify_all();
     if (config_.on_stream_cancelled) config_.on_stream_cancelled();
+    if (gate_->Abandon()) {  // still waiting for a worker: end it now
+      RecordAbandonedInQueue();
+      FinishOnce(BrokenStatus());
+      return;
+    }
     TsanHappensBefore(this);
   }
 
@@ -393,6 +457,7 @@ class StreamReactor final
   bool broken_ = false;          // guarded by mutex_
   bool finished_ = false;        // guarded by mutex_
   std::optional<absl::Status> final_status_;  // guarded by mutex_
+  const std::shared_ptr<JobGate> gate_ = std::make_shared<JobGate>();
 };
 
 }  // namespace

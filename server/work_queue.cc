@@ -38,14 +38,26 @@ WorkQueue::WorkQueue(int workers, int queue_capacity)
 
 WorkQueue::~WorkQueue() { Stop(); }
 
-bool WorkQueue::TrySubmit(absl::AnyInvocable<void() &&> job) {
+bool WorkQueue::TrySubmit(absl::AnyInvocable<void() &&> job,
+                          absl::AnyInvocable<bool() const> abandoned) {
   MutexLock lock(&mu_);
   if (stopping_) return false;
+  DropAbandonedLocked();
   // A job counts against the queue only if no worker is free to take it.
   const int in_system = running_ + static_cast<int>(jobs_.size());
   if (in_system >= workers() + queue_capacity_) return false;
-  jobs_.push_back(std::move(job));
+  jobs_.push_back({std::move(job), std::move(abandoned)});
   return true;
+}
+
+void WorkQueue::DropAbandonedLocked() {
+  for (auto it = jobs_.begin(); it != jobs_.end();) {
+    if (it->abandoned && it->abandoned()) {
+      it = jobs_.erase(it);
+    } else {
+      ++it;
+    }
+  }
 }
 
 void WorkQueue::Stop() {
@@ -61,7 +73,11 @@ void WorkQueue::Stop() {
 
 int WorkQueue::waiting() const {
   MutexLock lock(&mu_);
-  return static_cast<int>(jobs_.size());
+  int waiting = 0;
+  for (const Job& job : jobs_) {
+    waiting += job.abandoned && job.abandoned() ? 0 : 1;
+  }
+  return waiting;
 }
 
 int WorkQueue::running() const {
@@ -78,8 +94,10 @@ void WorkQueue::WorkerLoop() {
         return !jobs_.empty() || stopping_;
       });
       if (jobs_.empty()) return;  // stopping and drained
-      job = std::move(jobs_.front());
+      Job next = std::move(jobs_.front());
       jobs_.pop_front();
+      if (next.abandoned && next.abandoned()) continue;
+      job = std::move(next.run);
       ++running_;
     }
     RunGuarded(std::move(job));

@@ -37,7 +37,16 @@ class WorkQueue {
 
   // Queues `job` and returns true, or returns false (and drops `job`
   // unrun) when the pool is full or stopped.
-  bool TrySubmit(absl::AnyInvocable<void() &&> job);
+  //
+  // `abandoned`, when given, says the job is no longer wanted (its call
+  // was finished by someone else: the client left or its deadline passed
+  // while it waited). An abandoned job never runs, leaves the queue at the
+  // next TrySubmit or when a worker reaches it, and never counts against
+  // the capacity, so a sequential client whose calls time out in the queue
+  // is not refused because of its own earlier calls. Called under the
+  // queue's lock: must be cheap and must not call the queue.
+  bool TrySubmit(absl::AnyInvocable<void() &&> job,
+                 absl::AnyInvocable<bool() const> abandoned = nullptr);
 
   // Refuses new jobs, runs every job already accepted, joins the workers.
   // Idempotent and safe to call from several threads at once: every caller
@@ -54,7 +63,13 @@ class WorkQueue {
   int running() const;
 
  private:
+  struct Job {
+    absl::AnyInvocable<void() &&> run;
+    absl::AnyInvocable<bool() const> abandoned;  // may be null
+  };
   void WorkerLoop();
+  // Drops the abandoned jobs from jobs_.
+  void DropAbandonedLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
 
   const int queue_capacity_;
   std::vector<std::thread> threads_;
@@ -65,7 +80,7 @@ class WorkQueue {
   Mutex stop_mu_;
 
   mutable Mutex mu_;
-  std::deque<absl::AnyInvocable<void() &&>> jobs_ ABSL_GUARDED_BY(mu_);
+  std::deque<Job> jobs_ ABSL_GUARDED_BY(mu_);
   int running_ ABSL_GUARDED_BY(mu_) = 0;
   bool stopping_ ABSL_GUARDED_BY(mu_) = false;
 };

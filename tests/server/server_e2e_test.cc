@@ -354,6 +354,40 @@ TEST_F(ServerTest, FullQueueIsResourceExhausted) {
   EXPECT_EQ(Handled(Scrape(), "Detect", "ResourceExhausted"), 1);
 }
 
+// A sequential client whose calls time out while they wait for the busy
+// worker: each call ends at its deadline and frees its queue slot, so the
+// next one is queued again instead of refused.
+TEST_F(ServerTest, CallsWhoseDeadlinePassedInTheQueueFreeTheirSlotAtOnce) {
+  ServerConfig config = DefaultConfig();
+  config.concurrency = 1;
+  config.queue = 1;
+  StartServer(config);
+  const v1::DetectRequest request = MakeSyntheticRequest(1, false).request;
+  std::future<grpc::Status> running = StartHeldDetect(request);
+  for (int i = 0; i < 8; ++i) {
+    v1::DetectResponse response;
+    const auto start = std::chrono::steady_clock::now();
+    const grpc::Status status =
+        Detect(request, &response, std::chrono::milliseconds(100));
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+            .count();
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED)
+        << "call " << i << ": " << status.error_message();
+    EXPECT_LT(seconds, 5.0) << "call " << i;
+    // The server ends the call itself; wait until its slot is free.
+    ASSERT_TRUE(
+        WaitFor([this] { return server_->queued_jobs() == 0; }, kCallTimeout));
+  }
+  gate_.Open();
+  EXPECT_TRUE(running.get().ok());
+  const std::string metrics = Scrape();
+  EXPECT_EQ(Handled(metrics, "Detect", "ResourceExhausted"), 0);
+  EXPECT_THAT(
+      metrics,
+      HasSubstr("fovea_calls_shed_total{reason=\"abandoned_in_queue\"} 8"));
+}
+
 TEST_F(ServerTest, Sym3dOnAnIttiPyramidWithTJunctionsFindsObjects) {
   StartServer();
   SyntheticRequest synthetic = MakeSyntheticRequest(2, false);

@@ -66,6 +66,23 @@ TEST(WorkQueueTest, RefusesBeyondWorkersPlusQueue) {
   EXPECT_EQ(ran.load(), 2);
 }
 
+TEST(WorkQueueTest, AbandonedJobsNeverRunAndFreeTheirSlot) {
+  WorkQueue queue(1, 1);
+  Notification release;
+  std::atomic<int> ran{0};
+  std::atomic<bool> gone{false};
+  ASSERT_TRUE(SubmitHeldJob(queue, release, ran));
+  EXPECT_TRUE(queue.TrySubmit([&] { ran.fetch_add(100); },
+                              [&] { return gone.load(); }));
+  EXPECT_FALSE(queue.TrySubmit([&] { ran.fetch_add(1000); }));  // full
+  gone = true;  // its caller left: the slot is free again
+  EXPECT_EQ(queue.waiting(), 0);
+  EXPECT_TRUE(queue.TrySubmit([&] { ran.fetch_add(1); }));
+  release.Notify();
+  queue.Stop();
+  EXPECT_EQ(ran.load(), 2);  // the held job and the last one
+}
+
 TEST(WorkQueueTest, ZeroQueueStillFeedsAnIdleWorker) {
   WorkQueue queue(1, 0);
   Notification release;
