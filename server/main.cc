@@ -61,6 +61,10 @@ ABSL_FLAG(double, max_connection_age_s, 300.0,
           "spread over replicas added since; 0 keeps connections forever.");
 ABSL_FLAG(double, max_connection_age_grace_s, 30.0,
           "Seconds calls in flight on such a connection get to finish.");
+ABSL_FLAG(double, stream_stall_timeout_s,
+          fovea::server::ServerConfig{}.stream_stall_timeout_s,
+          "A Segment stream whose client takes no message for this long "
+          "while results wait for it is cancelled and its worker freed.");
 ABSL_FLAG(
     std::string, models_dir, fovea::server::ServerConfig{}.models_dir,
     "Folder of the trained models (cos_svm.txt, ...; see models/README.md). "
@@ -94,7 +98,8 @@ int main(int argc, char** argv) {
   const absl::Status from_env = fovea::server::ApplyFlagsFromEnv(
       {"listen", "metrics_listen", "concurrency", "queue", "max_message_bytes",
        "max_width", "max_height", "grace_period_s", "max_connection_age_s",
-       "max_connection_age_grace_s", "models_dir", "log_level"},
+       "max_connection_age_grace_s", "stream_stall_timeout_s", "models_dir",
+       "log_level"},
       [](const char* name) { return std::getenv(name); });
   if (!from_env.ok()) {
     LogError(from_env.ToString());
@@ -135,6 +140,7 @@ int main(int argc, char** argv) {
   config.max_connection_age_s = absl::GetFlag(FLAGS_max_connection_age_s);
   config.max_connection_age_grace_s =
       absl::GetFlag(FLAGS_max_connection_age_grace_s);
+  config.stream_stall_timeout_s = absl::GetFlag(FLAGS_stream_stall_timeout_s);
   config.models_dir = absl::GetFlag(FLAGS_models_dir);
 
   absl::StatusOr<std::unique_ptr<fovea::server::FoveaServer>> server =

@@ -249,7 +249,10 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
 // messages written one at a time as the worker makes them. The worker
 // waits while kMaxPendingMessages are unwritten (a client that stops
 // reading holds at most that many messages in memory) and stops when the
-// client cancels or a write fails. Finishes exactly once, after every
+// client cancels or a write fails. A client that takes no message for
+// config.stream_stall_timeout while the worker waits on it (for room, or
+// for its last messages to go) has its stream cancelled: a slow reader
+// holds a worker for at most that long. Finishes exactly once, after every
 // queued message was written; deletes itself in OnDone, which gRPC calls
 // only after Finish, and Finish only comes after the worker's last touch.
 template <typename Request, typename Options>
@@ -339,14 +342,16 @@ class StreamReactor final
   }
 
  private:
-  // At most this many messages wait unwritten before the worker blocks.
-  static constexpr size_t kMaxPendingMessages = 2;
+  // At most this many messages wait unwritten before the worker blocks:
+  // a mask is a few kB of run lengths, the first message the points.
+  static constexpr size_t kMaxPendingMessages = 16;
 
   // On a worker thread.
   void Run() {
     absl::Status status;
     try {
       status = Compute();
+      if (status.ok()) WaitForTheLastWrites();
     } catch (const std::bad_alloc&) {
       status = absl::ResourceExhaustedError(
           absl::StrCat(AbslView(method_), ": out of memory"));
@@ -382,10 +387,10 @@ class StreamReactor final
   }
 
   // Queues one message; blocks while kMaxPendingMessages wait. CANCELLED
-  // once the client has gone.
+  // once the client has gone or stalled.
   absl::Status Send(v1::SegmentResponse message) {
     std::unique_lock<std::mutex> lock(mutex_);
-    changed_.wait(lock, [this] {
+    WaitUnlessStalled(lock, [this] {
       return broken_ || pending_.size() < kMaxPendingMessages;
     });
     if (broken_) return BrokenStatus();
@@ -398,7 +403,37 @@ class StreamReactor final
     current_ = std::move(pending_.front());
     pending_.pop_front();
     writing_ = true;
+    write_started_ = Clock::now();
     StartWrite(&current_);
+  }
+
+  // Waits until `done`, unless the write in progress takes longer than the
+  // stall timeout: then the stream is marked broken and cancelled (which
+  // wakes every waiter) and the wait ends.
+  template <typename Predicate>
+  void WaitUnlessStalled(std::unique_lock<std::mutex>& lock, Predicate done) {
+    while (!done()) {
+      const Clock::time_point limit =
+          write_started_ + config_.stream_stall_timeout;
+      if (changed_.wait_until(lock, limit, done)) return;
+      if (writing_ && Clock::now() >= limit && !broken_) {
+        broken_ = true;
+        stalled_ = true;
+        lock.unlock();
+        RecordStalledStream();
+        context_->TryCancel();  // the reactor is alive: the job holds it
+        changed_.notify_all();
+        lock.lock();
+      }
+    }
+  }
+
+  // After the job's last Send: holds the worker until the client took
+  // every message (or stalled), so that a call ends with what it sent.
+  void WaitForTheLastWrites() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    WaitUnlessStalled(
+        lock, [this] { return broken_ || (!writing_ && pending_.empty()); });
   }
 
   // Finishes now when nothing is being written, else after the last write.
@@ -428,6 +463,11 @@ class StreamReactor final
   // reading, or its deadline passed): DEADLINE_EXCEEDED once the deadline
   // passed, else CANCELLED.
   absl::Status BrokenStatus() const {
+    if (stalled_) {
+      return absl::CancelledError(absl::StrCat(
+          "the client read nothing for ", config_.stream_stall_timeout.count(),
+          " ms; stream cancelled"));
+    }
     absl::Status status = CheckInterrupt(*context_);
     if (!status.ok()) return status;
     return absl::CancelledError("the client cancelled or stopped reading");
@@ -452,10 +492,12 @@ class StreamReactor final
   std::mutex mutex_;
   std::condition_variable changed_;
   std::deque<v1::SegmentResponse> pending_;  // guarded by mutex_
-  v1::SegmentResponse current_;  // being written; guarded by writing_
-  bool writing_ = false;         // guarded by mutex_
-  bool broken_ = false;          // guarded by mutex_
-  bool finished_ = false;        // guarded by mutex_
+  v1::SegmentResponse current_;      // being written; guarded by writing_
+  bool writing_ = false;             // guarded by mutex_
+  bool broken_ = false;              // guarded by mutex_
+  bool stalled_ = false;             // guarded by mutex_
+  Clock::time_point write_started_;  // guarded by mutex_
+  bool finished_ = false;            // guarded by mutex_
   std::optional<absl::Status> final_status_;  // guarded by mutex_
   const std::shared_ptr<JobGate> gate_ = std::make_shared<JobGate>();
 };

@@ -3,6 +3,7 @@
 
 #include <grpcpp/grpcpp.h>
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 
@@ -16,6 +17,10 @@ namespace fovea::server {
 struct ServiceConfig {
   FrameLimits limits;              // largest frame accepted
   uint64_t max_message_bytes = 0;  // reported by GetCapabilities
+  // A stream whose client has not taken a message for this long, while the
+  // worker has results waiting for it, is cancelled (CANCELLED, counted in
+  // fovea_calls_shed_total{reason="stalled_stream"}) and its worker freed.
+  std::chrono::milliseconds stream_stall_timeout{5000};
   // Test hook, null in production: called on the worker thread at the
   // start of every Detect job, before the deadline check. Tests block it
   // to fill the queue deterministically.

@@ -94,6 +94,12 @@ absl::Status Validate(const ServerConfig& config) {
         "--max_connection_age_grace_s: ", config.max_connection_age_grace_s,
         " is not in [0, ", kMaxConnectionAgeS, "]"));
   }
+  if (!(config.stream_stall_timeout_s > 0.0) ||
+      config.stream_stall_timeout_s > 3600.0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--stream_stall_timeout_s: ", config.stream_stall_timeout_s,
+        " is not in (0, 3600]"));
+  }
   if (absl::Status status = Validate(config.limits); !status.ok()) {
     return absl::Status(
         status.code(),
@@ -123,13 +129,18 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
     server->metrics_ = *std::move(metrics);
   }
   server->work_ = std::make_unique<WorkQueue>(config.concurrency, config.queue);
-  server->service_ = std::make_unique<PerceptionService>(
-      ServiceConfig{config.limits,
-                    static_cast<uint64_t>(config.max_message_bytes),
-                    config.before_detect_job, config.at_stage_boundary,
-                    config.on_stream_cancelled, server->models_->View(),
-                    server->models_->versions},
-      server->work_.get());
+  ServiceConfig service;
+  service.limits = config.limits;
+  service.max_message_bytes = static_cast<uint64_t>(config.max_message_bytes);
+  service.stream_stall_timeout = std::chrono::milliseconds(
+      std::lround(config.stream_stall_timeout_s * 1000.0));
+  service.before_detect_job = config.before_detect_job;
+  service.at_stage_boundary = config.at_stage_boundary;
+  service.on_stream_cancelled = config.on_stream_cancelled;
+  service.segment_models = server->models_->View();
+  service.model_versions = server->models_->versions;
+  server->service_ = std::make_unique<PerceptionService>(std::move(service),
+                                                         server->work_.get());
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();

@@ -38,6 +38,10 @@ struct ServerConfig {
   // max_connection_age_grace_s more to finish. 0: connections live forever.
   double max_connection_age_s = 0.0;
   double max_connection_age_grace_s = 30.0;  // >= 0
+  // A stream whose client takes no message for this long while results
+  // wait for it is cancelled (ServiceConfig::stream_stall_timeout), (0,
+  // 3600].
+  double stream_stall_timeout_s = 5.0;
   // Folder of the trained models (LoadModels); start-up fails when a model
   // is missing or corrupt.
   std::string models_dir = FOVEA_DEFAULT_MODELS_DIR;

@@ -430,6 +430,48 @@ SegmentCall CallSegment(v1::Perception::Stub& stub,
   return call;
 }
 
+// A client that never reads its stream (a transport window of about one
+// byte, no window growth) holds the worker only for the stall timeout: the
+// stream is cancelled, counted, and the worker serves the next call.
+TEST_F(ServerTest, StreamWhoseClientNeverReadsIsCancelledAndFreesItsWorker) {
+  ServerConfig config = DefaultConfig();
+  config.concurrency = 1;
+  config.queue = 1;
+  config.stream_stall_timeout_s = 0.3;
+  StartServer(config);
+  grpc::ChannelArguments args;
+  args.SetInt(GRPC_ARG_HTTP2_STREAM_LOOKAHEAD_BYTES, 1);
+  args.SetInt(GRPC_ARG_HTTP2_BDP_PROBE, 0);
+  const std::shared_ptr<grpc::Channel> channel =
+      grpc::CreateCustomChannel("127.0.0.1:" + std::to_string(server_->port()),
+                                grpc::InsecureChannelCredentials(), args);
+  std::unique_ptr<v1::Perception::Stub> lazy = v1::Perception::NewStub(channel);
+  v1::SegmentRequest request;
+  *request.mutable_frame() = MakeSyntheticRequest(3, false).request.frame();
+  // Each object's mask goes as a full-frame run-length list: make the
+  // messages large enough to fill any window.
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() +
+                       std::chrono::seconds(60));
+  auto never_read = lazy->Segment(&context, request);
+  ASSERT_TRUE(WaitFor(
+      [this] {
+        return MetricValue(Scrape(), "fovea_calls_shed_total",
+                           {"reason=\"stalled_stream\""}) >= 1;
+      },
+      kCallTimeout));
+  // The worker is free: a Detect from another client succeeds.
+  v1::DetectResponse response;
+  EXPECT_TRUE(Detect(MakeSyntheticRequest(1, false).request, &response,
+                     std::chrono::milliseconds(20000))
+                  .ok());
+  context.TryCancel();
+  v1::SegmentResponse ignored;
+  while (never_read->Read(&ignored)) {
+  }
+  EXPECT_EQ(never_read->Finish().error_code(), grpc::StatusCode::CANCELLED);
+}
+
 TEST_F(ServerTest, SegmentStreamsPointsThenObjectsThenTheSummary) {
   StartServer();
   v1::SegmentRequest request;
