@@ -1,5 +1,6 @@
 #include "server/perception_service.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -79,7 +80,7 @@ class CallRecord {
 // DEADLINE_EXCEEDED once the client's deadline passed, CANCELLED once the
 // call was cancelled, else OK. Safe on any thread.
 absl::Status CheckInterrupt(const grpc::CallbackServerContext& context) {
-  if (std::chrono::system_clock::now() >= context.deadline()) {
+  if (DeadlinePassed(context.raw_deadline())) {
     return absl::DeadlineExceededError("the client's deadline passed");
   }
   if (context.IsCancelled()) {
@@ -301,6 +302,7 @@ class StreamReactor final
       if (!ok) {
         broken_ = true;
         pending_.clear();
+        pending_bytes_ = 0;
       } else {
         RecordMessageSent(method_);
       }
@@ -342,9 +344,11 @@ class StreamReactor final
   }
 
  private:
-  // At most this many messages wait unwritten before the worker blocks:
-  // a mask is a few kB of run lengths, the first message the points.
+  // At most this many messages, and this many bytes of them (one message
+  // always fits), wait unwritten before the worker blocks: an object's
+  // mask is usually a few kB of run lengths.
   static constexpr size_t kMaxPendingMessages = 16;
+  static constexpr size_t kMaxPendingBytes = 2 << 20;
 
   // On a worker thread.
   void Run() {
@@ -390,10 +394,14 @@ class StreamReactor final
   // once the client has gone or stalled.
   absl::Status Send(v1::SegmentResponse message) {
     std::unique_lock<std::mutex> lock(mutex_);
-    WaitUnlessStalled(lock, [this] {
-      return broken_ || pending_.size() < kMaxPendingMessages;
+    const size_t bytes = message.ByteSizeLong();
+    WaitUnlessStalled(lock, [this, bytes] {
+      return broken_ || pending_.empty() ||
+             (pending_.size() < kMaxPendingMessages &&
+              pending_bytes_ + bytes <= kMaxPendingBytes);
     });
     if (broken_) return BrokenStatus();
+    pending_bytes_ += bytes;
     pending_.push_back(std::move(message));
     if (!writing_) StartNextWriteLocked();
     return absl::OkStatus();
@@ -402,6 +410,7 @@ class StreamReactor final
   void StartNextWriteLocked() {
     current_ = std::move(pending_.front());
     pending_.pop_front();
+    pending_bytes_ -= std::min(pending_bytes_, current_.ByteSizeLong());
     writing_ = true;
     write_started_ = Clock::now();
     StartWrite(&current_);
@@ -492,6 +501,7 @@ class StreamReactor final
   std::mutex mutex_;
   std::condition_variable changed_;
   std::deque<v1::SegmentResponse> pending_;  // guarded by mutex_
+  size_t pending_bytes_ = 0;                 // guarded by mutex_
   v1::SegmentResponse current_;      // being written; guarded by writing_
   bool writing_ = false;             // guarded by mutex_
   bool broken_ = false;              // guarded by mutex_

@@ -472,6 +472,22 @@ TEST_F(ServerTest, StreamWhoseClientNeverReadsIsCancelledAndFreesItsWorker) {
   EXPECT_EQ(never_read->Finish().error_code(), grpc::StatusCode::CANCELLED);
 }
 
+// grpc-timeout allows 99999999 hours (11,000 years): past 2262, beyond
+// std::chrono's nanosecond clock. Such a call is served, not refused as
+// already late.
+TEST_F(ServerTest, DeadlineFarInTheFutureIsNoDeadline) {
+  StartServer();
+  grpc::ClientContext context;
+  context.set_deadline(
+      gpr_time_add(gpr_now(GPR_CLOCK_REALTIME),
+                   gpr_time_from_hours(99999999, GPR_TIMESPAN)));
+  v1::DetectResponse response;
+  const grpc::Status status = stub_->Detect(
+      &context, MakeSyntheticRequest(1, false).request, &response);
+  EXPECT_TRUE(status.ok()) << status.error_message();
+  EXPECT_GT(response.points_size(), 0);
+}
+
 TEST_F(ServerTest, SegmentStreamsPointsThenObjectsThenTheSummary) {
   StartServer();
   v1::SegmentRequest request;

@@ -452,10 +452,10 @@ class StalledReaderTest
 };
 
 // What bounds the memory of a stream whose client reads nothing: the
-// reactor keeps at most kMaxPendingMessages (2) unwritten messages plus the
-// one being written, and gRPC sends that one only as far as the client's
-// HTTP/2 flow-control window lets it. The window is the client's: 64 KiB
-// at first, grown by BDP probing only while the client reads. The job
+// reactor keeps at most 2 MiB of unwritten messages (at least one, at most
+// 16) plus the one being written, and gRPC sends that one only as far as the
+// client's HTTP/2 flow-control window lets it. The window is the client's: 64
+// KiB at first, grown by BDP probing only while the client reads. The job
 // blocks in its next Send until the client reads, cancels or runs out of
 // time. Here each message is > 1 MiB and the window 64 KiB, so not even
 // the first message is written whole: the job must stop partway, holding
