@@ -44,9 +44,14 @@ ABSL_FLAG(int, concurrency, Cores(),
 ABSL_FLAG(int, queue, 2 * Cores(),
           "Frames waiting for a worker; beyond it calls fail at once with "
           "RESOURCE_EXHAUSTED. Default: twice the number of cores.");
-ABSL_FLAG(int, max_message_bytes, fovea::server::kDefaultMaxMessageBytes,
-          "Largest request accepted, bytes (64 MiB: a raw 1920x1080 "
-          "rgb8 + 32FC1 frame fits).");
+ABSL_FLAG(int, max_message_bytes, 0,
+          "Largest request accepted, bytes. 0: the largest raw frame "
+          "--max_width x --max_height allows (rgb8 + 32FC1, packed rows) "
+          "and 1 MiB: 15.5 MiB at 1920x1080.");
+ABSL_FLAG(int, memory_quota_mb,
+          static_cast<int>(fovea::server::kDefaultMemoryQuotaBytes >> 20),
+          "Memory gRPC may use for requests it receives and buffers "
+          "(resource quota), MiB; calls beyond it are refused.");
 ABSL_FLAG(uint32_t, max_width, fovea::FrameLimits{}.max_width,
           "Widest frame accepted, pixels; wider frames are INVALID_ARGUMENT.");
 ABSL_FLAG(uint32_t, max_height, fovea::FrameLimits{}.max_height,
@@ -98,8 +103,8 @@ int main(int argc, char** argv) {
   const absl::Status from_env = fovea::server::ApplyFlagsFromEnv(
       {"listen", "metrics_listen", "concurrency", "queue", "max_message_bytes",
        "max_width", "max_height", "grace_period_s", "max_connection_age_s",
-       "max_connection_age_grace_s", "stream_stall_timeout_s", "models_dir",
-       "log_level"},
+       "max_connection_age_grace_s", "stream_stall_timeout_s",
+       "memory_quota_mb", "models_dir", "log_level"},
       [](const char* name) { return std::getenv(name); });
   if (!from_env.ok()) {
     LogError(from_env.ToString());
@@ -135,6 +140,8 @@ int main(int argc, char** argv) {
   config.concurrency = absl::GetFlag(FLAGS_concurrency);
   config.queue = absl::GetFlag(FLAGS_queue);
   config.max_message_bytes = absl::GetFlag(FLAGS_max_message_bytes);
+  config.memory_quota_bytes = int64_t{absl::GetFlag(FLAGS_memory_quota_mb)}
+                              << 20;
   config.limits.max_width = absl::GetFlag(FLAGS_max_width);
   config.limits.max_height = absl::GetFlag(FLAGS_max_height);
   config.max_connection_age_s = absl::GetFlag(FLAGS_max_connection_age_s);

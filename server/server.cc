@@ -2,8 +2,11 @@
 
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/health_check_service_interface.h>
+#include <grpcpp/resource_quota.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -66,6 +69,11 @@ std::vector<std::string> DetectStages() {
 
 }  // namespace
 
+int DefaultMaxMessageBytes(const FrameLimits& limits) {
+  const int64_t raw = int64_t{limits.max_width} * limits.max_height * (3 + 4);
+  return static_cast<int>(std::min<int64_t>(raw + (1 << 20), INT32_MAX));
+}
+
 absl::Status Validate(const ServerConfig& config) {
   if (config.listen.empty()) {
     return absl::InvalidArgumentError("--listen: empty, expected host:port");
@@ -78,9 +86,14 @@ absl::Status Validate(const ServerConfig& config) {
     return absl::InvalidArgumentError(
         absl::StrCat("--queue: ", config.queue, " is negative"));
   }
-  if (config.max_message_bytes < 1) {
+  if (config.max_message_bytes < 0) {
     return absl::InvalidArgumentError(absl::StrCat(
-        "--max_message_bytes: ", config.max_message_bytes, " is below 1"));
+        "--max_message_bytes: ", config.max_message_bytes, " is negative"));
+  }
+  if (config.memory_quota_bytes < (int64_t{16} << 20)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--memory_quota_mb: ", config.memory_quota_bytes >> 20,
+                     " is below 16"));
   }
   if (!(config.max_connection_age_s >= 0.0) ||
       config.max_connection_age_s > kMaxConnectionAgeS) {
@@ -111,6 +124,9 @@ absl::Status Validate(const ServerConfig& config) {
 absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
     ServerConfig config) {
   if (absl::Status status = Validate(config); !status.ok()) return status;
+  if (config.max_message_bytes == 0) {
+    config.max_message_bytes = DefaultMaxMessageBytes(config.limits);
+  }
   InitMetrics(ServerVersion());
   InitStageSeries(DetectStages());
 
@@ -149,6 +165,9 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
   // share it silently with SO_REUSEPORT).
   builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
   builder.SetMaxReceiveMessageSize(config.max_message_bytes);
+  grpc::ResourceQuota quota("fovea-server");
+  quota.Resize(static_cast<size_t>(config.memory_quota_bytes));
+  builder.SetResourceQuota(quota);
   if (config.max_connection_age_s > 0.0) {
     builder.AddChannelArgument(
         GRPC_ARG_MAX_CONNECTION_AGE_MS,
@@ -171,12 +190,14 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
 
   LogInfo(absl::StrFormat(
       "fovea-server %s listening on %s (port %d), metrics %s, concurrency "
-      "%d, queue %d, max message %d bytes, max frame %dx%d",
+      "%d, queue %d, max message %d bytes, memory quota %d MiB, max frame "
+      "%dx%d",
       ServerVersion(), config.listen, server->port_,
       config.metrics_listen.empty()
           ? std::string("off")
           : absl::StrCat("on port ", server->metrics_port(), " /metrics"),
       config.concurrency, config.queue, config.max_message_bytes,
+      static_cast<int>(config.memory_quota_bytes >> 20),
       config.limits.max_width, config.limits.max_height));
 
   if (config.warm_up) {

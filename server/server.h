@@ -20,17 +20,27 @@
 
 namespace fovea::server {
 
-// Default largest receive message: a raw 1280x720 rgb8 + 32FC1 frame is
-// about 6.5 MB; 64 MiB leaves room for 1920x1080 and compressed files.
-inline constexpr int kDefaultMaxMessageBytes = 64 << 20;
+// The largest request worth receiving with these frame limits: a raw
+// frame of the largest size with packed rows (rgb8, 3 bytes a pixel, and
+// 32FC1 depth, 4) and 1 MiB for the options and the rest: 15.5 MiB at
+// 1920x1080. A compressed frame of that size is smaller.
+int DefaultMaxMessageBytes(const FrameLimits& limits);
+
+// Memory gRPC may use for what it receives and buffers (the resource
+// quota), default: requests larger than fit are refused with
+// RESOURCE_EXHAUSTED instead of growing the process.
+inline constexpr int64_t kDefaultMemoryQuotaBytes = int64_t{512} << 20;
 
 struct ServerConfig {
   std::string listen = "127.0.0.1:50051";  // host:port of the gRPC server
   std::string metrics_listen;              // host:port of /metrics; empty: none
   int concurrency = 1;                     // frames computed at once, >= 1
   int queue = 2;                           // frames waiting for a worker, >= 0
-  int max_message_bytes = kDefaultMaxMessageBytes;  // largest request, > 0
-  FrameLimits limits;                               // largest frame
+  // Largest request, > 0; 0: DefaultMaxMessageBytes(limits).
+  int max_message_bytes = 0;
+  // gRPC's resource quota, bytes (>= 16 MiB).
+  int64_t memory_quota_bytes = kDefaultMemoryQuotaBytes;
+  FrameLimits limits;   // largest frame
   bool warm_up = true;  // run one Detect before reporting SERVING
   // Seconds after which the server asks a client connection to go away
   // (GOAWAY; gRPC adds +-10 % jitter), so that clients re-resolve DNS and

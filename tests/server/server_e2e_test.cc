@@ -722,8 +722,8 @@ TEST_F(ServerTest, CapabilitiesReportWhatCoreImplements) {
   EXPECT_THAT(capabilities.depth_encodings(),
               ::testing::ElementsAre("16UC1", "32FC1"));
   EXPECT_EQ(capabilities.max_width(), 1920u);
-  EXPECT_EQ(capabilities.max_message_bytes(),
-            static_cast<uint64_t>(kDefaultMaxMessageBytes));
+  // The largest raw 1920x1080 frame and 1 MiB.
+  EXPECT_EQ(capabilities.max_message_bytes(), 1920u * 1080u * 7u + (1u << 20));
   EXPECT_THAT(capabilities.segmentation_methods(),
               ::testing::ElementsAre(v1::COS, v1::EBS));
   ASSERT_EQ(capabilities.models_size(), 3);

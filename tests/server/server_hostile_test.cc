@@ -283,5 +283,40 @@ TEST_F(HostileRequestTest, JpegClaimingHugeSizeIsRefusedFromItsHeader) {
   ExpectStillServing();
 }
 
+// The default largest request follows the frame limits: the largest raw
+// frame and 1 MiB (15.5 MiB at 1920x1080), not a fixed 64 MiB.
+TEST_F(HostileRequestTest, RequestLargerThanTheLargestFrameIsRefused) {
+  StartServer();
+  v1::DetectRequest request = ShRequest();
+  request.set_request_id(std::string(16 << 20, 'x'));
+  v1::DetectResponse response;
+  EXPECT_EQ(Detect(request, &response).error_code(),
+            grpc::StatusCode::RESOURCE_EXHAUSTED);
+  ExpectStillServing();
+}
+
+// Requests in flight cannot take more memory than the resource quota:
+// with 16 MiB, of six concurrent 12 MiB requests most are refused, and the
+// server goes on.
+TEST_F(HostileRequestTest, MemoryQuotaRefusesWhatDoesNotFit) {
+  ServerConfig config = DefaultConfig();
+  config.memory_quota_bytes = int64_t{16} << 20;
+  config.queue = 8;
+  StartServer(config);
+  v1::DetectRequest big = ShRequest();
+  big.set_request_id(std::string(12 << 20, 'x'));
+  std::vector<std::future<grpc::Status>> calls;
+  for (int i = 0; i < 6; ++i) calls.push_back(DetectAsync(big));
+  int refused = 0;
+  for (std::future<grpc::Status>& call : calls) {
+    const grpc::StatusCode code = call.get().error_code();
+    EXPECT_THAT(code, AnyOf(Eq(grpc::StatusCode::OK),
+                            Eq(grpc::StatusCode::RESOURCE_EXHAUSTED)));
+    refused += code == grpc::StatusCode::RESOURCE_EXHAUSTED ? 1 : 0;
+  }
+  EXPECT_GE(refused, 1);
+  ExpectStillServing();
+}
+
 }  // namespace
 }  // namespace fovea::server
