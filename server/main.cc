@@ -17,6 +17,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/time/time.h"
 #include "server/capabilities.h"
+#include "server/descriptors.h"
 #include "server/env_flags.h"
 #include "server/log.h"
 #include "server/server.h"
@@ -70,6 +71,10 @@ ABSL_FLAG(double, stream_stall_timeout_s,
           fovea::server::ServerConfig{}.stream_stall_timeout_s,
           "A Segment stream whose client takes no message for this long "
           "while results wait for it is cancelled and its worker freed.");
+ABSL_FLAG(double, handshake_timeout_s,
+          fovea::server::ServerConfig{}.handshake_timeout_s,
+          "A connection that has not completed the HTTP/2 (or TLS) "
+          "handshake within this many seconds is closed.");
 ABSL_FLAG(
     std::string, models_dir, fovea::server::ServerConfig{}.models_dir,
     "Folder of the trained models (cos_svm.txt, ...; see models/README.md). "
@@ -104,7 +109,7 @@ int main(int argc, char** argv) {
       {"listen", "metrics_listen", "concurrency", "queue", "max_message_bytes",
        "max_width", "max_height", "grace_period_s", "max_connection_age_s",
        "max_connection_age_grace_s", "stream_stall_timeout_s",
-       "memory_quota_mb", "models_dir", "log_level"},
+       "memory_quota_mb", "handshake_timeout_s", "models_dir", "log_level"},
       [](const char* name) { return std::getenv(name); });
   if (!from_env.ok()) {
     LogError(from_env.ToString());
@@ -134,6 +139,7 @@ int main(int argc, char** argv) {
   sigaddset(&stop_signals, SIGINT);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
 
+  LogInfo(fovea::server::RaiseDescriptorLimit());
   fovea::server::ServerConfig config;
   config.listen = absl::GetFlag(FLAGS_listen);
   config.metrics_listen = absl::GetFlag(FLAGS_metrics_listen);
@@ -148,6 +154,7 @@ int main(int argc, char** argv) {
   config.max_connection_age_grace_s =
       absl::GetFlag(FLAGS_max_connection_age_grace_s);
   config.stream_stall_timeout_s = absl::GetFlag(FLAGS_stream_stall_timeout_s);
+  config.handshake_timeout_s = absl::GetFlag(FLAGS_handshake_timeout_s);
   config.models_dir = absl::GetFlag(FLAGS_models_dir);
 
   absl::StatusOr<std::unique_ptr<fovea::server::FoveaServer>> server =

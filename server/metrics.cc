@@ -103,6 +103,9 @@ class Metrics {
   }
 
   prometheus::Gauge& inflight() { return inflight_; }
+  prometheus::Gauge& open_fds() { return open_fds_; }
+  prometheus::Gauge& fd_limit() { return fd_limit_; }
+  prometheus::Counter& refused() { return refused_; }
   prometheus::Histogram& queue_wait() { return queue_wait_; }
 
   void SetBuildInfo(std::string_view version) {
@@ -167,6 +170,22 @@ class Metrics {
                                "took the call), stalled_stream (the client "
                                "stopped reading a stream).")
                          .Register(*registry_)),
+        open_fds_(prometheus::BuildGauge()
+                      .Name("fovea_open_file_descriptors")
+                      .Help("File descriptors the process holds.")
+                      .Register(*registry_)
+                      .Add({})),
+        fd_limit_(prometheus::BuildGauge()
+                      .Name("fovea_file_descriptor_limit")
+                      .Help("The soft RLIMIT_NOFILE.")
+                      .Register(*registry_)
+                      .Add({})),
+        refused_(prometheus::BuildCounter()
+                     .Name("fovea_connections_refused_total")
+                     .Help("Connections closed at once (or delayed) because "
+                           "too few file descriptors were left.")
+                     .Register(*registry_)
+                     .Add({})),
         inflight_(prometheus::BuildGauge()
                       .Name("fovea_inflight_requests")
                       .Help("Calls started and not yet finished, queued "
@@ -223,6 +242,9 @@ class Metrics {
   prometheus::Family<prometheus::Histogram>& objects_family_;
   prometheus::Family<prometheus::Counter>& stops_family_;
   prometheus::Family<prometheus::Counter>& shed_family_;
+  prometheus::Gauge& open_fds_;
+  prometheus::Gauge& fd_limit_;
+  prometheus::Counter& refused_;
   prometheus::Gauge& inflight_;
   prometheus::Histogram& queue_wait_;
   prometheus::Family<prometheus::Gauge>& build_info_family_;
@@ -293,6 +315,15 @@ void RecordAbandonedInQueue() {
 
 void RecordStalledStream() {
   Metrics::Get().Shed("stalled_stream").Increment();
+}
+
+void RecordDescriptors(int open, int limit, int64_t refused_total) {
+  Metrics& metrics = Metrics::Get();
+  metrics.open_fds().Set(open);
+  metrics.fd_limit().Set(limit);
+  const double delta =
+      static_cast<double>(refused_total) - metrics.refused().Value();
+  if (delta > 0) metrics.refused().Increment(delta);
 }
 
 void IncrementInflight() { Metrics::Get().inflight().Increment(); }

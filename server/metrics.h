@@ -45,6 +45,8 @@ namespace fovea::server {
 //   fovea_calls_shed_total{reason}       counter: calls the server ended
 //                                        itself (abandoned_in_queue,
 //                                        stalled_stream)
+//   fovea_open_file_descriptors, fovea_file_descriptor_limit  gauges
+//   fovea_connections_refused_total      counter: closed by the accept guard
 //   fovea_inflight_requests              gauge: calls started, not finished
 //   fovea_queue_wait_seconds             histogram: submit to start of work
 //   fovea_build_info{version}            gauge, always 1
@@ -84,6 +86,10 @@ void RecordAbandonedInQueue();
 void RecordStalledStream();
 void IncrementInflight();
 void DecrementInflight();
+// fovea_open_file_descriptors, fovea_file_descriptor_limit (gauges) and
+// fovea_connections_refused_total (counter, set to `refused_total`:
+// connections the accept guard closed or delayed).
+void RecordDescriptors(int open, int limit, int64_t refused_total);
 
 // The registry in Prometheus' text format, as /metrics serves it.
 std::string MetricsText();

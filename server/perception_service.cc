@@ -90,6 +90,19 @@ absl::Status CheckInterrupt(const grpc::CallbackServerContext& context) {
   return absl::OkStatus();
 }
 
+// Why a call that waits for a worker was cancelled: DEADLINE_EXCEEDED
+// when its deadline passed or is due within 100 ms (the client's own timer
+// may fire, and its cancellation arrive, before the server's), CANCELLED
+// otherwise.
+absl::Status AbandonStatus(const grpc::CallbackServerContext& context) {
+  const gpr_timespec soon = gpr_time_sub(
+      context.raw_deadline(), gpr_time_from_millis(100, GPR_TIMESPAN));
+  if (DeadlinePassed(soon)) {
+    return absl::DeadlineExceededError("the client's deadline passed");
+  }
+  return absl::CancelledError("the call was cancelled");
+}
+
 // Who finishes a call whose job waits for a worker: the worker, once it
 // starts the job, or the reaction to the client leaving (its deadline
 // passed, it cancelled), if that comes first. Whichever wins the exchange
@@ -164,10 +177,8 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
   void OnCancel() override {
     TsanHappensAfter(this);
     if (gate_->Abandon()) {
-      absl::Status status = CheckInterrupt(*context_);
-      if (status.ok()) status = absl::CancelledError("the call was cancelled");
       RecordAbandonedInQueue();
-      Complete(status);
+      Complete(AbandonStatus(*context_));
       return;
     }
     TsanHappensBefore(this);
@@ -331,7 +342,7 @@ class StreamReactor final
     if (config_.on_stream_cancelled) config_.on_stream_cancelled();
     if (gate_->Abandon()) {  // still waiting for a worker: end it now
       RecordAbandonedInQueue();
-      FinishOnce(BrokenStatus());
+      FinishOnce(AbandonStatus(*context_));
       return;
     }
     TsanHappensBefore(this);

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -14,9 +15,11 @@
 #include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
 #include "core/synth/synth_scene.h"
+#include "server/accept_guard.h"
 #include "server/capabilities.h"
 #include "server/clock.h"
 #include "server/convert.h"
+#include "server/descriptors.h"
 #include "server/handle_detect.h"
 #include "server/log.h"
 
@@ -113,6 +116,17 @@ absl::Status Validate(const ServerConfig& config) {
         "--stream_stall_timeout_s: ", config.stream_stall_timeout_s,
         " is not in (0, 3600]"));
   }
+  if (!(config.handshake_timeout_s > 0.0) ||
+      config.handshake_timeout_s > 120.0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--handshake_timeout_s: ", config.handshake_timeout_s,
+                     " is not in (0, 120]"));
+  }
+  if (!(config.fd_high_water > 0.0) || config.fd_high_water > 1.0 ||
+      !(config.fd_check_interval_s > 0.0)) {
+    return absl::InvalidArgumentError(
+        "fd_high_water must be in (0, 1] and fd_check_interval_s positive");
+  }
   if (absl::Status status = Validate(config.limits); !status.ok()) {
     return absl::Status(
         status.code(),
@@ -129,6 +143,7 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
   }
   InitMetrics(ServerVersion());
   InitStageSeries(DetectStages());
+  SetAcceptReserve(config.fd_reserve);
 
   std::unique_ptr<FoveaServer> server(new FoveaServer);
   absl::StatusOr<LoadedModels> models = LoadModels(config.models_dir);
@@ -165,6 +180,9 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
   // share it silently with SO_REUSEPORT).
   builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
   builder.SetMaxReceiveMessageSize(config.max_message_bytes);
+  builder.AddChannelArgument(
+      GRPC_ARG_SERVER_HANDSHAKE_TIMEOUT_MS,
+      static_cast<int>(std::lround(config.handshake_timeout_s * 1000.0)));
   grpc::ResourceQuota quota("fovea-server");
   quota.Resize(static_cast<size_t>(config.memory_quota_bytes));
   builder.SetResourceQuota(quota);
@@ -208,12 +226,15 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
           self->WarmUp(limits, before_warm_up);
         });
   } else {
-    {
-      MutexLock lock(&server->mu_);
-      server->warmed_up_ = true;
-    }
-    server->SetServing(true);
+    MutexLock lock(&server->mu_);
+    server->warmed_up_ = true;
+    server->UpdateHealthLocked();
   }
+  server->fd_thread_ =
+      std::thread([self = server.get(), high = config.fd_high_water,
+                   interval = config.fd_check_interval_s] {
+        self->WatchDescriptors(high, interval);
+      });
   return server;
 }
 
@@ -226,6 +247,51 @@ int FoveaServer::metrics_port() const {
 bool FoveaServer::warmed_up() const {
   MutexLock lock(&mu_);
   return warmed_up_;
+}
+
+bool FoveaServer::out_of_descriptors() const {
+  MutexLock lock(&mu_);
+  return out_of_descriptors_;
+}
+
+void FoveaServer::UpdateHealthLocked() {
+  const bool serving = warmed_up_ && !draining_ && !out_of_descriptors_;
+  if (serving == serving_) return;
+  serving_ = serving;
+  SetServing(serving);
+  LogInfo(serving ? "health: SERVING" : "health: NOT_SERVING");
+}
+
+void FoveaServer::WatchDescriptors(double high_water, double interval_s) {
+  MutexLock lock(&mu_);
+  while (!shut_down_) {
+    // Near the limit even /proc/self/fd cannot be opened: count that as
+    // full.
+    std::optional<DescriptorUse> use = CountDescriptors();
+    if (!use.has_value()) use = DescriptorUse{1, 1};
+    RecordDescriptors(use->open, use->limit, AcceptsRefused());
+    if (use->limit > 0) {
+      const double share = static_cast<double>(use->open) / use->limit;
+      const bool out =
+          out_of_descriptors_ ? share > 0.9 * high_water : share > high_water;
+      if (out != out_of_descriptors_) {
+        out_of_descriptors_ = out;
+        if (out) {
+          LogError(absl::StrFormat(
+              "%d of %d file descriptors open: new connections cannot be "
+              "accepted; health NOT_SERVING until they close",
+              use->open, use->limit));
+        } else {
+          LogInfo(absl::StrFormat("%d of %d file descriptors open again",
+                                  use->open, use->limit));
+        }
+        UpdateHealthLocked();
+      }
+    }
+    mu_.AwaitWithTimeout(
+        [this]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_) { return shut_down_; },
+        absl::Seconds(interval_s));
+  }
 }
 
 void FoveaServer::SetServing(bool serving) {
@@ -257,18 +323,15 @@ void FoveaServer::WarmUp(const FrameLimits& limits,
   }
   MutexLock lock(&mu_);
   warmed_up_ = true;
-  if (!draining_) {
-    SetServing(true);
-    LogInfo("health: SERVING");
-  }
+  UpdateHealthLocked();
 }
 
 void FoveaServer::Drain() {
   MutexLock lock(&mu_);
   if (draining_) return;
   draining_ = true;
-  SetServing(false);
-  LogInfo("draining: health NOT_SERVING");
+  LogInfo("draining");
+  UpdateHealthLocked();
 }
 
 void FoveaServer::Shutdown(absl::Duration grace) {
@@ -288,6 +351,7 @@ void FoveaServer::Shutdown(absl::Duration grace) {
   }
   if (work_ != nullptr) work_->Stop();
   if (warm_up_thread_.joinable()) warm_up_thread_.join();
+  if (fd_thread_.joinable()) fd_thread_.join();
   metrics_.reset();
 }
 

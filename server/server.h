@@ -52,6 +52,18 @@ struct ServerConfig {
   // wait for it is cancelled (ServiceConfig::stream_stall_timeout), (0,
   // 3600].
   double stream_stall_timeout_s = 5.0;
+  // A connection that has not completed the HTTP/2 handshake (preface and
+  // settings) within this many seconds is closed: silent connections
+  // cannot pile up to the descriptor limit. (0, 120].
+  double handshake_timeout_s = 5.0;
+  // Health turns NOT_SERVING while the process holds more than this share
+  // of its descriptor limit (the listener could not accept), and SERVING
+  // again below 0.9 of it. Checked every fd_check_interval_s. (0, 1].
+  double fd_high_water = 0.95;
+  double fd_check_interval_s = 1.0;
+  // New connections are closed at once while fewer than this many
+  // descriptors are left under the limit (accept_guard.h); 0: off.
+  int fd_reserve = 64;
   // Folder of the trained models (LoadModels); start-up fails when a model
   // is missing or corrupt.
   std::string models_dir = FOVEA_DEFAULT_MODELS_DIR;
@@ -103,6 +115,10 @@ class FoveaServer {
   // True once the warm-up finished (OK or not).
   bool warmed_up() const;
 
+  // True while the process holds more descriptors than fd_high_water of
+  // its limit (health says NOT_SERVING meanwhile).
+  bool out_of_descriptors() const;
+
   // Health NOT_SERVING for both names; calls are still served, so load
   // balancers can move traffic away first. Idempotent.
   void Drain();
@@ -119,6 +135,11 @@ class FoveaServer {
  private:
   FoveaServer() = default;
   void SetServing(bool serving);
+  // What health should say now: warmed up, not draining, descriptors left.
+  void UpdateHealthLocked() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Every fd_check_interval_s until shutdown: open descriptors against the
+  // limit.
+  void WatchDescriptors(double high_water, double interval_s);
   void WarmUp(const FrameLimits& limits,
               const std::function<void()>& before_warm_up);
 
@@ -129,11 +150,14 @@ class FoveaServer {
   std::unique_ptr<MetricsEndpoint> metrics_;
   std::unique_ptr<grpc::Server> server_;  // after service_: destroyed first
   std::thread warm_up_thread_;
+  std::thread fd_thread_;
 
   mutable Mutex mu_;
   bool warmed_up_ ABSL_GUARDED_BY(mu_) = false;
   bool draining_ ABSL_GUARDED_BY(mu_) = false;
   bool shut_down_ ABSL_GUARDED_BY(mu_) = false;
+  bool out_of_descriptors_ ABSL_GUARDED_BY(mu_) = false;
+  bool serving_ ABSL_GUARDED_BY(mu_) = false;  // what health says
 };
 
 }  // namespace fovea::server

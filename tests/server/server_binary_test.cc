@@ -2,7 +2,10 @@
 // SIGTERM, idle or with calls in flight.
 
 #include <grpcpp/grpcpp.h>
+#include <netinet/in.h>
 #include <signal.h>
+#include <sys/resource.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -36,8 +39,9 @@ using ::fovea::server::testing::MetricValue;
 using ::fovea::server::testing::WaitFor;
 using ::testing::HasSubstr;
 
-// Starts fovea-server with `args`; returns its pid.
-pid_t Spawn(const std::vector<std::string>& args) {
+// Starts fovea-server with `args` (and a soft and hard RLIMIT_NOFILE of
+// `nofile` when positive); returns its pid.
+pid_t Spawn(const std::vector<std::string>& args, int nofile = 0) {
   std::vector<char*> argv;
   std::string binary = FOVEA_SERVER_BINARY;
   argv.push_back(binary.data());
@@ -46,6 +50,11 @@ pid_t Spawn(const std::vector<std::string>& args) {
   argv.push_back(nullptr);
   const pid_t pid = fork();
   if (pid == 0) {
+    if (nofile > 0) {
+      const rlimit limit{static_cast<rlim_t>(nofile),
+                         static_cast<rlim_t>(nofile)};
+      if (setrlimit(RLIMIT_NOFILE, &limit) != 0) _exit(126);
+    }
     execv(argv[0], argv.data());
     _exit(127);
   }
@@ -85,7 +94,11 @@ TEST(ServerBinaryTest, HelpListsEveryFlagWithItsDefault) {
         "--grace_period_s", "--log_level", "--models_dir"}) {
     EXPECT_THAT(output, HasSubstr(flag));
   }
-  EXPECT_THAT(output, HasSubstr("default: 67108864"));
+  for (const char* flag : {"--memory_quota_mb", "--stream_stall_timeout_s",
+                           "--handshake_timeout_s"}) {
+    EXPECT_THAT(output, HasSubstr(flag));
+  }
+  EXPECT_THAT(output, HasSubstr("default: 512"));
   EXPECT_THAT(output, HasSubstr("default: \"0.0.0.0:50051\""));
 }
 
@@ -168,7 +181,8 @@ struct ServerProcess {
 // Starts fovea-server and waits (up to 60 s) for health SERVING on both
 // names. Fails the test (ADD_FAILURE) and returns pid -1 when it exits
 // early or never serves.
-ServerProcess StartServing(const std::vector<std::string>& flags) {
+ServerProcess StartServing(const std::vector<std::string>& flags,
+                           int nofile = 0) {
   ServerProcess server;
   const int port = FreePort();
   server.metrics_port = FreePort();
@@ -177,7 +191,7 @@ ServerProcess StartServing(const std::vector<std::string>& flags) {
   args.push_back("--listen=" + server.target);
   args.push_back("--metrics_listen=127.0.0.1:" +
                  std::to_string(server.metrics_port));
-  server.pid = Spawn(args);
+  server.pid = Spawn(args, nofile);
   if (server.pid <= 0) {
     ADD_FAILURE() << "fork failed";
     return server;
@@ -221,6 +235,72 @@ void ExpectCleanExitOnSigterm(pid_t pid) {
   ASSERT_NE(status, -1) << "did not exit within 30 s of SIGTERM";
   EXPECT_TRUE(WIFEXITED(status)) << "wait status " << status;
   EXPECT_EQ(WEXITSTATUS(status), 0);
+}
+
+// A TCP connection to `port` on loopback that sends nothing; -1 on failure.
+int SilentConnection(int port) {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  if (fd < 0) return -1;
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(static_cast<uint16_t>(port));
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) !=
+      0) {
+    close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+bool DetectOk(const std::string& target, std::chrono::milliseconds deadline) {
+  auto stub = v1::Perception::NewStub(
+      grpc::CreateChannel(target, grpc::InsecureChannelCredentials()));
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + deadline);
+  v1::DetectResponse response;
+  return stub
+      ->Detect(&context, MakeSyntheticRequest(1, false).request, &response)
+      .ok();
+}
+
+// More silent connections than the server has descriptors (256): it keeps
+// some descriptors free (metrics still scrape), does not spin, drops the
+// silent connections after the handshake timeout, and serves a new client
+// within seconds of the flood ending. (gRPC 1.51 alone never accepted
+// again after its first EMFILE.)
+TEST(ServerBinaryTest, FloodOfSilentConnectionsLeavesTheListenerAlive) {
+  const ServerProcess server = StartServing(
+      {"--concurrency=1", "--handshake_timeout_s=2", "--grace_period_s=2"},
+      256);
+  ASSERT_GT(server.pid, 0);
+  const int port =
+      std::stoi(server.target.substr(server.target.rfind(':') + 1));
+  std::vector<int> flood;
+  for (int i = 0; i < 300; ++i) {
+    const int fd = SilentConnection(port);
+    if (fd >= 0) flood.push_back(fd);
+  }
+  EXPECT_GE(flood.size(), 250u);
+  // Metrics still answer while the flood is on, and count the refusals
+  // (updated every second).
+  EXPECT_TRUE(WaitFor(
+      [&] {
+        const std::optional<std::string> metrics =
+            HttpGet(server.metrics_port, "/metrics");
+        return metrics.has_value() &&
+               MetricValue(*metrics, "fovea_connections_refused_total", {})
+                       .value_or(0) > 0;
+      },
+      std::chrono::seconds(10)));
+  // The silent ones are dropped after the handshake timeout; then a client
+  // is served even with the flood's sockets still open on this side.
+  EXPECT_TRUE(WaitFor(
+      [&] { return DetectOk(server.target, std::chrono::milliseconds(2000)); },
+      std::chrono::seconds(30)));
+  for (const int fd : flood) close(fd);
+  EXPECT_TRUE(DetectOk(server.target, std::chrono::milliseconds(5000)));
+  ExpectCleanExitOnSigterm(server.pid);
 }
 
 TEST(ServerBinaryTest, ExitsZeroOnSigtermAfterServing) {

@@ -737,6 +737,26 @@ TEST_F(ServerTest, CapabilitiesReportWhatCoreImplements) {
   EXPECT_EQ(capabilities.default_detect_options().max_points(), 100u);
 }
 
+// Past the descriptor high-water mark (here any use at all) health turns
+// NOT_SERVING, so that a liveness probe notices a server that cannot
+// accept; the gauges show the count.
+TEST_F(ServerTest, HealthIsNotServingWhileDescriptorsRunOut) {
+  ServerConfig config = DefaultConfig();
+  config.fd_high_water = 1e-6;
+  config.fd_check_interval_s = 0.05;
+  StartServer(config, /*wait_serving=*/false);
+  EXPECT_TRUE(
+      WaitFor([this] { return server_->out_of_descriptors(); }, kCallTimeout));
+  EXPECT_TRUE(
+      WaitFor([this] { return server_->warmed_up(); }, testing::kStartTimeout));
+  EXPECT_EQ(HealthStatus(channel_, ""), "NOT_SERVING");
+  const std::string metrics = Scrape();
+  EXPECT_GT(MetricValue(metrics, "fovea_open_file_descriptors", {}).value_or(0),
+            3);
+  EXPECT_GT(MetricValue(metrics, "fovea_file_descriptor_limit", {}).value_or(0),
+            3);
+}
+
 TEST_F(ServerTest, HealthServingAfterWarmUpThenNotServingOnDrain) {
   StartServer();
   EXPECT_TRUE(server_->warmed_up());
