@@ -335,6 +335,9 @@ std::string MetricsText() {
       Metrics::Get().registry()->Collect());
 }
 
+// Handler threads of /metrics.
+constexpr int kMetricsThreads = 16;
+
 struct MetricsEndpoint::Impl {
   std::unique_ptr<prometheus::Exposer> exposer;
 };
@@ -348,7 +351,13 @@ absl::StatusOr<std::unique_ptr<MetricsEndpoint>> MetricsEndpoint::Start(
     const std::string& listen) {
   auto impl = std::make_unique<Impl>();
   try {
-    impl->exposer = std::make_unique<prometheus::Exposer>(listen);
+    // civetweb's options: enough handler threads that a few slow clients
+    // cannot take them all, and a request that has not arrived whole
+    // within 2 s is dropped (slowloris); a scrape takes milliseconds.
+    impl->exposer =
+        std::make_unique<prometheus::Exposer>(std::vector<std::string>{
+            "listening_ports", listen, "num_threads",
+            std::to_string(kMetricsThreads), "request_timeout_ms", "2000"});
   } catch (const std::exception& e) {
     return absl::UnavailableError(absl::StrCat(
         "--metrics_listen: cannot listen on '", listen, "': ", e.what()));

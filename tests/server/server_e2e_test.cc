@@ -1,6 +1,9 @@
 // End to end: an in-process FoveaServer on loopback, a real gRPC channel.
 
 #include <grpcpp/grpcpp.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
@@ -755,6 +758,34 @@ TEST_F(ServerTest, HealthIsNotServingWhileDescriptorsRunOut) {
             3);
   EXPECT_GT(MetricValue(metrics, "fovea_file_descriptor_limit", {}).value_or(0),
             3);
+}
+
+// Clients that open /metrics and never finish their request cannot block
+// the scrapes (two of them did, with two handler threads and no request
+// timeout).
+TEST_F(ServerTest, SlowMetricsClientsDoNotBlockScrapes) {
+  StartServer();
+  std::vector<int> slow;
+  for (int i = 0; i < 8; ++i) {
+    const int fd = socket(AF_INET, SOCK_STREAM, 0);
+    ASSERT_GE(fd, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_port = htons(static_cast<uint16_t>(server_->metrics_port()));
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ASSERT_EQ(
+        connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)), 0);
+    const char partial[] = "GET /metrics HTTP/1.1\r\nHost: x\r\n";
+    ASSERT_GT(send(fd, partial, sizeof(partial) - 1, 0), 0);
+    slow.push_back(fd);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_THAT(Scrape(), HasSubstr("fovea_build_info"));
+  EXPECT_LT(
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count(),
+      2.0);
+  for (const int fd : slow) close(fd);
 }
 
 TEST_F(ServerTest, HealthServingAfterWarmUpThenNotServingOnDrain) {
