@@ -13,7 +13,7 @@ absl::StatusOr<v1::DetectResponse> HandleDetect(
     double queue_seconds) {
   Clock::time_point start = Clock::now();
   absl::StatusOr<RgbdFrame> frame =
-      DecodeFrame(ToRawFrame(request.frame()), limits);
+      DecodeFrame(ToRawFrame(request.frame()), limits, interrupt);
   if (!frame.ok()) return frame.status();
   const double decode_seconds = SecondsSince(start);
   if (interrupt) {

@@ -30,7 +30,7 @@ absl::Status Stream(std::string_view method, const v1::Frame& wire_frame,
   RecordStage("queue", context.queue_seconds);
   const Clock::time_point decode_start = Clock::now();
   absl::StatusOr<RgbdFrame> frame =
-      DecodeFrame(ToRawFrame(wire_frame), context.limits);
+      DecodeFrame(ToRawFrame(wire_frame), context.limits, context.interrupt);
   if (!frame.ok()) return frame.status();
   RecordStage("decode", SecondsSince(decode_start));
   if (absl::Status status = CheckInterrupt(context.interrupt); !status.ok()) {

@@ -348,9 +348,11 @@ absl::StatusOr<Layout> Inspect(const RawImage& image, Slot slot,
 // checks the file's header against the layout's size before allocating.
 absl::StatusOr<cv::Mat> DecodeFile(std::string_view file, const Layout& layout,
                                    ImageDecodeMode mode,
-                                   absl::string_view field) {
+                                   absl::string_view field,
+                                   const InterruptCheck& interrupt) {
   ImageDecodeOptions options;
   options.mode = mode;
+  options.interrupt = interrupt;
   options.max_width = layout.width;
   options.max_height = layout.height;
   return DecodeImage(file, options, absl::StrCat(field, ".compressed"));
@@ -417,13 +419,14 @@ cv::Mat DepthFromRaw(const RawImage& image, const Layout& layout,
 }
 
 absl::StatusOr<cv::Mat> DecodeColor(const RawImage& image, const Layout& layout,
-                                    absl::string_view field) {
+                                    absl::string_view field,
+                                    const InterruptCheck& interrupt) {
   if (layout.format == Format::kRgb8 || layout.format == Format::kBgr8) {
     return ColorFromRaw(image, layout);
   }
   const absl::string_view kind = layout.format == Format::kPng ? "PNG" : "JPEG";
-  absl::StatusOr<cv::Mat> decoded =
-      DecodeFile(image.compressed, layout, ImageDecodeMode::kColor, field);
+  absl::StatusOr<cv::Mat> decoded = DecodeFile(
+      image.compressed, layout, ImageDecodeMode::kColor, field, interrupt);
   if (!decoded.ok()) return decoded.status();
   const cv::Mat& bgr = *decoded;
   if (bgr.type() != CV_8UC3 || bgr.cols != static_cast<int>(layout.width) ||
@@ -438,10 +441,11 @@ absl::StatusOr<cv::Mat> DecodeColor(const RawImage& image, const Layout& layout,
 }
 
 absl::StatusOr<cv::Mat> DecodeDepth(const RawImage& image, const Layout& layout,
-                                    double scale, absl::string_view field) {
+                                    double scale, absl::string_view field,
+                                    const InterruptCheck& interrupt) {
   if (layout.format != Format::kPng) return DepthFromRaw(image, layout, scale);
-  absl::StatusOr<cv::Mat> decoded =
-      DecodeFile(image.compressed, layout, ImageDecodeMode::kAnyDepth, field);
+  absl::StatusOr<cv::Mat> decoded = DecodeFile(
+      image.compressed, layout, ImageDecodeMode::kAnyDepth, field, interrupt);
   if (!decoded.ok()) return decoded.status();
   const cv::Mat& units = *decoded;
   if (units.type() != CV_16UC1 ||
@@ -470,8 +474,9 @@ bool HasValidDepth(const cv::Mat& depth) {
   return false;
 }
 
-absl::StatusOr<RgbdFrame> DecodeValidatedFrame(const RawFrame& raw,
-                                               const FrameLimits& limits) {
+absl::StatusOr<RgbdFrame> DecodeValidatedFrame(
+    const RawFrame& raw, const FrameLimits& limits,
+    const InterruptCheck& interrupt) {
   absl::Status status = Validate(limits);
   if (!status.ok()) return status;
   status = ValidateIntrinsics(raw.intrinsics, "frame.intrinsics");
@@ -502,7 +507,7 @@ absl::StatusOr<RgbdFrame> DecodeValidatedFrame(const RawFrame& raw,
   RgbdFrame frame;
   frame.intrinsics = raw.intrinsics;
   absl::StatusOr<cv::Mat> depth =
-      DecodeDepth(raw.depth, *depth_layout, scale, "frame.depth");
+      DecodeDepth(raw.depth, *depth_layout, scale, "frame.depth", interrupt);
   if (!depth.ok()) return depth.status();
   if (!HasValidDepth(*depth)) {
     return absl::InvalidArgumentError(
@@ -511,7 +516,7 @@ absl::StatusOr<RgbdFrame> DecodeValidatedFrame(const RawFrame& raw,
   }
   frame.depth = *std::move(depth);
   absl::StatusOr<cv::Mat> color =
-      DecodeColor(raw.color, *color_layout, "frame.color");
+      DecodeColor(raw.color, *color_layout, "frame.color", interrupt);
   if (!color.ok()) return color.status();
   frame.color = *std::move(color);
   return frame;
@@ -566,12 +571,13 @@ absl::Status ValidateIntrinsics(const Intrinsics& intrinsics,
 }
 
 absl::StatusOr<RgbdFrame> DecodeFrame(const RawFrame& raw,
-                                      const FrameLimits& limits) {
+                                      const FrameLimits& limits,
+                                      const InterruptCheck& interrupt) {
   // Sizes are bounded by `limits` before anything is allocated, so an
   // exception here is an allocation failure or an OpenCV bug; neither may
   // leave core/.
   try {
-    return DecodeValidatedFrame(raw, limits);
+    return DecodeValidatedFrame(raw, limits, interrupt);
   } catch (const std::bad_alloc&) {
     return absl::ResourceExhaustedError(
         "DecodeFrame: out of memory decoding the frame");

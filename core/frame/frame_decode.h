@@ -5,6 +5,7 @@
 #include <string_view>
 
 #include "absl/status/statusor.h"
+#include "core/base/interrupt.h"
 #include "core/frame/rgbd_frame.h"
 
 namespace fovea {
@@ -61,8 +62,11 @@ absl::Status Validate(const FrameLimits& limits);
 // negative values and values beyond kMaxDepthMetres all become NaN).
 // fx and fy must lie in [kMinFocalPixels, kMaxFocalPixels]; cx and cy may be
 // any finite value (a crop can put the principal point outside the image).
+// `interrupt` is checked while compressed images decode (ImageDecodeOptions)
+// and its error returned as is.
 absl::StatusOr<RgbdFrame> DecodeFrame(const RawFrame& raw,
-                                      const FrameLimits& limits);
+                                      const FrameLimits& limits,
+                                      const InterruptCheck& interrupt = {});
 
 // Checks intrinsics alone; `field` prefixes the message ("frame.intrinsics").
 absl::Status ValidateIntrinsics(const Intrinsics& intrinsics,

@@ -146,6 +146,11 @@ struct PngReadState {
   int bit_depth = 0;
   int color_type = 0;
   bool has_trns = false;
+  // Once the last row is being read, the file may be read up to here and
+  // no further: libpng inflates whatever compressed data follows the
+  // declared rows (checking for the end of the zlib stream), which a
+  // hostile file can make gigabytes. SIZE_MAX: no bound yet.
+  size_t read_limit = SIZE_MAX;
 };
 
 // Releases libpng's read structs on every path out of DecodePng.
@@ -162,6 +167,9 @@ void ReadPngBytes(png_structp png, png_bytep out, size_t length) {
   auto* state = static_cast<PngReadState*>(png_get_io_ptr(png));
   if (length > state->size - state->position) {
     png_error(png, "file truncated");
+  }
+  if (state->position + length > state->read_limit) {
+    png_error(png, "more compressed image data than the declared rows need");
   }
   std::memcpy(out, state->data + state->position, length);
   state->position += length;
@@ -185,6 +193,18 @@ bool PngReadHeader(PngReadState* state) {
   // The caller checks the size against its own limits, with a better
   // message than libpng's; libpng keeps only the spec's bound.
   png_set_user_limits(state->png, PNG_UINT_31_MAX, PNG_UINT_31_MAX);
+  // Only the pixels matter: ancillary chunks other than tRNS (text,
+  // compressed text, profiles, ...) are skipped unread, never inflated,
+  // whatever their number or size; and libpng's own bounds on what it
+  // would keep.
+  static constexpr png_byte kSkipped[] =
+      "bKGD\0cHRM\0eXIf\0gAMA\0hIST\0iCCP\0iTXt\0oFFs\0pCAL\0pHYs\0"
+      "sBIT\0sCAL\0sPLT\0sRGB\0tEXt\0tIME\0zTXt";
+  png_set_keep_unknown_chunks(state->png, PNG_HANDLE_CHUNK_NEVER, nullptr, 0);
+  png_set_keep_unknown_chunks(state->png, PNG_HANDLE_CHUNK_NEVER, kSkipped,
+                              static_cast<int>(sizeof(kSkipped) / 5));
+  png_set_chunk_cache_max(state->png, 32);
+  png_set_chunk_malloc_max(state->png, 1 << 20);
   png_set_read_fn(state->png, state, ReadPngBytes);
   png_read_info(state->png, state->info);
   png_get_IHDR(state->png, state->info, &state->width, &state->height,
@@ -232,11 +252,10 @@ PngPlan PlanPng(const PngReadState& header, ImageDecodeMode mode) {
   return plan;
 }
 
-// Applies `plan` and reads every row, then the chunks after the image data
-// (so a file cut after its last IDAT is refused too). setjmp frame: no C++
-// objects here.
-bool PngReadPixels(PngReadState* state, const PngPlan& plan, png_bytepp rows,
-                   size_t row_bytes) {
+// Applies `plan`; the passes libpng will make over the rows (7 for an
+// interlaced file, else 1). setjmp frame: no C++ objects here.
+bool PngStartPixels(PngReadState* state, const PngPlan& plan, size_t row_bytes,
+                    int* passes) {
   if (setjmp(state->error.jump)) return false;
   if (plan.palette_to_rgb) png_set_palette_to_rgb(state->png);
   if (plan.expand_grey) png_set_expand_gray_1_2_4_to_8(state->png);
@@ -246,7 +265,7 @@ bool PngReadPixels(PngReadState* state, const PngPlan& plan, png_bytepp rows,
   if (plan.grey_to_rgb) png_set_gray_to_rgb(state->png);
   if (plan.bgr) png_set_bgr(state->png);
   if (plan.swap) png_set_swap(state->png);
-  png_set_interlace_handling(state->png);
+  *passes = png_set_interlace_handling(state->png);
   png_read_update_info(state->png, state->info);
   if (png_get_channels(state->png, state->info) != plan.channels ||
       png_get_bit_depth(state->png, state->info) != plan.bit_depth ||
@@ -254,9 +273,43 @@ bool PngReadPixels(PngReadState* state, const PngPlan& plan, png_bytepp rows,
     SetMessage(&state->error, "unexpected layout after transformations");
     return false;
   }
-  png_read_image(state->png, rows);
-  png_read_end(state->png, nullptr);
   return true;
+}
+
+// Reads rows [begin, end) of the current pass. setjmp frame: no C++
+// objects here.
+bool PngReadRows(PngReadState* state, png_bytepp rows, png_uint_32 begin,
+                 png_uint_32 end) {
+  if (setjmp(state->error.jump)) return false;
+  for (png_uint_32 y = begin; y < end; ++y) {
+    png_read_row(state->png, rows[y], nullptr);
+  }
+  return true;
+}
+
+// Rows read between two interrupt checks.
+constexpr png_uint_32 kPngRowsPerCheck = 64;
+
+// The file's chunk structure, without inflating anything: every chunk lies
+// inside the file and IEND comes. libpng stops reading after the last row
+// of the declared image; this is what refuses a file cut short after it
+// (png_read_end would check that too, but inflates whatever compressed
+// data follows the declared rows first). Empty when sound.
+std::string CheckPngChunks(absl::string_view file) {
+  size_t at = kPngSignature.size();
+  while (at + 12 <= file.size()) {
+    const auto byte = [&](size_t i) {
+      return static_cast<uint32_t>(static_cast<unsigned char>(file[at + i]));
+    };
+    const uint32_t length =
+        byte(0) << 24 | byte(1) << 16 | byte(2) << 8 | byte(3);
+    if (length > 0x7fffffffu || length > file.size() - at - 12) {
+      return absl::StrCat("chunk at byte ", at, " runs past the end");
+    }
+    if (file.substr(at + 4, 4) == "IEND") return "";
+    at += 12 + size_t{length};
+  }
+  return "no IEND chunk (file truncated)";
 }
 
 absl::StatusOr<cv::Mat> DecodePng(absl::string_view file,
@@ -280,9 +333,41 @@ absl::StatusOr<cv::Mat> DecodePng(absl::string_view file,
       state.width, state.height, CV_MAKETYPE(depth, plan.channels));
   if (!buffer.ok()) return buffer.status();
   const size_t row_bytes = buffer->image.cols * buffer->image.elemSize();
-  if (!PngReadPixels(&state, plan, buffer->rows.data(), row_bytes)) {
+  if (const std::string bad = CheckPngChunks(file); !bad.empty()) {
+    return Undecodable("PNG", file.size(), "structure", bad.c_str(), field);
+  }
+  int passes = 1;
+  if (!PngStartPixels(&state, plan, row_bytes, &passes)) {
     return Undecodable("PNG", file.size(), "libpng", state.error.message,
                        field);
+  }
+  for (int pass = 0; pass < passes; ++pass) {
+    for (png_uint_32 y = 0; y < state.height; y += kPngRowsPerCheck) {
+      if (options.interrupt) {
+        if (absl::Status s = options.interrupt(); !s.ok()) return s;
+      }
+      png_uint_32 end = std::min(state.height, y + kPngRowsPerCheck);
+      const bool last = pass + 1 == passes && end == state.height;
+      if (last && end - y > 1) {
+        // All but the last row first, unbounded.
+        if (!PngReadRows(&state, buffer->rows.data(), y, end - 1)) {
+          return Undecodable("PNG", file.size(), "libpng", state.error.message,
+                             field);
+        }
+        y = end - 1;
+      }
+      if (last) {
+        // The last row's data (deflate grows incompressible data by a few
+        // bytes per 16 kB), the zlib trailer, chunk headers and CRCs, and
+        // one read of libpng's 8 kB buffer.
+        state.read_limit =
+            state.position + 2 * (row_bytes + 1) + (size_t{64} << 10);
+      }
+      if (!PngReadRows(&state, buffer->rows.data(), y, end)) {
+        return Undecodable("PNG", file.size(), "libpng", state.error.message,
+                           field);
+      }
+    }
   }
   const bool one_channel = options.mode == ImageDecodeMode::kGrey ||
                            options.mode == ImageDecodeMode::kAnyDepth;

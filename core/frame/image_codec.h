@@ -15,6 +15,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "core/base/interrupt.h"
 
 namespace fovea {
 
@@ -49,6 +50,10 @@ struct ImageDecodeOptions {
   // pixel buffer is allocated. In [1, kLargestDecodeSide].
   uint32_t max_width = 1920;
   uint32_t max_height = 1080;
+  // Checked every 64 rows of a PNG (whose decoding time a file can stretch
+  // far beyond its size); its error is returned as is. May be empty. A
+  // JPEG's work is bounded by its size and kMaxJpegScans.
+  InterruptCheck interrupt;
 };
 
 absl::Status Validate(const ImageDecodeOptions& options);

@@ -558,6 +558,70 @@ TEST(ImageCodecTest, RefusesAJpegHeaderBeyondTheLimit) {
               HasSubstr("width 60000 exceeds the limit of 640"));
 }
 
+// 300 zTXt chunks, each 1 MB of text when inflated (300 MB in all, 300 kB
+// of file), before the pixels: skipped unread (inflating them took 14 s
+// for 200 chunks of 7.8 MB), and the pixels come out as without them.
+TEST(ImageCodecTest, CompressedTextChunksAreSkippedAndThePixelsDecode) {
+  PngSpec spec;
+  spec.width = 16;
+  spec.height = 8;
+  const std::string plain = MakePng(spec, 7);
+  const size_t idat = plain.find("IDAT") - 4;
+  std::string text("comment\0\0", 9);
+  text += Deflate(std::string(1 << 20, 'a'));
+  std::string chunks;
+  for (int i = 0; i < 300; ++i) AppendChunk(chunks, "zTXt", text);
+  const std::string bomb = plain.substr(0, idat) + chunks + plain.substr(idat);
+  absl::StatusOr<cv::Mat> expected = Decode(plain, ImageDecodeMode::kGrey);
+  absl::StatusOr<cv::Mat> decoded = Decode(bomb, ImageDecodeMode::kGrey);
+  ASSERT_TRUE(expected.ok()) << expected.status();
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  EXPECT_EQ(cv::norm(*expected, *decoded, cv::NORM_INF), 0.0);
+}
+
+// A zlib stream holding far more rows than IHDR declares (the rest
+// inflates to gigabytes in the attack): refused once the declared rows are
+// read, before the rest is inflated.
+TEST(ImageCodecTest, CompressedRowsBeyondTheDeclaredHeightAreRefused) {
+  PngSpec spec;
+  spec.width = 8;
+  spec.height = 40000;  // random rows: 360 kB of deflate after the first 4
+  const std::string png = WithPngSize(MakePng(spec, 3), 8, 4);
+  absl::StatusOr<cv::Mat> decoded = Decode(png, ImageDecodeMode::kGrey);
+  EXPECT_EQ(decoded.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(decoded.status().message(),
+              HasSubstr("more compressed image data than the declared rows"));
+  // One row more than declared is within the slack.
+  spec.height = 5;
+  EXPECT_TRUE(
+      Decode(WithPngSize(MakePng(spec, 3), 8, 4), ImageDecodeMode::kGrey).ok());
+}
+
+// The decoder checks the interrupt every 64 rows and returns its error.
+TEST(ImageCodecTest, APngDecodeStopsAtTheInterrupt) {
+  PngSpec spec;
+  spec.width = 32;
+  spec.height = 300;
+  const std::string png = MakePng(spec, 5);
+  ImageDecodeOptions options;
+  options.mode = ImageDecodeMode::kGrey;
+  int checks = 0;
+  options.interrupt = [&checks] {
+    return ++checks < 3 ? absl::OkStatus()
+                        : absl::DeadlineExceededError("too late");
+  };
+  absl::StatusOr<cv::Mat> decoded = DecodeImage(png, options, kField);
+  EXPECT_EQ(decoded.status().code(), absl::StatusCode::kDeadlineExceeded);
+  EXPECT_EQ(checks, 3);
+  options.interrupt = [&checks] {
+    ++checks;
+    return absl::OkStatus();
+  };
+  checks = 0;
+  EXPECT_TRUE(DecodeImage(png, options, kField).ok());
+  EXPECT_EQ(checks, 5);  // rows 0, 64, 128, 192, 256
+}
+
 TEST(ImageCodecTest, RefusesGarbage) {
   ExpectInvalid(Decode("", ImageDecodeMode::kColor), "empty");
   ExpectInvalid(Decode(RandomBytes(3000, 7), ImageDecodeMode::kColor),
