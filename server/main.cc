@@ -61,6 +61,13 @@ ABSL_FLAG(uint32_t, max_height, fovea::FrameLimits{}.max_height,
 ABSL_FLAG(double, grace_period_s, 10.0,
           "On SIGTERM/SIGINT: seconds in-flight calls get to finish before "
           "they are cancelled.");
+ABSL_FLAG(bool, reflection, true,
+          "Serve gRPC server reflection (grpcurl and grpc_cli list and call "
+          "the services without the .proto files); false turns it off.");
+ABSL_FLAG(double, drain_delay_s, 1.0,
+          "On SIGTERM/SIGINT: seconds health says NOT_SERVING while calls "
+          "are still served (so load balancers move away first); then new "
+          "calls are refused and in-flight ones get --grace_period_s.");
 ABSL_FLAG(double, max_connection_age_s, 300.0,
           "Seconds after which a client connection is asked to reconnect "
           "(gRPC GOAWAY, +-10 % jitter), so clients re-resolve DNS and "
@@ -107,9 +114,10 @@ int main(int argc, char** argv) {
   // Before the command line, so that it wins.
   const absl::Status from_env = fovea::server::ApplyFlagsFromEnv(
       {"listen", "metrics_listen", "concurrency", "queue", "max_message_bytes",
-       "max_width", "max_height", "grace_period_s", "max_connection_age_s",
-       "max_connection_age_grace_s", "stream_stall_timeout_s",
-       "memory_quota_mb", "handshake_timeout_s", "models_dir", "log_level"},
+       "max_width", "max_height", "grace_period_s", "drain_delay_s",
+       "reflection", "max_connection_age_s", "max_connection_age_grace_s",
+       "stream_stall_timeout_s", "memory_quota_mb", "handshake_timeout_s",
+       "models_dir", "log_level"},
       [](const char* name) { return std::getenv(name); });
   if (!from_env.ok()) {
     LogError(from_env.ToString());
@@ -155,6 +163,8 @@ int main(int argc, char** argv) {
       absl::GetFlag(FLAGS_max_connection_age_grace_s);
   config.stream_stall_timeout_s = absl::GetFlag(FLAGS_stream_stall_timeout_s);
   config.handshake_timeout_s = absl::GetFlag(FLAGS_handshake_timeout_s);
+  config.drain_delay_s = absl::GetFlag(FLAGS_drain_delay_s);
+  config.reflection = absl::GetFlag(FLAGS_reflection);
   config.models_dir = absl::GetFlag(FLAGS_models_dir);
 
   absl::StatusOr<std::unique_ptr<fovea::server::FoveaServer>> server =

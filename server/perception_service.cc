@@ -38,10 +38,13 @@ constexpr size_t kMaxLoggedRequestId = 128;
 // handled at End*. Each call ends exactly once.
 class CallRecord {
  public:
-  CallRecord(std::string_view method, std::string_view request_id)
+  CallRecord(std::string_view method, std::string_view request_id,
+             ServiceState& state)
       : method_(method),
         request_id_(request_id.substr(0, kMaxLoggedRequestId)),
-        start_(Clock::now()) {
+        start_(Clock::now()),
+        state_(state) {
+    state_.calls.fetch_add(1);
     RecordCallStarted(method_);
     RecordMessageReceived(method_);
     IncrementInflight();
@@ -61,6 +64,7 @@ class CallRecord {
     const double seconds = SecondsSince(start_);
     RecordCallHandled(method_, status.code(), seconds);
     DecrementInflight();
+    state_.calls.fetch_sub(1);
     std::string line = absl::StrFormat(
         "call method=%s request_id=\"%s\" code=%s ms=%.1f", method_,
         absl::CEscape(request_id_), GrpcCodeName(status.code()), seconds * 1e3);
@@ -75,7 +79,16 @@ class CallRecord {
   const std::string_view method_;  // a string literal
   const std::string request_id_;
   const Clock::time_point start_;
+  ServiceState& state_;
 };
+
+// UNAVAILABLE once the server is shutting down (its drain delay is over).
+absl::Status CheckAccepting(const ServiceState& state) {
+  if (state.refusing.load()) {
+    return absl::UnavailableError("the server is shutting down; retry another");
+  }
+  return absl::OkStatus();
+}
 
 // DEADLINE_EXCEEDED once the client's deadline passed, CANCELLED once the
 // call was cancelled, else OK. Safe on any thread.
@@ -155,7 +168,11 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
         context_(context),
         request_(request),
         response_(response),
-        call_("Detect", request->request_id()) {
+        call_("Detect", request->request_id(), *config.state) {
+    if (absl::Status s = CheckAccepting(*config.state); !s.ok()) {
+      Complete(s);
+      return;
+    }
     absl::StatusOr<DetectOptions> options = ToDetectOptions(request->options());
     if (!options.ok()) {
       Complete(options.status());
@@ -285,8 +302,12 @@ class StreamReactor final
         config_(config),
         context_(context),
         request_(request),
-        call_(method, request->request_id()),
+        call_(method, request->request_id(), *config.state),
         start_(Clock::now()) {
+    if (absl::Status s = CheckAccepting(*config.state); !s.ok()) {
+      FinishOnce(s);
+      return;
+    }
     absl::StatusOr<Options> options = convert(*request);
     if (!options.ok()) {
       FinishOnce(options.status());
@@ -569,10 +590,11 @@ grpc::ServerUnaryReactor* PerceptionService::GetCapabilities(
     grpc::CallbackServerContext* context,
     const v1::GetCapabilitiesRequest* request, v1::Capabilities* response) {
   TsanHappensAfter(&config_);
-  CallRecord call("GetCapabilities", "");
-  *response = capabilities_;
+  CallRecord call("GetCapabilities", "", *config_.state);
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
-  reactor->Finish(call.EndUnary(absl::OkStatus()));
+  const absl::Status accepting = CheckAccepting(*config_.state);
+  if (accepting.ok()) *response = capabilities_;
+  reactor->Finish(call.EndUnary(accepting));
   return reactor;
 }
 

@@ -3,9 +3,11 @@
 
 #include <grpcpp/grpcpp.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <memory>
 
 #include "core/frame/frame_decode.h"
 #include "core/pipeline/segment.h"
@@ -14,7 +16,16 @@
 
 namespace fovea::server {
 
+// What the server and the calls share while the service runs.
+struct ServiceState {
+  std::atomic<int> calls{0};          // Perception calls not yet finished
+  std::atomic<bool> refusing{false};  // new calls get UNAVAILABLE
+};
+
 struct ServiceConfig {
+  // Shared with FoveaServer (Shutdown sets `refusing` and waits for
+  // `calls`); never null.
+  std::shared_ptr<ServiceState> state = std::make_shared<ServiceState>();
   FrameLimits limits;              // largest frame accepted
   uint64_t max_message_bytes = 0;  // reported by GetCapabilities
   // A stream whose client has not taken a message for this long, while the

@@ -2,11 +2,14 @@
 
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/health_check_service_interface.h>
+#include <grpcpp/impl/server_builder_option.h>
+#include <grpcpp/impl/server_builder_plugin.h>
 #include <grpcpp/resource_quota.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -60,6 +63,22 @@ v1::DetectRequest WarmUpRequest() {
       ToProtoFrame(scene.frame.frame, DepthEncoding::k32FC1);
   return request;
 }
+
+// Removes the reflection plugin from a builder: linking gRPC's reflection
+// library registers it for every server of the process.
+class WithoutReflection final : public grpc::ServerBuilderOption {
+ public:
+  void UpdateArguments(grpc::ChannelArguments*) override {}
+  void UpdatePlugins(std::vector<std::unique_ptr<grpc::ServerBuilderPlugin>>*
+                         plugins) override {
+    plugins->erase(
+        std::remove_if(plugins->begin(), plugins->end(),
+                       [](const std::unique_ptr<grpc::ServerBuilderPlugin>& p) {
+                         return p->name() == "proto_server_reflection";
+                       }),
+        plugins->end());
+  }
+};
 
 // Every stage a Detect response can time: the server's own and core's.
 std::vector<std::string> DetectStages() {
@@ -122,6 +141,10 @@ absl::Status Validate(const ServerConfig& config) {
         absl::StrCat("--handshake_timeout_s: ", config.handshake_timeout_s,
                      " is not in (0, 120]"));
   }
+  if (!(config.drain_delay_s >= 0.0) || config.drain_delay_s > 3600.0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--drain_delay_s: ", config.drain_delay_s, " is not in [0, 3600]"));
+  }
   if (!(config.fd_high_water > 0.0) || config.fd_high_water > 1.0 ||
       !(config.fd_check_interval_s > 0.0)) {
     return absl::InvalidArgumentError(
@@ -161,6 +184,8 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
   }
   server->work_ = std::make_unique<WorkQueue>(config.concurrency, config.queue);
   ServiceConfig service;
+  server->service_state_ = service.state;
+  server->drain_delay_s_ = config.drain_delay_s;
   service.limits = config.limits;
   service.max_message_bytes = static_cast<uint64_t>(config.max_message_bytes);
   service.stream_stall_timeout = std::chrono::milliseconds(
@@ -179,6 +204,8 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
   // Refuse a port another process already serves (Linux would otherwise
   // share it silently with SO_REUSEPORT).
   builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
+  if (!config.reflection)
+    builder.SetOption(std::make_unique<WithoutReflection>());
   builder.SetMaxReceiveMessageSize(config.max_message_bytes);
   builder.AddChannelArgument(
       GRPC_ARG_SERVER_HANDSHAKE_TIMEOUT_MS,
@@ -342,10 +369,26 @@ void FoveaServer::Shutdown(absl::Duration grace) {
   }
   Drain();
   if (server_ != nullptr) {
-    LogInfo(absl::StrCat("shutting down: in-flight calls have ",
-                         absl::FormatDuration(grace)));
+    if (drain_delay_s_ > 0.0) {
+      LogInfo(
+          absl::StrFormat("serving %.1f s more while health says "
+                          "NOT_SERVING",
+                          drain_delay_s_));
+      absl::SleepFor(absl::Seconds(drain_delay_s_));
+    }
+    LogInfo(
+        absl::StrCat("shutting down: new calls refused, in-flight calls "
+                     "have ",
+                     absl::FormatDuration(grace)));
     const Clock::time_point start = Clock::now();
-    server_->Shutdown(absl::ToChronoTime(absl::Now() + grace));
+    service_state_->refusing.store(true);
+    const absl::Time deadline = absl::Now() + grace;
+    while (service_state_->calls.load() > 0 && absl::Now() < deadline) {
+      absl::SleepFor(absl::Milliseconds(5));
+    }
+    // What is left: health Watch streams (which never end on their own),
+    // calls past the grace.
+    server_->Shutdown(absl::ToChronoTime(absl::Now()));
     LogInfo(absl::StrFormat("gRPC server stopped after %.1f ms",
                             SecondsSince(start) * 1e3));
   }

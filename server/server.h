@@ -42,6 +42,8 @@ struct ServerConfig {
   int64_t memory_quota_bytes = kDefaultMemoryQuotaBytes;
   FrameLimits limits;   // largest frame
   bool warm_up = true;  // run one Detect before reporting SERVING
+  // gRPC server reflection (grpcurl, grpc_cli list the services).
+  bool reflection = true;
   // Seconds after which the server asks a client connection to go away
   // (GOAWAY; gRPC adds +-10 % jitter), so that clients re-resolve DNS and
   // spread over replicas added since they connected; calls in flight get
@@ -59,6 +61,9 @@ struct ServerConfig {
   // Health turns NOT_SERVING while the process holds more than this share
   // of its descriptor limit (the listener could not accept), and SERVING
   // again below 0.9 of it. Checked every fd_check_interval_s. (0, 1].
+  // On Shutdown, seconds health says NOT_SERVING while calls are still
+  // served, so load balancers move traffic away before calls are refused.
+  double drain_delay_s = 0.0;
   double fd_high_water = 0.95;
   double fd_check_interval_s = 1.0;
   // New connections are closed at once while fewer than this many
@@ -123,10 +128,12 @@ class FoveaServer {
   // balancers can move traffic away first. Idempotent.
   void Drain();
 
-  // Drain, stop accepting calls, let in-flight calls (queued ones too)
-  // finish for up to `grace`, then cancel what is left (their jobs see
-  // CANCELLED at their next stage boundary) and wait for them; stop the
-  // workers and the metrics endpoint. Idempotent; blocks until done.
+  // Drain; keep serving for drain_delay_s; then refuse new calls
+  // (UNAVAILABLE), let in-flight calls (queued ones too) finish for up to
+  // `grace`, and stop the gRPC server at once: what is left (health Watch
+  // streams, calls past the grace) is cancelled (their jobs see CANCELLED
+  // at their next stage boundary) and waited for; stop the workers and the
+  // metrics endpoint. Idempotent; blocks until done.
   void Shutdown(absl::Duration grace);
 
   // Detect jobs accepted and waiting for a worker.
@@ -146,6 +153,8 @@ class FoveaServer {
   int port_ = 0;
   std::unique_ptr<LoadedModels> models_;  // the service points into it
   std::unique_ptr<WorkQueue> work_;
+  std::shared_ptr<ServiceState> service_state_;
+  double drain_delay_s_ = 0.0;
   std::unique_ptr<PerceptionService> service_;
   std::unique_ptr<MetricsEndpoint> metrics_;
   std::unique_ptr<grpc::Server> server_;  // after service_: destroyed first

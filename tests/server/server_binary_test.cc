@@ -1,6 +1,7 @@
 // The fovea-server executable: --help, bad flags, and a clean exit on
 // SIGTERM, idle or with calls in flight.
 
+#include <grpcpp/generic/generic_stub.h>
 #include <grpcpp/grpcpp.h>
 #include <netinet/in.h>
 #include <signal.h>
@@ -301,6 +302,46 @@ TEST(ServerBinaryTest, FloodOfSilentConnectionsLeavesTheListenerAlive) {
   for (const int fd : flood) close(fd);
   EXPECT_TRUE(DetectOk(server.target, std::chrono::milliseconds(5000)));
   ExpectCleanExitOnSigterm(server.pid);
+}
+
+// The reflection service's one method, called with an empty request
+// stream: its status.
+grpc::StatusCode ReflectionCallStatus(const std::string& target) {
+  grpc::GenericStub stub(
+      grpc::CreateChannel(target, grpc::InsecureChannelCredentials()));
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() +
+                       std::chrono::seconds(10));
+  grpc::CompletionQueue queue;
+  std::unique_ptr<grpc::GenericClientAsyncReaderWriter> call =
+      stub.PrepareCall(&context,
+                       "/grpc.reflection.v1alpha.ServerReflection/"
+                       "ServerReflectionInfo",
+                       &queue);
+  void* tag = nullptr;
+  bool ok = false;
+  call->StartCall(reinterpret_cast<void*>(1));
+  queue.Next(&tag, &ok);
+  call->WritesDone(reinterpret_cast<void*>(2));
+  queue.Next(&tag, &ok);
+  grpc::Status status;
+  call->Finish(&status, reinterpret_cast<void*>(3));
+  queue.Next(&tag, &ok);
+  queue.Shutdown();
+  while (queue.Next(&tag, &ok)) {
+  }
+  return status.error_code();
+}
+
+TEST(ServerBinaryTest, ReflectionIsOnUnlessTurnedOff) {
+  for (const bool on : {true, false}) {
+    const ServerProcess server = StartServing(
+        {"--concurrency=1", on ? "--reflection=true" : "--reflection=false"});
+    ASSERT_GT(server.pid, 0);
+    EXPECT_EQ(ReflectionCallStatus(server.target),
+              on ? grpc::StatusCode::OK : grpc::StatusCode::UNIMPLEMENTED);
+    ExpectCleanExitOnSigterm(server.pid);
+  }
 }
 
 TEST(ServerBinaryTest, ExitsZeroOnSigtermAfterServing) {

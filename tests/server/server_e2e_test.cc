@@ -19,6 +19,7 @@
 #include "core/synth/synth_scene.h"
 #include "fovea/v1/perception.grpc.pb.h"
 #include "gmock/gmock.h"
+#include "grpc/health/v1/health.grpc.pb.h"
 #include "gtest/gtest.h"
 #include "server/capabilities.h"
 #include "server/convert.h"
@@ -933,6 +934,46 @@ TEST_F(ServerTest, ShutdownLetsInFlightCallFinish) {
   gate_.Open();
   EXPECT_TRUE(in_flight.get().ok());
   shutdown.join();
+}
+
+// On Shutdown: health NOT_SERVING at once while calls are still served
+// for the drain delay, then new calls are refused; an open health Watch
+// (as round-robin clients keep) does not hold the shutdown for the grace
+// period: it ends as soon as the calls in flight have.
+TEST_F(ServerTest, ShutdownDrainsThenRefusesAndEndsWatchStreams) {
+  ServerConfig config = DefaultConfig();
+  config.drain_delay_s = 1.0;
+  StartServer(config);
+  auto health = grpc::health::v1::Health::NewStub(channel_);
+  grpc::ClientContext watch_context;
+  watch_context.set_deadline(std::chrono::system_clock::now() + kCallTimeout);
+  grpc::health::v1::HealthCheckRequest watch_request;
+  auto watch = health->Watch(&watch_context, watch_request);
+  grpc::health::v1::HealthCheckResponse update;
+  ASSERT_TRUE(watch->Read(&update));
+  EXPECT_EQ(update.status(), grpc::health::v1::HealthCheckResponse::SERVING);
+
+  const auto start = std::chrono::steady_clock::now();
+  std::thread shutdown([this] { server_->Shutdown(absl::Seconds(30)); });
+  ASSERT_TRUE(watch->Read(&update));
+  EXPECT_EQ(update.status(),
+            grpc::health::v1::HealthCheckResponse::NOT_SERVING);
+  // Still served during the drain delay.
+  v1::DetectResponse response;
+  EXPECT_TRUE(Detect(MakeSyntheticRequest(1, false).request, &response).ok());
+  EXPECT_LT(
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count(),
+      1.0);
+  while (watch->Read(&update)) {
+  }
+  watch->Finish();
+  shutdown.join();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
+  EXPECT_GE(seconds, 1.0);
+  EXPECT_LT(seconds, 10.0);  // not the 30 s grace
 }
 
 TEST_F(ServerTest, ShutdownCancelsCallsPastTheGracePeriod) {
