@@ -187,9 +187,10 @@ absl::StatusOr<std::vector<WeightedChannel>> ToChannels(
     absl::StatusOr<SaliencyOp> op = FromProto(in.op(), field + ".op");
     if (!op.ok()) return op.status();
     const double weight = in.weight();
-    if (!std::isfinite(weight) || weight < 0.0) {
+    if (!std::isfinite(weight) || weight < 0.0 || weight > 1e6) {
       return absl::InvalidArgumentError(absl::StrCat(
-          field, ".weight: ", weight, " is not a finite value >= 0"));
+          field, ".weight: ", weight,
+          " is not in [0, 1e6] (weights are relative; 0 means 1)"));
     }
     channels.push_back(
         {*op, weight == 0.0 ? 1.0f : static_cast<float>(weight)});

@@ -173,6 +173,11 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
       Complete(s);
       return;
     }
+    if (!request->has_frame()) {
+      Complete(absl::InvalidArgumentError(
+          "frame: missing (colour, depth and intrinsics are required)"));
+      return;
+    }
     absl::StatusOr<DetectOptions> options = ToDetectOptions(request->options());
     if (!options.ok()) {
       Complete(options.status());
@@ -306,6 +311,11 @@ class StreamReactor final
         start_(Clock::now()) {
     if (absl::Status s = CheckAccepting(*config.state); !s.ok()) {
       FinishOnce(s);
+      return;
+    }
+    if (!request->has_frame()) {
+      FinishOnce(absl::InvalidArgumentError(
+          "frame: missing (colour, depth and intrinsics are required)"));
       return;
     }
     absl::StatusOr<Options> options = convert(*request);

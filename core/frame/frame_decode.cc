@@ -504,6 +504,29 @@ absl::StatusOr<RgbdFrame> DecodeValidatedFrame(
                      color_layout->width, " x ", color_layout->height));
   }
 
+  // A crop can put the principal point outside the image, but the image's
+  // centre cannot lie more than 10 focal lengths from it (84 degrees off
+  // the optical axis): that is a unit error or garbage.
+  const struct {
+    absl::string_view name;
+    double value;
+    uint32_t size;
+    double focal;
+  } kCentre[] = {
+      {"cx", raw.intrinsics.cx, color_layout->width, raw.intrinsics.fx},
+      {"cy", raw.intrinsics.cy, color_layout->height, raw.intrinsics.fy}};
+  for (const auto& c : kCentre) {
+    const double lo = 0.5 * c.size - 10.0 * c.focal;
+    const double hi = 0.5 * c.size + 10.0 * c.focal;
+    if (c.value < lo || c.value > hi) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "frame.intrinsics.", c.name, ": ", c.value,
+          " puts the image more than 10 focal lengths off the optical axis; "
+          "expected [",
+          lo, ", ", hi, "] pixels"));
+    }
+  }
+
   RgbdFrame frame;
   frame.intrinsics = raw.intrinsics;
   absl::StatusOr<cv::Mat> depth =

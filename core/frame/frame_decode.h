@@ -60,8 +60,9 @@ absl::Status Validate(const FrameLimits& limits);
 // limits, no valid depth pixel, undecodable PNG/JPEG.
 // On success the depth is in metres with NaN for no data (0, NaN,
 // negative values and values beyond kMaxDepthMetres all become NaN).
-// fx and fy must lie in [kMinFocalPixels, kMaxFocalPixels]; cx and cy may be
-// any finite value (a crop can put the principal point outside the image).
+// fx and fy must lie in [kMinFocalPixels, kMaxFocalPixels]; cx and cy may
+// lie outside the image (a crop can put the principal point there) but
+// within 10 focal lengths of the image's centre.
 // `interrupt` is checked while compressed images decode (ImageDecodeOptions)
 // and its error returned as is.
 absl::StatusOr<RgbdFrame> DecodeFrame(const RawFrame& raw,

@@ -318,5 +318,32 @@ TEST_F(HostileRequestTest, MemoryQuotaRefusesWhatDoesNotFit) {
   ExpectStillServing();
 }
 
+// Rough edges a hostile client found, each a clear INVALID_ARGUMENT naming
+// the field: a request without a frame (was a focal-length error), a
+// weight beyond float range (was reported as "inf"), a principal point
+// thousands of images away.
+TEST_F(HostileRequestTest, MissingFrameHugeWeightAndFarPrincipalPointAreNamed) {
+  StartServer();
+  v1::DetectResponse response;
+  v1::DetectRequest no_frame;
+  grpc::Status status = Detect(no_frame, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("frame: missing"));
+
+  v1::DetectRequest heavy = ShRequest();
+  heavy.mutable_options()->mutable_saliency(0)->set_weight(1e39);
+  status = Detect(heavy, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("options.saliency[0].weight"));
+  EXPECT_THAT(status.error_message(), ::testing::Not(HasSubstr("inf")));
+
+  v1::DetectRequest far = ShRequest();
+  far.mutable_frame()->mutable_intrinsics()->set_cx(1e7);
+  status = Detect(far, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("frame.intrinsics.cx"));
+  ExpectStillServing();
+}
+
 }  // namespace
 }  // namespace fovea::server
