@@ -123,8 +123,17 @@ absl::StatusOr<std::shared_ptr<grpc::Channel>> CreateChannel(
   // Our service config, whatever a DNS TXT record might say.
   arguments.SetInt(GRPC_ARG_SERVICE_CONFIG_DISABLE_RESOLUTION, 1);
   arguments.SetServiceConfigJSON(ServiceConfigJson(options, balanced));
-  std::shared_ptr<grpc::Channel> channel = grpc::CreateCustomChannel(
-      *target, grpc::InsecureChannelCredentials(), arguments);
+  std::shared_ptr<grpc::ChannelCredentials> credentials =
+      grpc::InsecureChannelCredentials();
+  if (!options.tls_root_certs.empty()) {
+    grpc::SslCredentialsOptions ssl;
+    ssl.pem_root_certs = options.tls_root_certs;
+    ssl.pem_cert_chain = options.tls_cert_chain;
+    ssl.pem_private_key = options.tls_private_key;
+    credentials = grpc::SslCredentials(ssl);
+  }
+  std::shared_ptr<grpc::Channel> channel =
+      grpc::CreateCustomChannel(*target, credentials, arguments);
   if (channel == nullptr) {
     return absl::InvalidArgumentError(
         absl::StrCat("server: cannot create a channel to \"", *target, "\""));
@@ -138,6 +147,14 @@ absl::Status Validate(const ClientOptions& options) {
   if (options.max_message_bytes <= 0) {
     return absl::InvalidArgumentError(absl::StrCat(
         "max_message_bytes: must be > 0, got ", options.max_message_bytes));
+  }
+  if (options.tls_cert_chain.empty() != options.tls_private_key.empty()) {
+    return absl::InvalidArgumentError(
+        "tls_cert_chain, tls_private_key: give both or neither");
+  }
+  if (!options.tls_cert_chain.empty() && options.tls_root_certs.empty()) {
+    return absl::InvalidArgumentError(
+        "tls_root_certs: needed with a client certificate (TLS)");
   }
   if (options.max_attempts < 1 || options.max_attempts > kMostAttempts) {
     return absl::InvalidArgumentError(absl::StrCat("max_attempts: must be 1..",

@@ -42,6 +42,13 @@ struct ClientOptions {
   // commits the call once a reply arrives), so a caller never sees a
   // message twice.
   int max_attempts = 4;
+  // TLS (PEM file contents, not paths): with `tls_root_certs` the channel
+  // uses TLS and trusts these CAs; with `tls_cert_chain` and
+  // `tls_private_key` too, it presents that client certificate (mutual
+  // TLS). All empty: plaintext.
+  std::string tls_root_certs;
+  std::string tls_cert_chain;
+  std::string tls_private_key;
 };
 
 // INVALID_ARGUMENT naming the first bad field of `options`.

@@ -16,10 +16,13 @@
 
 #include <cstdint>
 #include <cstdlib>
+#include <fstream>
 #include <iostream>
+#include <iterator>
 #include <memory>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "absl/flags/flag.h"
@@ -46,6 +49,11 @@ ABSL_FLAG(std::string, server, "127.0.0.1:50051",
           "UNAVAILABLE");
 ABSL_FLAG(int64_t, deadline_ms, 30000,
           "deadline of the call, milliseconds from its start");
+ABSL_FLAG(std::string, tls_ca, "",
+          "PEM CA certificates to trust: connect with TLS (empty: plaintext)");
+ABSL_FLAG(std::string, tls_cert, "",
+          "PEM client certificate chain for mutual TLS (with --tls_key)");
+ABSL_FLAG(std::string, tls_key, "", "PEM private key of --tls_cert");
 ABSL_FLAG(bool, wait_for_ready, false,
           "wait (within the deadline) for the server to come up instead of "
           "failing with UNAVAILABLE at once");
@@ -190,9 +198,31 @@ absl::Duration Deadline() {
   return absl::Milliseconds(absl::GetFlag(FLAGS_deadline_ms));
 }
 
+// The whole file at `path` ("" for an empty path); `flag` names it.
+absl::StatusOr<std::string> ReadFileFlag(const std::string& path,
+                                         const char* flag) {
+  if (path.empty()) return std::string();
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--", flag, ": cannot read '", path, "'"));
+  }
+  return std::string((std::istreambuf_iterator<char>(in)),
+                     std::istreambuf_iterator<char>());
+}
+
 absl::StatusOr<std::unique_ptr<FoveaClient>> MakeClient() {
   ClientOptions options;
   options.wait_for_ready = absl::GetFlag(FLAGS_wait_for_ready);
+  for (const auto& [flag, value, out] :
+       {std::tuple<const char*, std::string, std::string*>{
+            "tls_ca", absl::GetFlag(FLAGS_tls_ca), &options.tls_root_certs},
+        {"tls_cert", absl::GetFlag(FLAGS_tls_cert), &options.tls_cert_chain},
+        {"tls_key", absl::GetFlag(FLAGS_tls_key), &options.tls_private_key}}) {
+    absl::StatusOr<std::string> text = ReadFileFlag(value, flag);
+    if (!text.ok()) return text.status();
+    *out = *std::move(text);
+  }
   return FoveaClient::Connect(absl::GetFlag(FLAGS_server), options);
 }
 

@@ -61,6 +61,13 @@ ABSL_FLAG(uint32_t, max_height, fovea::FrameLimits{}.max_height,
 ABSL_FLAG(double, grace_period_s, 10.0,
           "On SIGTERM/SIGINT: seconds in-flight calls get to finish before "
           "they are cancelled.");
+ABSL_FLAG(std::string, tls_cert, "",
+          "PEM certificate chain of the gRPC port; with --tls_key the port "
+          "speaks TLS only. Empty: plaintext (fine on loopback).");
+ABSL_FLAG(std::string, tls_key, "", "PEM private key of --tls_cert.");
+ABSL_FLAG(std::string, tls_client_ca, "",
+          "PEM CA certificates: when given, every client must present a "
+          "certificate they signed (mutual TLS).");
 ABSL_FLAG(bool, reflection, true,
           "Serve gRPC server reflection (grpcurl and grpc_cli list and call "
           "the services without the .proto files); false turns it off.");
@@ -113,11 +120,26 @@ int main(int argc, char** argv) {
   using fovea::server::LogInfo;
   // Before the command line, so that it wins.
   const absl::Status from_env = fovea::server::ApplyFlagsFromEnv(
-      {"listen", "metrics_listen", "concurrency", "queue", "max_message_bytes",
-       "max_width", "max_height", "grace_period_s", "drain_delay_s",
-       "reflection", "max_connection_age_s", "max_connection_age_grace_s",
-       "stream_stall_timeout_s", "memory_quota_mb", "handshake_timeout_s",
-       "models_dir", "log_level"},
+      {"listen",
+       "metrics_listen",
+       "concurrency",
+       "queue",
+       "max_message_bytes",
+       "max_width",
+       "max_height",
+       "grace_period_s",
+       "drain_delay_s",
+       "reflection",
+       "max_connection_age_s",
+       "max_connection_age_grace_s",
+       "stream_stall_timeout_s",
+       "memory_quota_mb",
+       "handshake_timeout_s",
+       "tls_cert",
+       "tls_key",
+       "tls_client_ca",
+       "models_dir",
+       "log_level"},
       [](const char* name) { return std::getenv(name); });
   if (!from_env.ok()) {
     LogError(from_env.ToString());
@@ -165,6 +187,9 @@ int main(int argc, char** argv) {
   config.handshake_timeout_s = absl::GetFlag(FLAGS_handshake_timeout_s);
   config.drain_delay_s = absl::GetFlag(FLAGS_drain_delay_s);
   config.reflection = absl::GetFlag(FLAGS_reflection);
+  config.tls_cert = absl::GetFlag(FLAGS_tls_cert);
+  config.tls_key = absl::GetFlag(FLAGS_tls_key);
+  config.tls_client_ca = absl::GetFlag(FLAGS_tls_client_ca);
   config.models_dir = absl::GetFlag(FLAGS_models_dir);
 
   absl::StatusOr<std::unique_ptr<fovea::server::FoveaServer>> server =

@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <optional>
 #include <utility>
@@ -79,6 +81,54 @@ class WithoutReflection final : public grpc::ServerBuilderOption {
         plugins->end());
   }
 };
+
+// The whole file at `path`; `flag` names it in the error.
+absl::StatusOr<std::string> ReadPem(const std::string& path, const char* flag) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(flag, ": cannot read '", path, "'"));
+  }
+  std::string text((std::istreambuf_iterator<char>(in)),
+                   std::istreambuf_iterator<char>());
+  if (text.find("-----BEGIN ") == std::string::npos) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(flag, ": '", path, "' is not a PEM file"));
+  }
+  return text;
+}
+
+// Plaintext, TLS or mutual TLS (ServerConfig::tls_*).
+absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> ServerCredentials(
+    const ServerConfig& config) {
+  if (config.tls_cert.empty() && config.tls_key.empty()) {
+    if (!config.tls_client_ca.empty()) {
+      return absl::InvalidArgumentError(
+          "--tls_client_ca: needs --tls_cert and --tls_key");
+    }
+    return grpc::InsecureServerCredentials();
+  }
+  if (config.tls_cert.empty() || config.tls_key.empty()) {
+    return absl::InvalidArgumentError(
+        "--tls_cert, --tls_key: give both or neither");
+  }
+  absl::StatusOr<std::string> cert = ReadPem(config.tls_cert, "--tls_cert");
+  if (!cert.ok()) return cert.status();
+  absl::StatusOr<std::string> key = ReadPem(config.tls_key, "--tls_key");
+  if (!key.ok()) return key.status();
+  grpc::SslServerCredentialsOptions ssl(
+      config.tls_client_ca.empty()
+          ? GRPC_SSL_DONT_REQUEST_CLIENT_CERTIFICATE
+          : GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY);
+  ssl.pem_key_cert_pairs.push_back({*key, *cert});
+  if (!config.tls_client_ca.empty()) {
+    absl::StatusOr<std::string> ca =
+        ReadPem(config.tls_client_ca, "--tls_client_ca");
+    if (!ca.ok()) return ca.status();
+    ssl.pem_root_certs = *ca;
+  }
+  return grpc::SslServerCredentials(ssl);
+}
 
 // Every stage a Detect response can time: the server's own and core's.
 std::vector<std::string> DetectStages() {
@@ -222,8 +272,10 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
         static_cast<int>(
             std::lround(config.max_connection_age_grace_s * 1000.0)));
   }
-  builder.AddListeningPort(config.listen, grpc::InsecureServerCredentials(),
-                           &server->port_);
+  absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> credentials =
+      ServerCredentials(config);
+  if (!credentials.ok()) return credentials.status();
+  builder.AddListeningPort(config.listen, *credentials, &server->port_);
   builder.RegisterService(server->service_.get());
   server->server_ = builder.BuildAndStart();
   if (server->server_ == nullptr || server->port_ == 0) {
@@ -234,10 +286,13 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
   server->SetServing(false);
 
   LogInfo(absl::StrFormat(
-      "fovea-server %s listening on %s (port %d), metrics %s, concurrency "
+      "fovea-server %s listening on %s (port %d, %s), metrics %s, concurrency "
       "%d, queue %d, max message %d bytes, memory quota %d MiB, max frame "
       "%dx%d",
       ServerVersion(), config.listen, server->port_,
+      config.tls_cert.empty()        ? "plaintext"
+      : config.tls_client_ca.empty() ? "TLS"
+                                     : "mutual TLS",
       config.metrics_listen.empty()
           ? std::string("off")
           : absl::StrCat("on port ", server->metrics_port(), " /metrics"),

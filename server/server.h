@@ -44,6 +44,12 @@ struct ServerConfig {
   bool warm_up = true;  // run one Detect before reporting SERVING
   // gRPC server reflection (grpcurl, grpc_cli list the services).
   bool reflection = true;
+  // TLS: PEM files (paths). With a certificate and key the gRPC port
+  // speaks TLS only; with a client CA too, every client must present a
+  // certificate that CA signed (mutual TLS). Empty: plaintext.
+  std::string tls_cert;
+  std::string tls_key;
+  std::string tls_client_ca;
   // Seconds after which the server asks a client connection to go away
   // (GOAWAY; gRPC adds +-10 % jitter), so that clients re-resolve DNS and
   // spread over replicas added since they connected; calls in flight get

@@ -75,6 +75,16 @@ TEST(ClientOptionsTest, ValidateNamesTheField) {
   EXPECT_THAT(Validate(options).message(), HasSubstr("max_message_bytes"));
 }
 
+TEST(ClientOptionsTest, TlsNeedsACaForAClientCertificateAndBothHalves) {
+  ClientOptions options;
+  options.tls_cert_chain = "-----BEGIN CERTIFICATE-----";
+  EXPECT_THAT(Validate(options).message(), HasSubstr("tls_private_key"));
+  options.tls_private_key = "-----BEGIN PRIVATE KEY-----";
+  EXPECT_THAT(Validate(options).message(), HasSubstr("tls_root_certs"));
+  options.tls_root_certs = "-----BEGIN CERTIFICATE-----";
+  EXPECT_TRUE(Validate(options).ok());
+}
+
 TEST(CreateBalancedChannelTest, RefusesWhatChannelTargetRefuses) {
   EXPECT_EQ(CreateBalancedChannel("127.0.0.1:1,", {}).status().code(),
             absl::StatusCode::kInvalidArgument);

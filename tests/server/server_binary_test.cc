@@ -12,9 +12,11 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <future>
+#include <iterator>
 #include <memory>
 #include <optional>
 #include <string>
@@ -342,6 +344,92 @@ TEST(ServerBinaryTest, ReflectionIsOnUnlessTurnedOff) {
               on ? grpc::StatusCode::OK : grpc::StatusCode::UNIMPLEMENTED);
     ExpectCleanExitOnSigterm(server.pid);
   }
+}
+
+// A CA, a server certificate for 127.0.0.1 and a client certificate, made
+// with openssl in a fresh folder; empty when openssl is missing or fails.
+std::string MakeCertificates() {
+  char pattern[] = "/tmp/fovea_tls_XXXXXX";
+  const char* dir = mkdtemp(pattern);
+  if (dir == nullptr) return "";
+  const std::string d = dir;
+  // Written to a file: the shell std::system runs would expand $who.
+  {
+    std::ofstream script(d + "/make.sh");
+    script << "set -e\ncd '" << d << "'\n"
+           << "openssl req -x509 -newkey rsa:2048 -nodes -keyout ca.key "
+              "-out ca.pem -days 1 -subj /CN=fovea-test-ca\n"
+           << "for who in server client; do\n"
+              "  openssl req -newkey rsa:2048 -nodes -keyout $who.key "
+              "-out $who.csr -subj /CN=$who\n"
+              "  printf 'subjectAltName=IP:127.0.0.1,DNS:localhost\\n' "
+              "> $who.ext\n"
+              "  openssl x509 -req -in $who.csr -CA ca.pem -CAkey ca.key "
+              "-CAcreateserial -out $who.pem -days 1 -extfile $who.ext\n"
+              "done\n";
+  }
+  const std::string command = "bash '" + d + "/make.sh' >/dev/null 2>&1";
+  return std::system(command.c_str()) == 0 ? d : "";
+}
+
+std::string ReadAll(const std::string& path) {
+  std::ifstream in(path);
+  return std::string((std::istreambuf_iterator<char>(in)),
+                     std::istreambuf_iterator<char>());
+}
+
+grpc::StatusCode DetectWith(const std::string& target,
+                            std::shared_ptr<grpc::ChannelCredentials> creds) {
+  grpc::ChannelArguments args;
+  args.SetMaxSendMessageSize(64 << 20);
+  auto stub =
+      v1::Perception::NewStub(grpc::CreateCustomChannel(target, creds, args));
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() +
+                       std::chrono::seconds(10));
+  v1::DetectResponse response;
+  return stub
+      ->Detect(&context, MakeSyntheticRequest(1, false).request, &response)
+      .error_code();
+}
+
+// With a certificate, a key and a client CA the port speaks mutual TLS
+// only: a client with a certificate the CA signed is served; one without a
+// certificate, or in plaintext, is not.
+TEST(ServerBinaryTest, MutualTlsServesOnlyClientsWithACertificate) {
+  const std::string dir = MakeCertificates();
+  if (dir.empty()) GTEST_SKIP() << "openssl could not make certificates";
+  const int port = FreePort();
+  const std::string target = "127.0.0.1:" + std::to_string(port);
+  const pid_t pid = Spawn(
+      {"--listen=" + target, "--metrics_listen=", "--concurrency=1",
+       "--tls_cert=" + dir + "/server.pem", "--tls_key=" + dir + "/server.key",
+       "--tls_client_ca=" + dir + "/ca.pem"});
+  ASSERT_GT(pid, 0);
+  grpc::SslCredentialsOptions with_cert;
+  with_cert.pem_root_certs = ReadAll(dir + "/ca.pem");
+  with_cert.pem_cert_chain = ReadAll(dir + "/client.pem");
+  with_cert.pem_private_key = ReadAll(dir + "/client.key");
+  grpc::SslCredentialsOptions without_cert;
+  without_cert.pem_root_certs = with_cert.pem_root_certs;
+  EXPECT_TRUE(WaitFor(
+      [&] {
+        return DetectWith(target, grpc::SslCredentials(with_cert)) ==
+               grpc::StatusCode::OK;
+      },
+      std::chrono::seconds(60)));
+  EXPECT_NE(DetectWith(target, grpc::SslCredentials(without_cert)),
+            grpc::StatusCode::OK);
+  EXPECT_NE(DetectWith(target, grpc::InsecureChannelCredentials()),
+            grpc::StatusCode::OK);
+  ExpectCleanExitOnSigterm(pid);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ServerBinaryTest, BadTlsFlagsStopStartUpNamingThem) {
+  const auto [output, status] = RunToCompletion("--tls_cert=/nonexistent.pem");
+  EXPECT_NE(status, 0);
+  EXPECT_THAT(output, HasSubstr("--tls_cert"));
 }
 
 TEST(ServerBinaryTest, ExitsZeroOnSigtermAfterServing) {

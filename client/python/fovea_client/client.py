@@ -47,17 +47,33 @@ class FoveaClient:
     deadline). With `channel`, every call goes through it as it is.
     """
 
-    def __init__(self, target, channel=None, max_attempts=4):
+    def __init__(self, target, channel=None, max_attempts=4, tls_ca=None,
+                 tls_cert=None, tls_key=None):
+        """tls_ca: PEM bytes of the CAs to trust; given, the channel uses
+        TLS. tls_cert, tls_key: PEM bytes of a client certificate and its
+        key, for a server that requires one (mutual TLS)."""
         if channel is not None:
             self._channel = self._health_channel = channel
         else:
             target = channel_target(target)
-            self._channel = grpc.insecure_channel(
-                target, options=channel_options(_MAX_MESSAGE_BYTES,
-                                                max_attempts))
-            self._health_channel = grpc.insecure_channel(
-                target, options=channel_options(_MAX_MESSAGE_BYTES,
-                                                balanced=False))
+            if (tls_cert is None) != (tls_key is None):
+                raise ValueError("tls_cert, tls_key: give both or neither")
+            if tls_cert is not None and tls_ca is None:
+                raise ValueError("tls_ca: needed with a client certificate")
+
+            def make(options):
+                if tls_ca is None:
+                    return grpc.insecure_channel(target, options=options)
+                credentials = grpc.ssl_channel_credentials(
+                    root_certificates=tls_ca, private_key=tls_key,
+                    certificate_chain=tls_cert)
+                return grpc.secure_channel(target, credentials,
+                                           options=options)
+
+            self._channel = make(channel_options(_MAX_MESSAGE_BYTES,
+                                                 max_attempts))
+            self._health_channel = make(channel_options(_MAX_MESSAGE_BYTES,
+                                                        balanced=False))
         self._stub = perception_pb2_grpc.PerceptionStub(self._channel)
         self._health = self._health_channel.unary_unary(
             _HEALTH_CHECK,
