@@ -90,6 +90,18 @@ absl::Status CheckAccepting(const ServiceState& state) {
   return absl::OkStatus();
 }
 
+// What every frame-carrying call checks first: the server still accepts
+// calls, and the request has a frame.
+template <typename Request>
+absl::Status AdmitFrameCall(const ServiceState& state, const Request& request) {
+  if (absl::Status s = CheckAccepting(state); !s.ok()) return s;
+  if (!request.has_frame()) {
+    return absl::InvalidArgumentError(
+        "frame: missing (colour, depth and intrinsics are required)");
+  }
+  return absl::OkStatus();
+}
+
 // DEADLINE_EXCEEDED once the client's deadline passed, CANCELLED once the
 // call was cancelled, else OK. Safe on any thread.
 absl::Status CheckInterrupt(const grpc::CallbackServerContext& context) {
@@ -169,13 +181,8 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
         request_(request),
         response_(response),
         call_("Detect", request->request_id(), *config.state) {
-    if (absl::Status s = CheckAccepting(*config.state); !s.ok()) {
+    if (absl::Status s = AdmitFrameCall(*config.state, *request); !s.ok()) {
       Complete(s);
-      return;
-    }
-    if (!request->has_frame()) {
-      Complete(absl::InvalidArgumentError(
-          "frame: missing (colour, depth and intrinsics are required)"));
       return;
     }
     absl::StatusOr<DetectOptions> options = ToDetectOptions(request->options());
@@ -310,13 +317,8 @@ class StreamReactor final
         request_(request),
         call_(method, request->request_id(), *config.state),
         start_(Clock::now()) {
-    if (absl::Status s = CheckAccepting(*config.state); !s.ok()) {
+    if (absl::Status s = AdmitFrameCall(*config.state, *request); !s.ok()) {
       FinishOnce(s);
-      return;
-    }
-    if (!request->has_frame()) {
-      FinishOnce(absl::InvalidArgumentError(
-          "frame: missing (colour, depth and intrinsics are required)"));
       return;
     }
     absl::StatusOr<Options> options = convert(*request);

@@ -45,6 +45,13 @@ Scene Prepare(synth::SynthScene synth) {
   return s;
 }
 
+// The relations of the scene's surfaces, against its support's normal.
+RelationComputer Relations(const Scene& scene, const CosScene& surfaces) {
+  return RelationComputer(scene.prepared.cloud, surfaces.patches.labels,
+                          static_cast<int>(surfaces.patches.patches.size()),
+                          scene.prepared.plane.normal, RelationOptions{});
+}
+
 double Iou(const cv::Mat& mask, const cv::Mat& truth) {
   const double both = cv::countNonZero(mask & truth);
   return both / std::max(1, cv::countNonZero(mask | truth));
@@ -55,10 +62,7 @@ TEST(RelationsTest, FacesOfOneBoxRelateMoreThanFacesOfTwo) {
   absl::StatusOr<CosScene> surfaces =
       BuildCosScene(scene.prepared.cloud, scene.prepared.plane, CosOptions{});
   ASSERT_TRUE(surfaces.ok());
-  const int n = static_cast<int>(surfaces->patches.patches.size());
-  const RelationComputer relations(
-      scene.prepared.cloud, surfaces->patches.labels, n,
-      scene.prepared.plane.normal, RelationOptions{});
+  const RelationComputer relations = Relations(scene, *surfaces);
   const std::vector<int> object =
       PatchObjectIds(*surfaces, scene.synth.frame.labels);
   double same_color = 0, other_color = 0;
@@ -105,10 +109,7 @@ TEST(RelationsTest, AStackedBoxFoldsInwardsWhereItsFacesFoldOutwards) {
   absl::StatusOr<CosScene> surfaces =
       BuildCosScene(scene.prepared.cloud, scene.prepared.plane, CosOptions{});
   ASSERT_TRUE(surfaces.ok());
-  const int n = static_cast<int>(surfaces->patches.patches.size());
-  const RelationComputer relations(
-      scene.prepared.cloud, surfaces->patches.labels, n,
-      scene.prepared.plane.normal, RelationOptions{});
+  const RelationComputer relations = Relations(scene, *surfaces);
   const std::vector<int> object =
       PatchObjectIds(*surfaces, scene.synth.frame.labels);
   const std::vector<std::string>& names = RelationFeatureNames();
