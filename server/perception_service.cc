@@ -26,6 +26,7 @@
 #include "server/handle_segment.h"
 #include "server/log.h"
 #include "server/metrics.h"
+#include "server/request_parse.h"
 #include "server/status_util.h"
 
 namespace fovea::server {
@@ -91,10 +92,14 @@ absl::Status CheckAccepting(const ServiceState& state) {
 }
 
 // What every frame-carrying call checks first: the server still accepts
-// calls, and the request has a frame.
+// calls, its body parsed (`parsed`, from ParseRequest), and the request
+// has a frame.
 template <typename Request>
-absl::Status AdmitFrameCall(const ServiceState& state, const Request& request) {
+absl::Status AdmitFrameCall(const ServiceState& state,
+                            const absl::Status& parsed,
+                            const Request& request) {
   if (absl::Status s = CheckAccepting(state); !s.ok()) return s;
+  if (!parsed.ok()) return parsed;
   if (!request.has_frame()) {
     return absl::InvalidArgumentError(
         "frame: missing (colour, depth and intrinsics are required)");
@@ -175,17 +180,20 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
  public:
   DetectReactor(const ServiceConfig& config, WorkQueue& work,
                 grpc::CallbackServerContext* context,
-                const v1::DetectRequest* request, v1::DetectResponse* response)
+                std::unique_ptr<const v1::DetectRequest> request,
+                const absl::Status& parsed, v1::DetectResponse* response)
       : config_(config),
         context_(context),
-        request_(request),
+        request_(std::move(request)),
         response_(response),
-        call_("Detect", request->request_id(), *config.state) {
-    if (absl::Status s = AdmitFrameCall(*config.state, *request); !s.ok()) {
+        call_("Detect", request_->request_id(), *config.state) {
+    if (absl::Status s = AdmitFrameCall(*config.state, parsed, *request_);
+        !s.ok()) {
       Complete(s);
       return;
     }
-    absl::StatusOr<DetectOptions> options = ToDetectOptions(request->options());
+    absl::StatusOr<DetectOptions> options =
+        ToDetectOptions(request_->options());
     if (!options.ok()) {
       Complete(options.status());
       return;
@@ -279,8 +287,8 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
   const ServiceConfig& config_;  // the service's; outlives every call
   // gRPC's, valid until OnDone.
   grpc::CallbackServerContext* const context_;
-  const v1::DetectRequest* const request_;
-  v1::DetectResponse* const response_;
+  const std::unique_ptr<const v1::DetectRequest> request_;
+  v1::DetectResponse* const response_;  // gRPC's, valid until OnDone
   CallRecord call_;
   DetectOptions options_;
   Clock::time_point submitted_;
@@ -309,19 +317,22 @@ class StreamReactor final
 
   StreamReactor(std::string_view method, Convert convert, Handle handle,
                 const ServiceConfig& config, WorkQueue& work,
-                grpc::CallbackServerContext* context, const Request* request)
+                grpc::CallbackServerContext* context,
+                std::unique_ptr<const Request> request,
+                const absl::Status& parsed)
       : method_(method),
         handle_(handle),
         config_(config),
         context_(context),
-        request_(request),
-        call_(method, request->request_id(), *config.state),
+        request_(std::move(request)),
+        call_(method, request_->request_id(), *config.state),
         start_(Clock::now()) {
-    if (absl::Status s = AdmitFrameCall(*config.state, *request); !s.ok()) {
+    if (absl::Status s = AdmitFrameCall(*config.state, parsed, *request_);
+        !s.ok()) {
       FinishOnce(s);
       return;
     }
-    absl::StatusOr<Options> options = convert(*request);
+    absl::StatusOr<Options> options = convert(*request_);
     if (!options.ok()) {
       FinishOnce(options.status());
       return;
@@ -538,7 +549,7 @@ class StreamReactor final
   const Handle handle_;
   const ServiceConfig& config_;
   grpc::CallbackServerContext* const context_;  // gRPC's, valid until OnDone
-  const Request* const request_;                // gRPC's, valid until OnDone
+  const std::unique_ptr<const Request> request_;
   CallRecord call_;
   const Clock::time_point start_;
   Options options_;
@@ -557,6 +568,18 @@ class StreamReactor final
   const std::shared_ptr<JobGate> gate_ = std::make_shared<JobGate>();
 };
 
+// The request as parsed from its body, and how the parse went; the body's
+// slices are released once parsed. gRPC allocated the body (non-const) and
+// destroys it only when the call is done, so it may be cleared here.
+template <typename Request>
+std::pair<std::unique_ptr<const Request>, absl::Status> Parse(
+    const grpc::ByteBuffer* body) {
+  auto request = std::make_unique<Request>();
+  absl::Status parsed = ParseRequest(*body, request.get());
+  const_cast<grpc::ByteBuffer*>(body)->Clear();
+  return {std::move(request), std::move(parsed)};
+}
+
 }  // namespace
 
 PerceptionService::PerceptionService(ServiceConfig config, WorkQueue* work)
@@ -564,6 +587,39 @@ PerceptionService::PerceptionService(ServiceConfig config, WorkQueue* work)
       work_(work),
       capabilities_(BuildCapabilities(config_.limits, config_.max_message_bytes,
                                       config_.model_versions)) {
+  // Each method takes its request's bytes (see ParseRequest) and answers
+  // typed messages: the handlers the generated CallbackService registered
+  // are replaced, in the service's method order, with handlers of the
+  // same kind (grpc::internal's, which generated code uses too) whose
+  // request type is grpc::ByteBuffer, which gRPC never fails to
+  // deserialise.
+  MarkMethodCallback(
+      0,
+      new grpc::internal::CallbackUnaryHandler<grpc::ByteBuffer,
+                                               v1::DetectResponse>(
+          [this](grpc::CallbackServerContext* context,
+                 const grpc::ByteBuffer* body, v1::DetectResponse* response) {
+            return OnDetect(context, body, response);
+          }));
+  MarkMethodCallback(1, new grpc::internal::CallbackServerStreamingHandler<
+                            grpc::ByteBuffer, v1::SegmentResponse>(
+                            [this](grpc::CallbackServerContext* context,
+                                   const grpc::ByteBuffer* body) {
+                              return OnSegment(context, body);
+                            }));
+  MarkMethodCallback(2, new grpc::internal::CallbackServerStreamingHandler<
+                            grpc::ByteBuffer, v1::SegmentResponse>(
+                            [this](grpc::CallbackServerContext* context,
+                                   const grpc::ByteBuffer* body) {
+                              return OnSegmentIncremental(context, body);
+                            }));
+  MarkMethodCallback(
+      3, new grpc::internal::CallbackUnaryHandler<grpc::ByteBuffer,
+                                                  v1::Capabilities>(
+             [this](grpc::CallbackServerContext* context,
+                    const grpc::ByteBuffer* body, v1::Capabilities* response) {
+               return OnGetCapabilities(context, body, response);
+             }));
   // gRPC's threads call the methods below; what was built here (and the
   // work queue before it) happens before, through libgrpc (see
   // DetectReactor::OnDone).
@@ -574,40 +630,44 @@ PerceptionService::~PerceptionService() {
   TsanHappensAfter(&config_);  // after every call's OnDone
 }
 
-grpc::ServerUnaryReactor* PerceptionService::Detect(
-    grpc::CallbackServerContext* context, const v1::DetectRequest* request,
+grpc::ServerUnaryReactor* PerceptionService::OnDetect(
+    grpc::CallbackServerContext* context, const grpc::ByteBuffer* body,
     v1::DetectResponse* response) {
   TsanHappensAfter(&config_);
-  return new DetectReactor(config_, *work_, context, request, response);
+  auto [request, parsed] = Parse<v1::DetectRequest>(body);
+  return new DetectReactor(config_, *work_, context, std::move(request), parsed,
+                           response);
 }
 
-grpc::ServerWriteReactor<v1::SegmentResponse>* PerceptionService::Segment(
-    grpc::CallbackServerContext* context, const v1::SegmentRequest* request) {
+grpc::ServerWriteReactor<v1::SegmentResponse>* PerceptionService::OnSegment(
+    grpc::CallbackServerContext* context, const grpc::ByteBuffer* body) {
   TsanHappensAfter(&config_);
+  auto [request, parsed] = Parse<v1::SegmentRequest>(body);
   return new StreamReactor<v1::SegmentRequest, SegmentOptions>(
       "Segment", &ToSegmentOptions, &HandleSegment, config_, *work_, context,
-      request);
+      std::move(request), parsed);
 }
 
 grpc::ServerWriteReactor<v1::SegmentResponse>*
-PerceptionService::SegmentIncremental(
-    grpc::CallbackServerContext* context,
-    const v1::SegmentIncrementalRequest* request) {
+PerceptionService::OnSegmentIncremental(grpc::CallbackServerContext* context,
+                                        const grpc::ByteBuffer* body) {
   TsanHappensAfter(&config_);
+  auto [request, parsed] = Parse<v1::SegmentIncrementalRequest>(body);
   return new StreamReactor<v1::SegmentIncrementalRequest, IncrementalOptions>(
       "SegmentIncremental", &ToIncrementalOptions, &HandleSegmentIncremental,
-      config_, *work_, context, request);
+      config_, *work_, context, std::move(request), parsed);
 }
 
-grpc::ServerUnaryReactor* PerceptionService::GetCapabilities(
-    grpc::CallbackServerContext* context,
-    const v1::GetCapabilitiesRequest* request, v1::Capabilities* response) {
+grpc::ServerUnaryReactor* PerceptionService::OnGetCapabilities(
+    grpc::CallbackServerContext* context, const grpc::ByteBuffer* body,
+    v1::Capabilities* response) {
   TsanHappensAfter(&config_);
   CallRecord call("GetCapabilities", "", *config_.state);
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
-  const absl::Status accepting = CheckAccepting(*config_.state);
-  if (accepting.ok()) *response = capabilities_;
-  reactor->Finish(call.EndUnary(accepting));
+  absl::Status status = CheckAccepting(*config_.state);
+  if (status.ok()) status = Parse<v1::GetCapabilitiesRequest>(body).second;
+  if (status.ok()) *response = capabilities_;
+  reactor->Finish(call.EndUnary(status));
   return reactor;
 }
 

@@ -81,6 +81,10 @@ struct ServiceConfig {
 // SegmentIncremental: the same streaming, with INC's objects in order of
 // saliency; also stops on the request's time budget.
 // GetCapabilities: BuildCapabilities, computed once.
+// Every method parses its request's body itself: a body that is not a
+// valid request (truncated, a proto3 string that is not UTF-8, ...) is
+// INVALID_ARGUMENT saying what and where, counted and logged like any
+// call.
 class PerceptionService final : public v1::Perception::CallbackService {
  public:
   // `work` is not owned; it must outlive every call the service starts
@@ -88,21 +92,19 @@ class PerceptionService final : public v1::Perception::CallbackService {
   PerceptionService(ServiceConfig config, WorkQueue* work);
   ~PerceptionService() override;
 
-  grpc::ServerUnaryReactor* Detect(grpc::CallbackServerContext* context,
-                                   const v1::DetectRequest* request,
-                                   v1::DetectResponse* response) override;
-  grpc::ServerWriteReactor<v1::SegmentResponse>* Segment(
-      grpc::CallbackServerContext* context,
-      const v1::SegmentRequest* request) override;
-  grpc::ServerWriteReactor<v1::SegmentResponse>* SegmentIncremental(
-      grpc::CallbackServerContext* context,
-      const v1::SegmentIncrementalRequest* request) override;
-  grpc::ServerUnaryReactor* GetCapabilities(
-      grpc::CallbackServerContext* context,
-      const v1::GetCapabilitiesRequest* request,
-      v1::Capabilities* response) override;
-
  private:
+  // The handlers; each parses its request from `body` (see ParseRequest).
+  grpc::ServerUnaryReactor* OnDetect(grpc::CallbackServerContext* context,
+                                     const grpc::ByteBuffer* body,
+                                     v1::DetectResponse* response);
+  grpc::ServerWriteReactor<v1::SegmentResponse>* OnSegment(
+      grpc::CallbackServerContext* context, const grpc::ByteBuffer* body);
+  grpc::ServerWriteReactor<v1::SegmentResponse>* OnSegmentIncremental(
+      grpc::CallbackServerContext* context, const grpc::ByteBuffer* body);
+  grpc::ServerUnaryReactor* OnGetCapabilities(
+      grpc::CallbackServerContext* context, const grpc::ByteBuffer* body,
+      v1::Capabilities* response);
+
   const ServiceConfig config_;
   WorkQueue* const work_;  // not owned
   const v1::Capabilities capabilities_;

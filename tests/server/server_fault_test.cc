@@ -659,50 +659,64 @@ RawCallResult CallWithBytes(const std::shared_ptr<grpc::Channel>& channel,
   return result;
 }
 
-// Bytes that no protobuf parser accepts, each as the whole request.
+// Bytes that no protobuf parser accepts, each as the whole request, and
+// what the answer must say.
 struct Malformed {
   const char* name;
   std::string bytes;
+  const char* says;
 };
 
 std::vector<Malformed> MalformedRequests() {
   return {
       // Field 1, varint, whose bytes all say "more follows".
-      {"truncated varint", std::string("\x08\xff\xff\xff", 4)},
+      {"truncated varint", std::string("\x08\xff\xff\xff", 4),
+       "field request_id (1) has a truncated varint"},
       // Field 1 with wire type 7, which does not exist.
-      {"wire type 7", std::string("\x0f\x01\x02\x03", 4)},
+      {"wire type 7", std::string("\x0f\x01\x02\x03", 4), "has wire type 7"},
       // Field 2 (the frame), length-delimited, claiming 2^31 bytes.
-      {"2 GiB length", std::string("\x12\x80\x80\x80\x80\x08\x0a\x00", 8)},
+      {"2 GiB length", std::string("\x12\x80\x80\x80\x80\x08\x0a\x00", 8),
+       "(2) declares 2147483648 bytes but 2 follow"},
       // Field 2 (the frame) cut short: 5 bytes claimed, 2 given.
-      {"short sub-message", std::string("\x12\x05\x0a\x00", 4)},
+      {"short sub-message", std::string("\x12\x05\x0a\x00", 4),
+       "(2) declares 5 bytes but 2 follow"},
       // request_id (a proto3 string) that is not UTF-8.
-      {"bad UTF-8", std::string("\x0a\x02\xc3\x28", 4)},
+      {"bad UTF-8", std::string("\x0a\x02\xc3\x28", 4), "is not valid UTF-8"},
   };
 }
 
-// gRPC refuses such a request before any handler of the server runs (so
-// the server neither counts nor logs it). gRPC 1.51's callback API answers
-// UNIMPLEMENTED with an empty message ("if deserialization or reactor
-// creator failed, we need to fail the call"), misleading but harmless;
-// other versions may say INTERNAL or INVALID_ARGUMENT.
-TEST_F(FaultTest, MalformedProtobufIsRefusedAndServerGoesOn) {
+// Each method parses its request's body itself: a malformed one is
+// INVALID_ARGUMENT saying what is wrong, counted like any call, and the
+// server goes on. (gRPC's own deserialisation answered UNIMPLEMENTED with
+// no message, before any of the server's code ran.)
+TEST_F(FaultTest,
+       MalformedProtobufIsInvalidArgumentSayingWhereAndServerGoesOn) {
   Start();
   for (Method method :
        {Method::kDetect, Method::kSegment, Method::kSegmentIncremental}) {
     const std::string path = "/fovea.v1.Perception/" + MethodName(method);
+    const std::vector<std::string> labels = {
+        "grpc_method=\"" + MethodName(method) + "\"",
+        "grpc_code=\"InvalidArgument\""};
+    const double before =
+        MetricValue(Scrape(), "grpc_server_handled_total", labels).value_or(0);
     for (const Malformed& malformed : MalformedRequests()) {
       const RawCallResult result =
           CallWithBytes(channel_, path, malformed.bytes);
-      EXPECT_THAT(result.status.error_code(),
-                  AnyOf(Eq(grpc::StatusCode::UNIMPLEMENTED),
-                        Eq(grpc::StatusCode::INTERNAL),
-                        Eq(grpc::StatusCode::INVALID_ARGUMENT)))
+      EXPECT_EQ(result.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT)
           << path << ", " << malformed.name << ": "
           << result.status.error_message();
+      EXPECT_THAT(result.status.error_message(),
+                  AllOf(HasSubstr("request body is not a valid fovea.v1."),
+                        HasSubstr(malformed.says)))
+          << path << ", " << malformed.name;
       EXPECT_EQ(result.messages, 0) << path << ", " << malformed.name;
-      RecordProperty(MethodName(method) + " " + malformed.name,
-                     result.status.error_code());
     }
+    EXPECT_EQ(
+        MetricValue(Scrape(), "grpc_server_handled_total", labels).value_or(0) -
+            before,
+        static_cast<double>(MalformedRequests().size()))
+        << path;
     // The same path with a good request's bytes works.
     std::string good;
     ASSERT_TRUE(method == Method::kDetect
@@ -715,6 +729,15 @@ TEST_F(FaultTest, MalformedProtobufIsRefusedAndServerGoesOn) {
         << path << ": " << result.status.error_message();
     EXPECT_GE(result.messages, 1) << path;
   }
+  // A string deep in the request names its whole path.
+  v1::DetectRequest request = SmallRequests().detect;
+  request.mutable_frame()->set_frame_id("\xc3\x28");
+  std::string bytes = request.SerializePartialAsString();
+  const RawCallResult deep =
+      CallWithBytes(channel_, "/fovea.v1.Perception/Detect", bytes);
+  EXPECT_EQ(deep.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(deep.status.error_message(),
+              HasSubstr("field frame (2).frame_id ("));
   EXPECT_EQ(MetricValue(Scrape(), "fovea_inflight_requests", {}), 0);
 }
 
