@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <vector>
@@ -59,6 +61,94 @@ int HalfWindow(const NormalOptions& options, float focal_px, float z) {
   return std::clamp(r, options.min_half_window, options.max_half_window);
 }
 
+// Gaps of at most this many pixels are bridged (BackProject).
+constexpr int kMaxBridgedGap = 2;
+// Steepest surface a gap is bridged on, as the tangent of the angle
+// between its normal and the viewing ray: a surface at that angle changes
+// depth by z * tan / f per pixel, so 5 (79 degrees) bridges surfaces seen
+// at a grazing angle and leaves a depth step at an object's edge
+// unbridged: at 1 m on a Kinect, a step of 2 cm across a one-pixel gap.
+constexpr float kMaxBridgedTangent = 5.0f;
+// Gaps are bridged only when they would add at least this share of the
+// frame's points: a sensor's regular dropouts (every other or every 4th
+// column or row) add a third or more, while the thin gaps of ordinary
+// frames (at edges, on dark objects) add well under 1 %: 0.03 % on
+// Kinect frames, 0.04-0.24 % on RealSense office frames, at most 3 % on
+// synthetic piles with dark objects. Those frames stay exactly as sent.
+constexpr double kMinBridgedShare = 0.10;
+// The share is estimated on every kShareSampling-th row and column.
+constexpr int kShareSampling = 4;
+
+// Walks the runs of at most kMaxBridgedGap pixels without depth along one
+// line (`count` pixels `step` apart in memory, from `line`) whose two ends
+// lie on one surface; bridges them when `bridge`, else only counts them.
+// Returns the number of pixels bridged (or that would be). `focal` is the
+// focal length along the line, pixels.
+int WalkThinGaps(cv::Vec3f* line, int count, int step, float focal,
+                 bool bridge) {
+  const float slope = kMaxBridgedTangent / focal;
+  int bridged = 0;
+  int last_valid = -1;
+  for (int i = 0; i < count; ++i) {
+    const cv::Vec3f& p = line[i * step];
+    if (std::isnan(p[2])) continue;
+    const int gap = i - last_valid - 1;
+    if (last_valid >= 0 && gap >= 1 && gap <= kMaxBridgedGap) {
+      const cv::Vec3f& a = line[last_valid * step];
+      const float z = std::min(a[2], p[2]);
+      if (std::abs(a[2] - p[2]) <= slope * z * static_cast<float>(gap + 1)) {
+        bridged += gap;
+        // Each pixel's ray (x/z, y/z) is linear along the line, and so is
+        // 1/z on a plane: the bridge is the plane through the two ends.
+        const cv::Vec3f ray_a = a * (1.0f / a[2]);
+        const cv::Vec3f ray_p = p * (1.0f / p[2]);
+        for (int k = 1; bridge && k <= gap; ++k) {
+          const float t = static_cast<float>(k) / static_cast<float>(gap + 1);
+          const float inverse_z = (1.0f - t) / a[2] + t / p[2];
+          line[(last_valid + k) * step] =
+              (ray_a + t * (ray_p - ray_a)) * (1.0f / inverse_z);
+        }
+      }
+    }
+    last_valid = i;
+  }
+  return bridged;
+}
+
+// Bridges thin gaps along every row, then along every column (a pixel
+// missing in both directions takes its column's ends, which the row pass
+// may have made), when they are a regular pattern (kMinBridgedShare).
+void BridgeThinGaps(const Intrinsics& intrinsics, cv::Mat& xyz) {
+  CV_Assert(xyz.isContinuous());
+  cv::Vec3f* data = xyz.ptr<cv::Vec3f>(0);
+  const int w = xyz.cols, h = xyz.rows;
+  const auto fx = static_cast<float>(intrinsics.fx);
+  const auto fy = static_cast<float>(intrinsics.fy);
+  int64_t sampled_points = 0;
+  int64_t sampled_gaps = 0;
+  for (int v = 0; v < h; v += kShareSampling) {
+    const cv::Vec3f* row = data + static_cast<ptrdiff_t>(v) * w;
+    for (int u = 0; u < w; ++u) sampled_points += !std::isnan(row[u][2]);
+    sampled_gaps += WalkThinGaps(data + static_cast<ptrdiff_t>(v) * w, w, 1, fx,
+                                 /*bridge=*/false);
+  }
+  for (int u = 0; u < w; u += kShareSampling) {
+    for (int v = 0; v < h; ++v) {
+      sampled_points += !std::isnan(data[static_cast<ptrdiff_t>(v) * w + u][2]);
+    }
+    sampled_gaps += WalkThinGaps(data + u, h, w, fy, /*bridge=*/false);
+  }
+  if (static_cast<double>(sampled_gaps) <
+      kMinBridgedShare *
+          static_cast<double>(std::max<int64_t>(1, sampled_points))) {
+    return;
+  }
+  for (int v = 0; v < h; ++v) {
+    WalkThinGaps(data + static_cast<ptrdiff_t>(v) * w, w, 1, fx, true);
+  }
+  for (int u = 0; u < w; ++u) WalkThinGaps(data + u, h, w, fy, true);
+}
+
 }  // namespace
 
 absl::Status Validate(const NormalOptions& options) {
@@ -111,6 +201,7 @@ OrganizedCloud BackProject(const RgbdFrame& frame) {
       }
     }
   }
+  BridgeThinGaps(frame.intrinsics, cloud.xyz);
   return cloud;
 }
 

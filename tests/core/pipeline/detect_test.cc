@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include "core/synth/room.h"
@@ -25,6 +26,47 @@ TEST(DetectTest, FirstPointLiesOnAnObjectInSyntheticScenes) {
     EXPECT_FALSE(std::isnan(p.point.z()));
   }
   EXPECT_GE(on_object, kScenes - 1);
+}
+
+// A driver that drops every other column, every other row or every 4th
+// column of depth: the table is still found and the first point still
+// lies on an object, in every scene where it does with all the depth.
+TEST(DetectTest, RegularDepthDropoutsStillFindTheObjects) {
+  struct Pattern {
+    const char* name;
+    int column_period;  // 0: no missing columns
+    int row_period;
+  };
+  for (int seed = 1; seed <= 4; ++seed) {
+    const synth::SynthScene scene = synth::GenerateScene(seed);
+    absl::StatusOr<DetectResult> whole = RunDetect(scene.frame.frame, {});
+    ASSERT_TRUE(whole.ok()) << seed;
+    ASSERT_FALSE(whole->points.empty());
+    const AttentionPoint& first = whole->points[0];
+    if (scene.frame.labels.at<int>(first.v, first.u) < 20) continue;
+    for (const Pattern& pattern :
+         {Pattern{"every other column", 2, 0}, Pattern{"every other row", 0, 2},
+          Pattern{"every 4th column", 4, 0}}) {
+      RgbdFrame frame = scene.frame.frame;
+      frame.depth = frame.depth.clone();
+      for (int v = 0; v < frame.height(); ++v) {
+        for (int u = 0; u < frame.width(); ++u) {
+          if ((pattern.column_period && u % pattern.column_period == 0) ||
+              (pattern.row_period && v % pattern.row_period == 0)) {
+            frame.depth.at<float>(v, u) =
+                std::numeric_limits<float>::quiet_NaN();
+          }
+        }
+      }
+      absl::StatusOr<DetectResult> result = RunDetect(frame, {});
+      ASSERT_TRUE(result.ok())
+          << "seed " << seed << ", " << pattern.name << ": " << result.status();
+      ASSERT_FALSE(result->points.empty()) << seed << ", " << pattern.name;
+      const AttentionPoint& p = result->points[0];
+      EXPECT_GE(scene.frame.labels.at<int>(p.v, p.u), 20)
+          << "seed " << seed << ", " << pattern.name;
+    }
+  }
 }
 
 TEST(DetectTest, DefaultsGiveAStackedBoxItsOwnPoint) {
