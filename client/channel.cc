@@ -13,6 +13,7 @@
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/string_view.h"
+#include "core/base/status_macros.h"
 #include "grpc/grpc.h"
 #include "grpcpp/create_channel.h"
 #include "grpcpp/security/credentials.h"
@@ -106,9 +107,8 @@ std::string ServiceConfigJson(const ClientOptions& options, bool balanced) {
 absl::StatusOr<std::shared_ptr<grpc::Channel>> CreateChannel(
     const std::string& servers, const ClientOptions& options,
     grpc::ChannelArguments arguments, bool balanced) {
-  if (absl::Status status = Validate(options); !status.ok()) return status;
-  absl::StatusOr<std::string> target = ChannelTarget(servers);
-  if (!target.ok()) return target.status();
+  FOVEA_RETURN_IF_ERROR(Validate(options));
+  FOVEA_ASSIGN_OR_RETURN(std::string target, ChannelTarget(servers));
   arguments.SetMaxReceiveMessageSize(options.max_message_bytes);
   arguments.SetMaxSendMessageSize(options.max_message_bytes);
   // A call larger than the retry buffer (gRPC's default: 256 KiB, less
@@ -133,10 +133,10 @@ absl::StatusOr<std::shared_ptr<grpc::Channel>> CreateChannel(
     credentials = grpc::SslCredentials(ssl);
   }
   std::shared_ptr<grpc::Channel> channel =
-      grpc::CreateCustomChannel(*target, credentials, arguments);
+      grpc::CreateCustomChannel(target, credentials, arguments);
   if (channel == nullptr) {
     return absl::InvalidArgumentError(
-        absl::StrCat("server: cannot create a channel to \"", *target, "\""));
+        absl::StrCat("server: cannot create a channel to \"", target, "\""));
   }
   return channel;
 }
@@ -181,14 +181,14 @@ absl::StatusOr<std::string> ChannelTarget(const std::string& servers) {
   int position = 0;
   for (absl::string_view entry : absl::StrSplit(trimmed, ',')) {
     entry = absl::StripAsciiWhitespace(entry);
-    absl::StatusOr<Family> family = CheckListEntry(entry, ++position, servers);
-    if (!family.ok()) return family.status();
+    FOVEA_ASSIGN_OR_RETURN(Family family,
+                           CheckListEntry(entry, ++position, servers));
     if (!seen.emplace(entry).second) {
       return absl::InvalidArgumentError(
           absl::StrCat("server: entry ", position, " of \"", servers,
                        "\" repeats \"", entry, "\""));
     }
-    families.insert(*family);
+    families.insert(family);
     entries.emplace_back(entry);
   }
   if (families.size() > 1) {

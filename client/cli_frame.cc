@@ -7,6 +7,7 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "client/frame_builder.h"
+#include "core/base/status_macros.h"
 #include "core/frame/image_codec.h"
 #include "core/frame/osd_pcd.h"
 #include "core/frame/rgbd_frame.h"
@@ -51,13 +52,13 @@ absl::StatusOr<fovea::v1::Image> ImageFromMat(const cv::Mat& mat,
 absl::StatusOr<LoadedFrame> FromRgbdFrame(const RgbdFrame& rgbd,
                                           const FrameSource& source,
                                           std::string description) {
-  absl::StatusOr<fovea::v1::Image> color = ImageFromMat(rgbd.color, "rgb8");
-  if (!color.ok()) return color.status();
-  absl::StatusOr<fovea::v1::Image> depth = ImageFromMat(rgbd.depth, "32FC1");
-  if (!depth.ok()) return depth.status();
+  FOVEA_ASSIGN_OR_RETURN(fovea::v1::Image color,
+                         ImageFromMat(rgbd.color, "rgb8"));
+  FOVEA_ASSIGN_OR_RETURN(fovea::v1::Image depth,
+                         ImageFromMat(rgbd.depth, "32FC1"));
   LoadedFrame loaded;
   loaded.frame =
-      MakeFrame(*std::move(color), *std::move(depth),
+      MakeFrame(std::move(color), std::move(depth),
                 ToProto(ChooseIntrinsics(source, rgbd.intrinsics)), 0.0);
   cv::cvtColor(rgbd.color, loaded.color_bgr, cv::COLOR_RGB2BGR);
   loaded.description = std::move(description);
@@ -65,10 +66,10 @@ absl::StatusOr<LoadedFrame> FromRgbdFrame(const RgbdFrame& rgbd,
 }
 
 absl::StatusOr<LoadedFrame> FromFiles(const FrameSource& source) {
-  absl::StatusOr<std::string> color_bytes = ReadFileBytes(source.color_path);
-  if (!color_bytes.ok()) return color_bytes.status();
-  absl::StatusOr<std::string> depth_bytes = ReadFileBytes(source.depth_path);
-  if (!depth_bytes.ok()) return depth_bytes.status();
+  FOVEA_ASSIGN_OR_RETURN(std::string color_bytes,
+                         ReadFileBytes(source.color_path));
+  FOVEA_ASSIGN_OR_RETURN(std::string depth_bytes,
+                         ReadFileBytes(source.depth_path));
 
   LoadedFrame loaded;
   ImageDecodeOptions options;
@@ -76,17 +77,17 @@ absl::StatusOr<LoadedFrame> FromFiles(const FrameSource& source) {
   options.max_width = kMaxOverlaySide;
   options.max_height = kMaxOverlaySide;
   absl::StatusOr<cv::Mat> color_bgr =
-      DecodeImage(*color_bytes, options, "--color");
+      DecodeImage(color_bytes, options, "--color");
   // Left empty when undecodable: the server will say what is wrong.
   if (color_bgr.ok()) loaded.color_bgr = *std::move(color_bgr);
   absl::StatusOr<fovea::v1::Image> color =
-      MakeCompressedImage(*std::move(color_bytes));
+      MakeCompressedImage(std::move(color_bytes));
   if (!color.ok()) {
     return absl::InvalidArgumentError(absl::StrCat(
         "--color ", source.color_path, ": ", color.status().message()));
   }
   absl::StatusOr<fovea::v1::Image> depth =
-      MakeCompressedImage(*std::move(depth_bytes));
+      MakeCompressedImage(std::move(depth_bytes));
   if (!depth.ok()) {
     return absl::InvalidArgumentError(absl::StrCat(
         "--depth ", source.depth_path, ": ", depth.status().message()));
@@ -120,13 +121,14 @@ absl::StatusOr<LoadedFrame> LoadFrame(const FrameSource& source) {
     }
     loaded = FromFiles(source);
   } else if (pcd) {
-    absl::StatusOr<LabelledFrame> labelled = LoadOsdPcd(
-        source.pcd_path, ChooseIntrinsics(source, kKinectV1Intrinsics));
-    if (!labelled.ok()) return labelled.status();
+    FOVEA_ASSIGN_OR_RETURN(
+        LabelledFrame labelled,
+        LoadOsdPcd(source.pcd_path,
+                   ChooseIntrinsics(source, kKinectV1Intrinsics)));
     loaded = FromRgbdFrame(
-        labelled->frame, source,
-        absl::StrCat(source.pcd_path, " (", labelled->frame.width(), "x",
-                     labelled->frame.height(), ", raw rgb8 + 32FC1)"));
+        labelled.frame, source,
+        absl::StrCat(source.pcd_path, " (", labelled.frame.width(), "x",
+                     labelled.frame.height(), ", raw rgb8 + 32FC1)"));
   } else {
     synth::SynthScene scene = synth::GenerateScene(*source.synthetic_seed);
     loaded = FromRgbdFrame(

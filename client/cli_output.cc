@@ -13,6 +13,7 @@
 #include "absl/strings/str_join.h"
 #include "client/option_names.h"
 #include "client/rle.h"
+#include "core/base/status_macros.h"
 #include "core/frame/image_codec.h"
 #include "google/protobuf/util/json_util.h"
 
@@ -59,10 +60,10 @@ absl::StatusOr<cv::Mat> DecodeMap(const fovea::v1::Image& image) {
       options.mode = ImageDecodeMode::kUnchanged;
       options.max_width = kLargestDecodeSide;
       options.max_height = kLargestDecodeSide;
-      absl::StatusOr<cv::Mat> png =
-          DecodeImage(image.compressed(), options, "image.compressed");
-      if (!png.ok()) return png.status();
-      decoded = *std::move(png);
+      FOVEA_ASSIGN_OR_RETURN(
+          cv::Mat png,
+          DecodeImage(image.compressed(), options, "image.compressed"));
+      decoded = std::move(png);
     } else if (!image.data().empty()) {
       int type = -1;
       if (image.encoding() == "16UC1" || image.encoding() == "mono16") {
@@ -337,7 +338,7 @@ void PrintCapabilities(const fovea::v1::Capabilities& c, std::ostream& out) {
 absl::StatusOr<std::vector<std::string>> WriteDetectOutputs(
     const std::string& dir, const fovea::v1::DetectResponse& response,
     const cv::Mat& color_bgr) {
-  if (absl::Status status = CreateDir(dir); !status.ok()) return status;
+  FOVEA_RETURN_IF_ERROR(CreateDir(dir));
   const std::filesystem::path root(dir);
   std::vector<std::string> written;
   auto write_png = [&](const std::string& name,
@@ -347,17 +348,14 @@ absl::StatusOr<std::vector<std::string>> WriteDetectOutputs(
     return status;
   };
 
-  if (absl::Status status =
-          WriteText(root / "response.json", ToJson(response, true));
-      !status.ok()) {
-    return status;
-  }
+  FOVEA_RETURN_IF_ERROR(
+      WriteText(root / "response.json", ToJson(response, true)));
   written.push_back((root / "response.json").string());
 
   if (!color_bgr.empty()) {
     cv::Mat overlay = color_bgr.clone();
     DrawPoints(overlay, response.points());
-    if (absl::Status s = write_png("overlay.png", overlay); !s.ok()) return s;
+    FOVEA_RETURN_IF_ERROR(write_png("overlay.png", overlay));
   }
   for (const fovea::v1::SaliencyMapImage& map_image : response.maps()) {
     absl::StatusOr<cv::Mat> map = DecodeMap(map_image.image());
@@ -372,7 +370,7 @@ absl::StatusOr<std::vector<std::string>> WriteDetectOutputs(
     const std::string name =
         master ? "saliency.png"
                : absl::StrCat("saliency_", SafeName(map_image.name()), ".png");
-    if (absl::Status s = write_png(name, coloured); !s.ok()) return s;
+    FOVEA_RETURN_IF_ERROR(write_png(name, coloured));
     if (master && !color_bgr.empty()) {
       cv::Mat resized = coloured;
       if (coloured.size() != color_bgr.size()) {
@@ -383,10 +381,7 @@ absl::StatusOr<std::vector<std::string>> WriteDetectOutputs(
       cv::addWeighted(color_bgr, 1.0 - kOverlayAlpha, resized, kOverlayAlpha,
                       0.0, blended);
       DrawPoints(blended, response.points());
-      if (absl::Status s = write_png("saliency_overlay.png", blended);
-          !s.ok()) {
-        return s;
-      }
+      FOVEA_RETURN_IF_ERROR(write_png("saliency_overlay.png", blended));
     }
   }
   return written;
@@ -394,7 +389,7 @@ absl::StatusOr<std::vector<std::string>> WriteDetectOutputs(
 
 absl::StatusOr<std::string> WriteObjectMask(
     const std::string& dir, const fovea::v1::ObjectResult& object) {
-  if (absl::Status status = CreateDir(dir); !status.ok()) return status;
+  FOVEA_RETURN_IF_ERROR(CreateDir(dir));
   absl::StatusOr<ByteMask> mask = DecodeRle(object.mask());
   if (!mask.ok()) {
     return absl::InvalidArgumentError(
@@ -407,7 +402,7 @@ absl::StatusOr<std::string> WriteObjectMask(
   const std::filesystem::path path =
       std::filesystem::path(dir) /
       absl::StrCat("mask_", object.index(), ".png");
-  if (absl::Status s = WritePng(path, mask_image); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(WritePng(path, mask_image));
   return path.string();
 }
 
@@ -415,7 +410,7 @@ absl::StatusOr<std::vector<std::string>> WriteSegmentOutputs(
     const std::string& dir,
     const std::vector<fovea::v1::SegmentResponse>& messages,
     const cv::Mat& color_bgr) {
-  if (absl::Status status = CreateDir(dir); !status.ok()) return status;
+  FOVEA_RETURN_IF_ERROR(CreateDir(dir));
   const std::filesystem::path root(dir);
   std::vector<std::string> written;
 
@@ -423,9 +418,7 @@ absl::StatusOr<std::vector<std::string>> WriteSegmentOutputs(
   for (const fovea::v1::SegmentResponse& message : messages) {
     absl::StrAppend(&lines, ToJson(message), "\n");
   }
-  if (absl::Status s = WriteText(root / "responses.jsonl", lines); !s.ok()) {
-    return s;
-  }
+  FOVEA_RETURN_IF_ERROR(WriteText(root / "responses.jsonl", lines));
   written.push_back((root / "responses.jsonl").string());
 
   cv::Mat overlay = color_bgr.empty() ? cv::Mat() : color_bgr.clone();
@@ -459,7 +452,7 @@ absl::StatusOr<std::vector<std::string>> WriteSegmentOutputs(
   if (!overlay.empty()) {
     if (!messages.empty()) DrawPoints(overlay, messages[0].attention_points());
     const std::filesystem::path path = root / "overlay.png";
-    if (absl::Status s = WritePng(path, overlay); !s.ok()) return s;
+    FOVEA_RETURN_IF_ERROR(WritePng(path, overlay));
     written.push_back(path.string());
   }
   return written;

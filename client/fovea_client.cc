@@ -3,6 +3,7 @@
 #include <utility>
 
 #include "absl/memory/memory.h"
+#include "core/base/status_macros.h"
 #include "grpcpp/client_context.h"
 
 namespace fovea::client {
@@ -37,14 +38,12 @@ absl::Status DrainStream(Reader& reader, const SegmentCallback& on_message) {
 
 absl::StatusOr<std::unique_ptr<FoveaClient>> FoveaClient::Connect(
     const std::string& target, const ClientOptions& options) {
-  absl::StatusOr<std::shared_ptr<grpc::Channel>> channel =
-      CreateBalancedChannel(target, options);
-  if (!channel.ok()) return channel.status();
-  absl::StatusOr<std::shared_ptr<grpc::Channel>> health_channel =
-      CreateProbeChannel(target, options);
-  if (!health_channel.ok()) return health_channel.status();
-  return absl::WrapUnique(new FoveaClient(*std::move(channel),
-                                          *std::move(health_channel), options));
+  FOVEA_ASSIGN_OR_RETURN(std::shared_ptr<grpc::Channel> channel,
+                         CreateBalancedChannel(target, options));
+  FOVEA_ASSIGN_OR_RETURN(std::shared_ptr<grpc::Channel> health_channel,
+                         CreateProbeChannel(target, options));
+  return absl::WrapUnique(
+      new FoveaClient(std::move(channel), std::move(health_channel), options));
 }
 
 FoveaClient::FoveaClient(std::shared_ptr<grpc::Channel> channel,

@@ -7,6 +7,7 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 
 namespace fovea::client {
 namespace {
@@ -171,11 +172,10 @@ absl::StatusOr<CompressedInfo> ProbeCompressedImage(absl::string_view bytes) {
 }
 
 absl::StatusOr<fovea::v1::Image> MakeCompressedImage(std::string bytes) {
-  absl::StatusOr<CompressedInfo> info = ProbeCompressedImage(bytes);
-  if (!info.ok()) return info.status();
+  FOVEA_ASSIGN_OR_RETURN(CompressedInfo info, ProbeCompressedImage(bytes));
   fovea::v1::Image image;
-  image.set_width(info->width);
-  image.set_height(info->height);
+  image.set_width(info.width);
+  image.set_height(info.height);
   *image.mutable_compressed() = std::move(bytes);
   return image;
 }

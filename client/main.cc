@@ -41,6 +41,7 @@
 #include "client/cli_output.h"
 #include "client/fovea_client.h"
 #include "client/option_names.h"
+#include "core/base/status_macros.h"
 
 ABSL_FLAG(std::string, server, "127.0.0.1:50051",
           "gRPC server: HOST:PORT, replicas as IP:PORT,IP:PORT,... or one "
@@ -219,9 +220,8 @@ absl::StatusOr<std::unique_ptr<FoveaClient>> MakeClient() {
             "tls_ca", absl::GetFlag(FLAGS_tls_ca), &options.tls_root_certs},
         {"tls_cert", absl::GetFlag(FLAGS_tls_cert), &options.tls_cert_chain},
         {"tls_key", absl::GetFlag(FLAGS_tls_key), &options.tls_private_key}}) {
-    absl::StatusOr<std::string> text = ReadFileFlag(value, flag);
-    if (!text.ok()) return text.status();
-    *out = *std::move(text);
+    FOVEA_ASSIGN_OR_RETURN(std::string text, ReadFileFlag(value, flag));
+    *out = std::move(text);
   }
   return FoveaClient::Connect(absl::GetFlag(FLAGS_server), options);
 }
@@ -289,20 +289,19 @@ absl::Status SceneFromFlags(fovea::v1::SceneOptions& scene) {
   scene.set_processing_width(
       static_cast<uint32_t>(absl::GetFlag(FLAGS_processing_width)));
   if (const std::string g = absl::GetFlag(FLAGS_gravity); !g.empty()) {
-    absl::StatusOr<std::vector<double>> v = Numbers("gravity", g, 3);
-    if (!v.ok()) return v.status();
-    scene.mutable_gravity()->set_x((*v)[0]);
-    scene.mutable_gravity()->set_y((*v)[1]);
-    scene.mutable_gravity()->set_z((*v)[2]);
+    FOVEA_ASSIGN_OR_RETURN(std::vector<double> v, Numbers("gravity", g, 3));
+    scene.mutable_gravity()->set_x((v)[0]);
+    scene.mutable_gravity()->set_y((v)[1]);
+    scene.mutable_gravity()->set_z((v)[2]);
   }
   if (const std::string p = absl::GetFlag(FLAGS_support_plane); !p.empty()) {
-    absl::StatusOr<std::vector<double>> v = Numbers("support_plane", p, 4);
-    if (!v.ok()) return v.status();
+    FOVEA_ASSIGN_OR_RETURN(std::vector<double> v,
+                           Numbers("support_plane", p, 4));
     fovea::v1::Plane* plane = scene.mutable_support_plane();
-    plane->mutable_normal()->set_x((*v)[0]);
-    plane->mutable_normal()->set_y((*v)[1]);
-    plane->mutable_normal()->set_z((*v)[2]);
-    plane->set_d((*v)[3]);
+    plane->mutable_normal()->set_x((v)[0]);
+    plane->mutable_normal()->set_y((v)[1]);
+    plane->mutable_normal()->set_z((v)[2]);
+    plane->set_d((v)[3]);
   }
   const std::string box = absl::GetFlag(FLAGS_workspace_box);
   const double min_depth = absl::GetFlag(FLAGS_min_depth);
@@ -312,15 +311,15 @@ absl::Status SceneFromFlags(fovea::v1::SceneOptions& scene) {
     w->set_min_depth_m(min_depth);
     w->set_max_depth_m(max_depth);
     if (!box.empty()) {
-      absl::StatusOr<std::vector<double>> v = Numbers("workspace_box", box, 6);
-      if (!v.ok()) return v.status();
+      FOVEA_ASSIGN_OR_RETURN(std::vector<double> v,
+                             Numbers("workspace_box", box, 6));
       fovea::v1::Box* b = w->mutable_box();
-      b->mutable_min()->set_x((*v)[0]);
-      b->mutable_min()->set_y((*v)[1]);
-      b->mutable_min()->set_z((*v)[2]);
-      b->mutable_max()->set_x((*v)[3]);
-      b->mutable_max()->set_y((*v)[4]);
-      b->mutable_max()->set_z((*v)[5]);
+      b->mutable_min()->set_x((v)[0]);
+      b->mutable_min()->set_y((v)[1]);
+      b->mutable_min()->set_z((v)[2]);
+      b->mutable_max()->set_x((v)[3]);
+      b->mutable_max()->set_y((v)[4]);
+      b->mutable_max()->set_z((v)[5]);
     }
   }
   return absl::OkStatus();
@@ -329,18 +328,16 @@ absl::Status SceneFromFlags(fovea::v1::SceneOptions& scene) {
 // Detect options from the flags; INVALID_ARGUMENT naming a bad one.
 absl::StatusOr<fovea::v1::DetectOptions> DetectOptionsFromFlags() {
   fovea::v1::DetectOptions options;
-  absl::StatusOr<std::vector<fovea::v1::WeightedOperator>> saliency =
-      ParseSaliency(absl::GetFlag(FLAGS_saliency));
-  if (!saliency.ok()) return saliency.status();
-  for (fovea::v1::WeightedOperator& op : *saliency) {
+  FOVEA_ASSIGN_OR_RETURN(std::vector<fovea::v1::WeightedOperator> saliency,
+                         ParseSaliency(absl::GetFlag(FLAGS_saliency)));
+  for (fovea::v1::WeightedOperator& op : saliency) {
     *options.add_saliency() = std::move(op);
   }
   // Each enum flag: parse when given, leave UNSPECIFIED otherwise.
   auto set = [](const std::string& text, auto parse, auto setter) {
     if (text.empty()) return absl::OkStatus();
-    auto value = parse(text);
-    if (!value.ok()) return value.status();
-    setter(*value);
+    FOVEA_ASSIGN_OR_RETURN(auto value, parse(text));
+    setter(value);
     return absl::OkStatus();
   };
   for (absl::Status status : {
@@ -368,10 +365,7 @@ absl::StatusOr<fovea::v1::DetectOptions> DetectOptionsFromFlags() {
     options.set_split_at_surface_edges(*split);
   }
   options.set_return_saliency_map(!absl::GetFlag(FLAGS_out).empty());
-  if (absl::Status status = SceneFromFlags(*options.mutable_scene());
-      !status.ok()) {
-    return status;
-  }
+  FOVEA_RETURN_IF_ERROR(SceneFromFlags(*options.mutable_scene()));
   return options;
 }
 

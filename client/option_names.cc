@@ -10,6 +10,7 @@
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
+#include "core/base/status_macros.h"
 
 namespace fovea::client {
 namespace {
@@ -69,17 +70,16 @@ absl::StatusOr<std::vector<fovea::v1::WeightedOperator>> ParseSaliency(
                          "\" is not a number >= 0"));
       }
     }
-    absl::StatusOr<fovea::v1::SaliencyOperator> op =
-        Lookup("saliency", name, SaliencyNames());
-    if (!op.ok()) return op.status();
+    FOVEA_ASSIGN_OR_RETURN(fovea::v1::SaliencyOperator op,
+                           Lookup("saliency", name, SaliencyNames()));
     for (const fovea::v1::WeightedOperator& seen : operators) {
-      if (seen.op() == *op) {
+      if (seen.op() == op) {
         return absl::InvalidArgumentError(
             absl::StrCat("saliency: \"", name, "\" given twice"));
       }
     }
     fovea::v1::WeightedOperator& weighted = operators.emplace_back();
-    weighted.set_op(*op);
+    weighted.set_op(op);
     weighted.set_weight(weight);
   }
   return operators;

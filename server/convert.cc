@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/frame/image_codec.h"
 
@@ -184,16 +185,14 @@ absl::StatusOr<std::vector<WeightedChannel>> ToChannels(
   for (int i = 0; i < options.saliency_size(); ++i) {
     const v1::WeightedOperator& in = options.saliency(i);
     const std::string field = absl::StrCat("options.saliency[", i, "]");
-    absl::StatusOr<SaliencyOp> op = FromProto(in.op(), field + ".op");
-    if (!op.ok()) return op.status();
+    FOVEA_ASSIGN_OR_RETURN(SaliencyOp op, FromProto(in.op(), field + ".op"));
     const double weight = in.weight();
     if (!std::isfinite(weight) || weight < 0.0 || weight > 1e6) {
       return absl::InvalidArgumentError(absl::StrCat(
           field, ".weight: ", weight,
           " is not in [0, 1e6] (weights are relative; 0 means 1)"));
     }
-    channels.push_back(
-        {*op, weight == 0.0 ? 1.0f : static_cast<float>(weight)});
+    channels.push_back({op, weight == 0.0 ? 1.0f : static_cast<float>(weight)});
   }
   return channels;
 }
@@ -405,9 +404,9 @@ absl::StatusOr<DetectOptions> ToDetectOptions(
     const v1::DetectOptions& options) {
   DetectOptions out;
   if (options.saliency_size() > 0) {
-    absl::StatusOr<std::vector<WeightedChannel>> channels = ToChannels(options);
-    if (!channels.ok()) return channels.status();
-    out.channels = *std::move(channels);
+    FOVEA_ASSIGN_OR_RETURN(std::vector<WeightedChannel> channels,
+                           ToChannels(options));
+    out.channels = std::move(channels);
   }
   for (absl::Status status :
        {FromProto(options.pyramid(), out.pyramid),
@@ -430,16 +429,12 @@ absl::StatusOr<DetectOptions> ToDetectOptions(
   if (options.has_split_at_surface_edges()) {
     out.split_at_surface_edges = options.split_at_surface_edges();
   }
-  if (absl::Status status = ApplyTopDownCues(options, out); !status.ok()) {
-    return status;
-  }
-  if (absl::Status status = ApplyScene(options.scene(), out); !status.ok()) {
-    return status;
-  }
+  FOVEA_RETURN_IF_ERROR(ApplyTopDownCues(options, out));
+  FOVEA_RETURN_IF_ERROR(ApplyScene(options.scene(), out));
 
   // Core names the field itself ("options.saliency: 'ph' is given more
   // than once ...").
-  if (absl::Status status = Validate(out); !status.ok()) return status;
+  FOVEA_RETURN_IF_ERROR(Validate(out));
   return out;
 }
 
@@ -618,17 +613,11 @@ absl::StatusOr<v1::DetectResponse> ToDetectResponse(
   *response.mutable_support_plane() = ToProtoSupportPlane(result.plane);
 
   if (request.options().return_saliency_map()) {
-    if (absl::Status status = AddMap("master", result.master, response);
-        !status.ok()) {
-      return status;
-    }
+    FOVEA_RETURN_IF_ERROR(AddMap("master", result.master, response));
   }
   if (request.options().return_channel_maps()) {
     for (const NamedMap& map : result.channel_maps) {
-      if (absl::Status status = AddMap(map.name, map.map, response);
-          !status.ok()) {
-        return status;
-      }
+      FOVEA_RETURN_IF_ERROR(AddMap(map.name, map.map, response));
     }
   }
 
@@ -658,10 +647,9 @@ absl::StatusOr<DetectOptions> ToNestedDetectOptions(
 absl::StatusOr<SegmentOptions> ToSegmentOptions(
     const v1::SegmentRequest& request) {
   SegmentOptions options;
-  absl::StatusOr<DetectOptions> detect =
-      ToNestedDetectOptions(request.detect_options());
-  if (!detect.ok()) return detect.status();
-  options.detect = *std::move(detect);
+  FOVEA_ASSIGN_OR_RETURN(DetectOptions detect,
+                         ToNestedDetectOptions(request.detect_options()));
+  options.detect = std::move(detect);
   switch (request.method()) {
     case v1::SEGMENTATION_METHOD_UNSPECIFIED:
     case v1::COS:
@@ -674,10 +662,9 @@ absl::StatusOr<SegmentOptions> ToSegmentOptions(
       return absl::InvalidArgumentError(absl::StrCat(
           "method: unknown value ", static_cast<int>(request.method())));
   }
-  absl::StatusOr<std::vector<cv::Point>> seeds =
-      ToPixels(request.seeds(), "seeds");
-  if (!seeds.ok()) return seeds.status();
-  options.seeds = *std::move(seeds);
+  FOVEA_ASSIGN_OR_RETURN(std::vector<cv::Point> seeds,
+                         ToPixels(request.seeds(), "seeds"));
+  options.seeds = std::move(seeds);
   options.max_objects =
       static_cast<int>(std::min<uint32_t>(request.max_objects(), 1u << 20));
   if (request.has_cover_scene()) options.cover_scene = request.cover_scene();
@@ -687,14 +674,13 @@ absl::StatusOr<SegmentOptions> ToSegmentOptions(
 absl::StatusOr<IncrementalOptions> ToIncrementalOptions(
     const v1::SegmentIncrementalRequest& request) {
   IncrementalOptions options;
-  absl::StatusOr<DetectOptions> detect =
-      ToNestedDetectOptions(request.detect_options());
-  if (!detect.ok()) return detect.status();
-  options.detect = *std::move(detect);
-  absl::StatusOr<std::vector<cv::Point>> points =
-      ToPixels(request.attention_points(), "attention_points");
-  if (!points.ok()) return points.status();
-  options.attention_points = *std::move(points);
+  FOVEA_ASSIGN_OR_RETURN(DetectOptions detect,
+                         ToNestedDetectOptions(request.detect_options()));
+  options.detect = std::move(detect);
+  FOVEA_ASSIGN_OR_RETURN(
+      std::vector<cv::Point> points,
+      ToPixels(request.attention_points(), "attention_points"));
+  options.attention_points = std::move(points);
   options.max_objects =
       static_cast<int>(std::min<uint32_t>(request.max_objects(), 1u << 20));
   const double budget = request.time_budget_seconds();

@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "core/base/status_macros.h"
 #include "server/clock.h"
 #include "server/convert.h"
 
@@ -12,21 +13,20 @@ absl::StatusOr<v1::DetectResponse> HandleDetect(
     const FrameLimits& limits, const InterruptCheck& interrupt,
     double queue_seconds) {
   Clock::time_point start = Clock::now();
-  absl::StatusOr<RgbdFrame> frame =
-      DecodeFrame(ToRawFrame(request.frame()), limits, interrupt);
-  if (!frame.ok()) return frame.status();
+  FOVEA_ASSIGN_OR_RETURN(
+      RgbdFrame frame,
+      DecodeFrame(ToRawFrame(request.frame()), limits, interrupt));
   const double decode_seconds = SecondsSince(start);
   if (interrupt) {
-    if (absl::Status status = interrupt(); !status.ok()) return status;
+    FOVEA_RETURN_IF_ERROR(interrupt());
   }
 
-  absl::StatusOr<DetectResult> result = RunDetect(*frame, options, interrupt);
-  if (!result.ok()) return result.status();
+  FOVEA_ASSIGN_OR_RETURN(DetectResult result,
+                         RunDetect(frame, options, interrupt));
 
   start = Clock::now();
-  absl::StatusOr<v1::DetectResponse> response =
-      ToDetectResponse(*result, request);
-  if (!response.ok()) return response.status();
+  FOVEA_ASSIGN_OR_RETURN(v1::DetectResponse response,
+                         ToDetectResponse(result, request));
   const double encode_seconds = SecondsSince(start);
 
   // Put "queue" and "decode" before core's stages, "encode" after.
@@ -38,11 +38,11 @@ absl::StatusOr<v1::DetectResponse> HandleDetect(
   };
   add("queue", queue_seconds);
   add("decode", decode_seconds);
-  for (const v1::StageTiming& timing : response->timings()) {
+  for (const v1::StageTiming& timing : response.timings()) {
     add(timing.stage(), timing.seconds());
   }
   add("encode", encode_seconds);
-  response->mutable_timings()->Swap(&timings);
+  response.mutable_timings()->Swap(&timings);
   return response;
 }
 

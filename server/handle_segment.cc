@@ -3,6 +3,7 @@
 #include <optional>
 #include <utility>
 
+#include "core/base/status_macros.h"
 #include "server/convert.h"
 #include "server/metrics.h"
 
@@ -29,13 +30,11 @@ absl::Status Stream(std::string_view method, const v1::Frame& wire_frame,
                     const SegmentHandlerContext& context, Run run) {
   RecordStage("queue", context.queue_seconds);
   const Clock::time_point decode_start = Clock::now();
-  absl::StatusOr<RgbdFrame> frame =
-      DecodeFrame(ToRawFrame(wire_frame), context.limits, context.interrupt);
-  if (!frame.ok()) return frame.status();
+  FOVEA_ASSIGN_OR_RETURN(
+      RgbdFrame frame,
+      DecodeFrame(ToRawFrame(wire_frame), context.limits, context.interrupt));
   RecordStage("decode", SecondsSince(decode_start));
-  if (absl::Status status = CheckInterrupt(context.interrupt); !status.ok()) {
-    return status;
-  }
+  FOVEA_RETURN_IF_ERROR(CheckInterrupt(context.interrupt));
   int objects = 0;
   std::optional<SupportPlane> support;
   SegmentSinks sinks;
@@ -51,7 +50,7 @@ absl::Status Stream(std::string_view method, const v1::Frame& wire_frame,
     if (objects++ == 0) RecordFirstObject(method, object.seconds_since_start);
     return context.send(ToObjectMessage(object, request_id));
   };
-  absl::StatusOr<SegmentSummary> summary = run(*frame, sinks);
+  absl::StatusOr<SegmentSummary> summary = run(frame, sinks);
   RecordObjectsPerRequest(method, objects);
   if (!summary.ok()) {
     RecordStopReason(

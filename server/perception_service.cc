@@ -17,6 +17,7 @@
 #include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/base/tsan.h"
 #include "server/capabilities.h"
@@ -98,7 +99,7 @@ template <typename Request>
 absl::Status AdmitFrameCall(const ServiceState& state,
                             const absl::Status& parsed,
                             const Request& request) {
-  if (absl::Status s = CheckAccepting(state); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(CheckAccepting(state));
   if (!parsed.ok()) return parsed;
   if (!request.has_frame()) {
     return absl::InvalidArgumentError(
@@ -259,9 +260,7 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
     const double queue_seconds = SecondsSince(submitted_);
     RecordQueueWait(queue_seconds);
     if (config_.before_detect_job) config_.before_detect_job();
-    if (absl::Status status = CheckInterrupt(*context_); !status.ok()) {
-      return status;
-    }
+    FOVEA_RETURN_IF_ERROR(CheckInterrupt(*context_));
     absl::StatusOr<v1::DetectResponse> response = HandleDetect(
         *request_, options_, config_.limits,
         [this] {
@@ -428,9 +427,7 @@ class StreamReactor final
   absl::Status Compute() {
     const double queue_seconds = SecondsSince(start_);
     RecordQueueWait(queue_seconds);
-    if (absl::Status status = CheckInterrupt(*context_); !status.ok()) {
-      return status;
-    }
+    FOVEA_RETURN_IF_ERROR(CheckInterrupt(*context_));
     SegmentHandlerContext handler;
     handler.models = config_.segment_models;
     handler.limits = config_.limits;

@@ -19,6 +19,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
+#include "core/base/status_macros.h"
 #include "core/synth/synth_scene.h"
 #include "server/accept_guard.h"
 #include "server/capabilities.h"
@@ -112,20 +113,18 @@ absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> ServerCredentials(
     return absl::InvalidArgumentError(
         "--tls_cert, --tls_key: give both or neither");
   }
-  absl::StatusOr<std::string> cert = ReadPem(config.tls_cert, "--tls_cert");
-  if (!cert.ok()) return cert.status();
-  absl::StatusOr<std::string> key = ReadPem(config.tls_key, "--tls_key");
-  if (!key.ok()) return key.status();
+  FOVEA_ASSIGN_OR_RETURN(std::string cert,
+                         ReadPem(config.tls_cert, "--tls_cert"));
+  FOVEA_ASSIGN_OR_RETURN(std::string key, ReadPem(config.tls_key, "--tls_key"));
   grpc::SslServerCredentialsOptions ssl(
       config.tls_client_ca.empty()
           ? GRPC_SSL_DONT_REQUEST_CLIENT_CERTIFICATE
           : GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY);
-  ssl.pem_key_cert_pairs.push_back({*key, *cert});
+  ssl.pem_key_cert_pairs.push_back({key, cert});
   if (!config.tls_client_ca.empty()) {
-    absl::StatusOr<std::string> ca =
-        ReadPem(config.tls_client_ca, "--tls_client_ca");
-    if (!ca.ok()) return ca.status();
-    ssl.pem_root_certs = *ca;
+    FOVEA_ASSIGN_OR_RETURN(std::string ca,
+                           ReadPem(config.tls_client_ca, "--tls_client_ca"));
+    ssl.pem_root_certs = ca;
   }
   return grpc::SslServerCredentials(ssl);
 }
@@ -210,7 +209,7 @@ absl::Status Validate(const ServerConfig& config) {
 
 absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
     ServerConfig config) {
-  if (absl::Status status = Validate(config); !status.ok()) return status;
+  FOVEA_RETURN_IF_ERROR(Validate(config));
   if (config.max_message_bytes == 0) {
     config.max_message_bytes = DefaultMaxMessageBytes(config.limits);
   }
@@ -227,10 +226,9 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
   }
   server->models_ = std::make_unique<LoadedModels>(*std::move(models));
   if (!config.metrics_listen.empty()) {
-    absl::StatusOr<std::unique_ptr<MetricsEndpoint>> metrics =
-        MetricsEndpoint::Start(config.metrics_listen);
-    if (!metrics.ok()) return metrics.status();
-    server->metrics_ = *std::move(metrics);
+    FOVEA_ASSIGN_OR_RETURN(std::unique_ptr<MetricsEndpoint> metrics,
+                           MetricsEndpoint::Start(config.metrics_listen));
+    server->metrics_ = std::move(metrics);
   }
   server->work_ = std::make_unique<WorkQueue>(config.concurrency, config.queue);
   ServiceConfig service;
@@ -272,10 +270,9 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
         static_cast<int>(
             std::lround(config.max_connection_age_grace_s * 1000.0)));
   }
-  absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> credentials =
-      ServerCredentials(config);
-  if (!credentials.ok()) return credentials.status();
-  builder.AddListeningPort(config.listen, *credentials, &server->port_);
+  FOVEA_ASSIGN_OR_RETURN(std::shared_ptr<grpc::ServerCredentials> credentials,
+                         ServerCredentials(config));
+  builder.AddListeningPort(config.listen, credentials, &server->port_);
   builder.RegisterService(server->service_.get());
   server->server_ = builder.BuildAndStart();
   if (server->server_ == nullptr || server->port_ == 0) {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 
 namespace fovea {
 namespace {
@@ -117,7 +118,7 @@ absl::Status Validate(const MsrOptions& options) {
 
 absl::StatusOr<std::vector<AttentionPoint>> ExtractMsrPoints(
     const cv::Mat& map, int max_points, const MsrOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   if (map.empty() || map.type() != CV_32FC1) {
     return absl::InvalidArgumentError("msr: map must be a non-empty CV_32FC1");
   }

@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
+#include "core/base/status_macros.h"
 
 namespace fovea {
 namespace {
@@ -352,7 +353,7 @@ absl::Status Validate(const TjOptions& options) {
 
 absl::StatusOr<std::vector<AttentionPoint>> ExtractTjPoints(
     const cv::Mat& map, int max_points, const TjOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   if (map.empty() || map.type() != CV_32FC1) {
     return absl::InvalidArgumentError("tj: map must be a non-empty CV_32FC1");
   }

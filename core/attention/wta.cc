@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 
 namespace fovea {
 namespace {
@@ -181,7 +182,7 @@ absl::Status Validate(const WtaOptions& options) {
 
 absl::StatusOr<std::vector<AttentionPoint>> ExtractWtaPoints(
     const cv::Mat& map, int max_points, const WtaOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   if (map.empty() || map.type() != CV_32FC1) {
     return absl::InvalidArgumentError("wta: map must be a non-empty CV_32FC1");
   }

@@ -15,6 +15,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
+#include "core/base/guarded.h"
 
 namespace fovea {
 namespace {
@@ -190,13 +191,9 @@ absl::StatusOr<PixelClusters> ClusterPixels(const OrganizedCloud& cloud,
     return absl::InvalidArgumentError(
         "pcl_clusters: the mask must be CV_8UC1 of the cloud's size");
   }
-  try {
+  return Guarded("pcl_clusters", [&]() -> absl::StatusOr<PixelClusters> {
     return Cluster(cloud, mask, options);
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError("pcl_clusters: out of memory");
-  } catch (const std::exception& e) {
-    return absl::InternalError(absl::StrCat("pcl_clusters: ", e.what()));
-  }
+  });
 }
 
 absl::StatusOr<std::vector<AttentionPoint>> DetectPclClusters(

@@ -20,6 +20,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
+#include "core/base/guarded.h"
 #include "core/frame/support_plane.h"
 
 namespace fovea {
@@ -392,7 +393,7 @@ absl::StatusOr<SceneSegmentation> SegmentSceneEuclidean(
   if (cloud.xyz.empty()) return SceneSegmentation{};
   if (absl::Status s = CheckCloud(cloud); !s.ok()) return s;
   if (!HasAnyPoint(cloud)) return NoSegments(cloud);
-  try {
+  return Guarded("pcl-euclidean", [&]() -> absl::StatusOr<SceneSegmentation> {
     absl::StatusOr<TableScene> table =
         StandingOnSupport(cloud, options.support);
     if (!table.ok()) return table.status();
@@ -403,11 +404,7 @@ absl::StatusOr<SceneSegmentation> SegmentSceneEuclidean(
     result.labels = std::move(clusters->labels);
     result.segments = static_cast<int>(clusters->voxels.size());
     return result;
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError("pcl-euclidean: out of memory");
-  } catch (const std::exception& e) {
-    return absl::InternalError(absl::StrCat("pcl-euclidean: ", e.what()));
-  }
+  });
 }
 
 absl::StatusOr<SceneSegmentation> SegmentSceneLccp(
@@ -416,16 +413,12 @@ absl::StatusOr<SceneSegmentation> SegmentSceneLccp(
   if (cloud.xyz.empty()) return SceneSegmentation{};
   if (absl::Status s = CheckCloud(cloud); !s.ok()) return s;
   if (!HasAnyPoint(cloud)) return NoSegments(cloud);
-  try {
+  return Guarded("pcl-lccp", [&]() -> absl::StatusOr<SceneSegmentation> {
     absl::StatusOr<TableScene> table =
         StandingOnSupport(cloud, options.support);
     if (!table.ok()) return table.status();
     return Lccp(cloud, *table, options);
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError("pcl-lccp: out of memory");
-  } catch (const std::exception& e) {
-    return absl::InternalError(absl::StrCat("pcl-lccp: ", e.what()));
-  }
+  });
 }
 
 }  // namespace fovea

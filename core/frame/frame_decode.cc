@@ -19,6 +19,8 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
 #include "core/base/check.h"
+#include "core/base/guarded.h"
+#include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/frame/image_codec.h"
 
@@ -242,9 +244,8 @@ absl::StatusOr<Layout> InspectCompressed(const RawImage& image, Slot slot,
   absl::string_view kind;
   if (file.substr(0, kPngSignature.size()) == kPngSignature) {
     kind = "PNG";
-    absl::StatusOr<FileHeader> png = ReadPngHeader(file, field);
-    if (!png.ok()) return png.status();
-    header = *png;
+    FOVEA_ASSIGN_OR_RETURN(FileHeader png, ReadPngHeader(file, field));
+    header = png;
     layout.format = Format::kPng;
     if (slot == Slot::kDepth &&
         (header.bit_depth != 16 || header.channels != kPngColorTypeGrey)) {
@@ -265,9 +266,8 @@ absl::StatusOr<Layout> InspectCompressed(const RawImage& image, Slot slot,
       return absl::InvalidArgumentError(absl::StrCat(
           field, ".compressed: a JPEG; depth takes a 16-bit grey PNG"));
     }
-    absl::StatusOr<FileHeader> jpeg = ReadJpegHeader(file, field);
-    if (!jpeg.ok()) return jpeg.status();
-    header = *jpeg;
+    FOVEA_ASSIGN_OR_RETURN(FileHeader jpeg, ReadJpegHeader(file, field));
+    header = jpeg;
     layout.format = Format::kJpeg;
   } else {
     return absl::InvalidArgumentError(absl::StrCat(
@@ -425,10 +425,10 @@ absl::StatusOr<cv::Mat> DecodeColor(const RawImage& image, const Layout& layout,
     return ColorFromRaw(image, layout);
   }
   const absl::string_view kind = layout.format == Format::kPng ? "PNG" : "JPEG";
-  absl::StatusOr<cv::Mat> decoded = DecodeFile(
-      image.compressed, layout, ImageDecodeMode::kColor, field, interrupt);
-  if (!decoded.ok()) return decoded.status();
-  const cv::Mat& bgr = *decoded;
+  FOVEA_ASSIGN_OR_RETURN(cv::Mat decoded,
+                         DecodeFile(image.compressed, layout,
+                                    ImageDecodeMode::kColor, field, interrupt));
+  const cv::Mat& bgr = decoded;
   if (bgr.type() != CV_8UC3 || bgr.cols != static_cast<int>(layout.width) ||
       bgr.rows != static_cast<int>(layout.height)) {
     return absl::InvalidArgumentError(
@@ -444,10 +444,10 @@ absl::StatusOr<cv::Mat> DecodeDepth(const RawImage& image, const Layout& layout,
                                     double scale, absl::string_view field,
                                     const InterruptCheck& interrupt) {
   if (layout.format != Format::kPng) return DepthFromRaw(image, layout, scale);
-  absl::StatusOr<cv::Mat> decoded = DecodeFile(
-      image.compressed, layout, ImageDecodeMode::kAnyDepth, field, interrupt);
-  if (!decoded.ok()) return decoded.status();
-  const cv::Mat& units = *decoded;
+  FOVEA_ASSIGN_OR_RETURN(cv::Mat decoded, DecodeFile(image.compressed, layout,
+                                                     ImageDecodeMode::kAnyDepth,
+                                                     field, interrupt));
+  const cv::Mat& units = decoded;
   if (units.type() != CV_16UC1 ||
       units.cols != static_cast<int>(layout.width) ||
       units.rows != static_cast<int>(layout.height)) {
@@ -490,18 +490,16 @@ absl::StatusOr<RgbdFrame> DecodeValidatedFrame(
   const double scale =
       raw.depth_scale == 0.0 ? kDefaultDepthScale : raw.depth_scale;
 
-  absl::StatusOr<Layout> color_layout =
-      Inspect(raw.color, Slot::kColor, "frame.color", limits);
-  if (!color_layout.ok()) return color_layout.status();
-  absl::StatusOr<Layout> depth_layout =
-      Inspect(raw.depth, Slot::kDepth, "frame.depth", limits);
-  if (!depth_layout.ok()) return depth_layout.status();
-  if (color_layout->width != depth_layout->width ||
-      color_layout->height != depth_layout->height) {
+  FOVEA_ASSIGN_OR_RETURN(Layout color_layout, Inspect(raw.color, Slot::kColor,
+                                                      "frame.color", limits));
+  FOVEA_ASSIGN_OR_RETURN(Layout depth_layout, Inspect(raw.depth, Slot::kDepth,
+                                                      "frame.depth", limits));
+  if (color_layout.width != depth_layout.width ||
+      color_layout.height != depth_layout.height) {
     return absl::InvalidArgumentError(
-        absl::StrCat("frame.depth: ", depth_layout->width, " x ",
-                     depth_layout->height, " does not match frame.color ",
-                     color_layout->width, " x ", color_layout->height));
+        absl::StrCat("frame.depth: ", depth_layout.width, " x ",
+                     depth_layout.height, " does not match frame.color ",
+                     color_layout.width, " x ", color_layout.height));
   }
 
   // A crop can put the principal point outside the image, but the image's
@@ -513,8 +511,8 @@ absl::StatusOr<RgbdFrame> DecodeValidatedFrame(
     uint32_t size;
     double focal;
   } kCentre[] = {
-      {"cx", raw.intrinsics.cx, color_layout->width, raw.intrinsics.fx},
-      {"cy", raw.intrinsics.cy, color_layout->height, raw.intrinsics.fy}};
+      {"cx", raw.intrinsics.cx, color_layout.width, raw.intrinsics.fx},
+      {"cy", raw.intrinsics.cy, color_layout.height, raw.intrinsics.fy}};
   for (const auto& c : kCentre) {
     const double lo = 0.5 * c.size - 10.0 * c.focal;
     const double hi = 0.5 * c.size + 10.0 * c.focal;
@@ -529,19 +527,18 @@ absl::StatusOr<RgbdFrame> DecodeValidatedFrame(
 
   RgbdFrame frame;
   frame.intrinsics = raw.intrinsics;
-  absl::StatusOr<cv::Mat> depth =
-      DecodeDepth(raw.depth, *depth_layout, scale, "frame.depth", interrupt);
-  if (!depth.ok()) return depth.status();
-  if (!HasValidDepth(*depth)) {
+  FOVEA_ASSIGN_OR_RETURN(
+      cv::Mat depth,
+      DecodeDepth(raw.depth, depth_layout, scale, "frame.depth", interrupt));
+  if (!HasValidDepth(depth)) {
     return absl::InvalidArgumentError(
-        absl::StrCat("frame.depth: no valid depth pixel in ", depth->cols,
-                     " x ", depth->rows, " (all 0, NaN, negative or inf)"));
+        absl::StrCat("frame.depth: no valid depth pixel in ", depth.cols, " x ",
+                     depth.rows, " (all 0, NaN, negative or inf)"));
   }
-  frame.depth = *std::move(depth);
-  absl::StatusOr<cv::Mat> color =
-      DecodeColor(raw.color, *color_layout, "frame.color", interrupt);
-  if (!color.ok()) return color.status();
-  frame.color = *std::move(color);
+  frame.depth = std::move(depth);
+  FOVEA_ASSIGN_OR_RETURN(cv::Mat color, DecodeColor(raw.color, color_layout,
+                                                    "frame.color", interrupt));
+  frame.color = std::move(color);
   return frame;
 }
 
@@ -599,14 +596,9 @@ absl::StatusOr<RgbdFrame> DecodeFrame(const RawFrame& raw,
   // Sizes are bounded by `limits` before anything is allocated, so an
   // exception here is an allocation failure or an OpenCV bug; neither may
   // leave core/.
-  try {
+  return Guarded("DecodeFrame", [&]() -> absl::StatusOr<RgbdFrame> {
     return DecodeValidatedFrame(raw, limits, interrupt);
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError(
-        "DecodeFrame: out of memory decoding the frame");
-  } catch (const std::exception& e) {
-    return absl::InternalError(absl::StrCat("DecodeFrame: ", e.what()));
-  }
+  });
 }
 
 }  // namespace fovea

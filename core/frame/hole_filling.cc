@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 
 namespace fovea {
 namespace {
@@ -73,7 +74,7 @@ absl::Status Validate(const HoleFillingOptions& options) {
 
 absl::StatusOr<FilledDepth> FillDepthHoles(const RgbdFrame& frame,
                                            const HoleFillingOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   if (frame.depth.type() != CV_32FC1 || frame.color.type() != CV_8UC3 ||
       frame.depth.size() != frame.color.size()) {
     return absl::InvalidArgumentError(

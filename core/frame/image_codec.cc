@@ -23,6 +23,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
+#include "core/base/guarded.h"
+#include "core/base/status_macros.h"
 #include "core/base/strings.h"
 
 // How this file uses setjmp/longjmp: libpng and libjpeg report errors by
@@ -329,10 +331,10 @@ absl::StatusOr<cv::Mat> DecodePng(absl::string_view file,
 
   const PngPlan plan = PlanPng(state, options.mode);
   const int depth = plan.bit_depth == 16 ? CV_16U : CV_8U;
-  absl::StatusOr<PixelBuffer> buffer = AllocatePixels(
-      state.width, state.height, CV_MAKETYPE(depth, plan.channels));
-  if (!buffer.ok()) return buffer.status();
-  const size_t row_bytes = buffer->image.cols * buffer->image.elemSize();
+  FOVEA_ASSIGN_OR_RETURN(PixelBuffer buffer,
+                         AllocatePixels(state.width, state.height,
+                                        CV_MAKETYPE(depth, plan.channels)));
+  const size_t row_bytes = buffer.image.cols * buffer.image.elemSize();
   if (const std::string bad = CheckPngChunks(file); !bad.empty()) {
     return Undecodable("PNG", file.size(), "structure", bad.c_str(), field);
   }
@@ -344,13 +346,13 @@ absl::StatusOr<cv::Mat> DecodePng(absl::string_view file,
   for (int pass = 0; pass < passes; ++pass) {
     for (png_uint_32 y = 0; y < state.height; y += kPngRowsPerCheck) {
       if (options.interrupt) {
-        if (absl::Status s = options.interrupt(); !s.ok()) return s;
+        FOVEA_RETURN_IF_ERROR(options.interrupt());
       }
       png_uint_32 end = std::min(state.height, y + kPngRowsPerCheck);
       const bool last = pass + 1 == passes && end == state.height;
       if (last && end - y > 1) {
         // All but the last row first, unbounded.
-        if (!PngReadRows(&state, buffer->rows.data(), y, end - 1)) {
+        if (!PngReadRows(&state, buffer.rows.data(), y, end - 1)) {
           return Undecodable("PNG", file.size(), "libpng", state.error.message,
                              field);
         }
@@ -363,7 +365,7 @@ absl::StatusOr<cv::Mat> DecodePng(absl::string_view file,
         state.read_limit =
             state.position + 2 * (row_bytes + 1) + (size_t{64} << 10);
       }
-      if (!PngReadRows(&state, buffer->rows.data(), y, end)) {
+      if (!PngReadRows(&state, buffer.rows.data(), y, end)) {
         return Undecodable("PNG", file.size(), "libpng", state.error.message,
                            field);
       }
@@ -371,8 +373,8 @@ absl::StatusOr<cv::Mat> DecodePng(absl::string_view file,
   }
   const bool one_channel = options.mode == ImageDecodeMode::kGrey ||
                            options.mode == ImageDecodeMode::kAnyDepth;
-  if (one_channel && plan.channels == 3) return ToGrey(buffer->image);
-  return std::move(buffer->image);
+  if (one_channel && plan.channels == 3) return ToGrey(buffer.image);
+  return std::move(buffer.image);
 }
 
 // ------------------------------------------------------------- libjpeg-turbo
@@ -501,14 +503,14 @@ absl::StatusOr<cv::Mat> DecodeJpeg(absl::string_view file,
                      cinfo.num_components == 1);
   cinfo.out_color_space = grey ? JCS_GRAYSCALE : JCS_EXT_BGR;
   const int channels = grey ? 1 : 3;
-  absl::StatusOr<PixelBuffer> buffer = AllocatePixels(
-      cinfo.image_width, cinfo.image_height, CV_MAKETYPE(CV_8U, channels));
-  if (!buffer.ok()) return buffer.status();
-  if (!JpegReadPixels(&state, buffer->rows.data(), channels)) {
+  FOVEA_ASSIGN_OR_RETURN(PixelBuffer buffer,
+                         AllocatePixels(cinfo.image_width, cinfo.image_height,
+                                        CV_MAKETYPE(CV_8U, channels)));
+  if (!JpegReadPixels(&state, buffer.rows.data(), channels)) {
     return Undecodable("JPEG", file.size(), "libjpeg",
                        state.errors.error.message, field);
   }
-  return std::move(buffer->image);
+  return std::move(buffer.image);
 }
 
 // --------------------------------------------------------------- PNG write
@@ -672,7 +674,7 @@ absl::StatusOr<std::string> EncodePng(const cv::Mat& image,
 
   PngWriteState state;
   PngWriteGuard guard{&state};
-  try {
+  return Guarded("EncodePng", [&]() -> absl::StatusOr<std::string> {
     // libpng copies each row before transforming it, so the const image is
     // only read.
     std::vector<png_bytep> rows(image.rows);
@@ -684,11 +686,7 @@ absl::StatusOr<std::string> EncodePng(const cv::Mat& image,
           absl::StrCat("EncodePng: libpng: ", state.error.message));
     }
     return std::string(reinterpret_cast<const char*>(state.bytes), state.size);
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat("EncodePng: out of memory for a ", image.cols, " x ",
-                     image.rows, " image"));
-  }
+  });
 }
 
 }  // namespace fovea

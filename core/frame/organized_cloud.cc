@@ -10,6 +10,7 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 
 namespace fovea {
 namespace {
@@ -251,7 +252,7 @@ void EstimateNormals(const NormalOptions& options, OrganizedCloud& cloud) {
 
 absl::StatusOr<OrganizedCloud> BuildOrganizedCloud(
     const RgbdFrame& frame, const NormalOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   if (frame.depth.empty() || frame.depth.type() != CV_32FC1) {
     return absl::InvalidArgumentError("frame.depth: expected CV_32FC1 metres");
   }

@@ -20,6 +20,8 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
 #include "core/base/check.h"
+#include "core/base/guarded.h"
+#include "core/base/status_macros.h"
 #include "core/frame/frame_decode.h"
 #include "core/frame/pcd_reader.h"
 
@@ -134,40 +136,37 @@ absl::StatusOr<CloudFields> ResolveFields(const PcdCloud& cloud,
       return absl::InvalidArgumentError(
           absl::StrCat(path, ": no '", xyz_names[i], "' field"));
     }
-    absl::StatusOr<FieldReader> reader = resolve(*field, is_float, "TYPE F");
-    if (!reader.ok()) return reader.status();
-    *xyz[i] = *reader;
+    FOVEA_ASSIGN_OR_RETURN(FieldReader reader,
+                           resolve(*field, is_float, "TYPE F"));
+    *xyz[i] = reader;
   }
   if (const PcdField* label = FindPcdField(cloud, "label")) {
-    absl::StatusOr<FieldReader> reader =
-        resolve(*label, is_integer, "TYPE I or U");
-    if (!reader.ok()) return reader.status();
-    fields.label = *reader;
+    FOVEA_ASSIGN_OR_RETURN(FieldReader reader,
+                           resolve(*label, is_integer, "TYPE I or U"));
+    fields.label = reader;
   }
   const PcdField* color = FindPcdField(cloud, "rgba");
   if (color == nullptr) color = FindPcdField(cloud, "rgb");
   if (color != nullptr) {
-    absl::StatusOr<FieldReader> reader =
-        resolve(*color, is_four_bytes, "SIZE 4");
-    if (!reader.ok()) return reader.status();
-    fields.color = *reader;
+    FOVEA_ASSIGN_OR_RETURN(FieldReader reader,
+                           resolve(*color, is_four_bytes, "SIZE 4"));
+    fields.color = reader;
   }
   return fields;
 }
 
 // Reads the cloud and checks that an organized one fits an image.
 absl::StatusOr<PcdCloud> ReadCloud(const std::string& path) {
-  absl::StatusOr<PcdCloud> cloud = ReadPcd(path);
-  if (!cloud.ok()) return cloud.status();
+  FOVEA_ASSIGN_OR_RETURN(PcdCloud cloud, ReadPcd(path));
   // ReadPcd: width, height >= 1 and data of width x height points.
-  FOVEA_CHECK(cloud->width >= 1 && cloud->height >= 1 &&
-              cloud->data.size() ==
-                  uint64_t{cloud->width} * cloud->height * cloud->point_step);
-  if (cloud->height > 1 &&
-      (cloud->width > kMaxImageSide || cloud->height > kMaxImageSide)) {
+  FOVEA_CHECK(cloud.width >= 1 && cloud.height >= 1 &&
+              cloud.data.size() ==
+                  uint64_t{cloud.width} * cloud.height * cloud.point_step);
+  if (cloud.height > 1 &&
+      (cloud.width > kMaxImageSide || cloud.height > kMaxImageSide)) {
     return absl::InvalidArgumentError(
-        absl::StrCat(path, ": organized cloud of ", cloud->width, " x ",
-                     cloud->height, " exceeds ", kMaxImageSide, " on a side"));
+        absl::StrCat(path, ": organized cloud of ", cloud.width, " x ",
+                     cloud.height, " exceeds ", kMaxImageSide, " on a side"));
   }
   return cloud;
 }
@@ -284,16 +283,14 @@ absl::StatusOr<LabelledFrame> LoadOsdPcdUnguarded(const std::string& path,
                                                   int width, int height) {
   absl::Status status = ValidateIntrinsics(intrinsics, "intrinsics");
   if (!status.ok()) return status;
-  absl::StatusOr<PcdCloud> cloud = ReadCloud(path);
-  if (!cloud.ok()) return cloud.status();
-  absl::StatusOr<CloudFields> fields = ResolveFields(*cloud, path);
-  if (!fields.ok()) return fields.status();
+  FOVEA_ASSIGN_OR_RETURN(PcdCloud cloud, ReadCloud(path));
+  FOVEA_ASSIGN_OR_RETURN(CloudFields fields, ResolveFields(cloud, path));
 
   LabelledFrame out;
   out.name = std::filesystem::path(path).stem().string();
   out.frame.intrinsics = intrinsics;
-  if (cloud->height > 1) {
-    CopyOrganized(*cloud, *fields, out);
+  if (cloud.height > 1) {
+    CopyOrganized(cloud, fields, out);
     return out;
   }
   if (width < 1 || height < 1 || width > kMaxImageSide ||
@@ -302,7 +299,7 @@ absl::StatusOr<LabelledFrame> LoadOsdPcdUnguarded(const std::string& path,
         "width x height: ", width, " x ", height, " is not in [1, ",
         kMaxImageSide, "] for re-organizing ", path));
   }
-  ProjectUnorganized(*cloud, *fields, intrinsics, width, height, out);
+  ProjectUnorganized(cloud, fields, intrinsics, width, height, out);
   return out;
 }
 
@@ -311,14 +308,9 @@ absl::StatusOr<LabelledFrame> LoadOsdPcdUnguarded(const std::string& path,
 absl::StatusOr<LabelledFrame> LoadOsdPcd(const std::string& path,
                                          const Intrinsics& intrinsics,
                                          int width, int height) {
-  try {
+  return Guarded(path, [&] {
     return LoadOsdPcdUnguarded(path, intrinsics, width, height);
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat(path, ": out of memory loading the cloud"));
-  } catch (const std::exception& e) {
-    return absl::InternalError(absl::StrCat(path, ": ", e.what()));
-  }
+  });
 }
 
 absl::StatusOr<std::vector<std::string>> ListPcdFiles(const std::string& dir) {

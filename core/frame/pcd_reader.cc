@@ -28,6 +28,8 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/string_view.h"
+#include "core/base/guarded.h"
+#include "core/base/status_macros.h"
 #include "core/frame/lzf.h"
 
 namespace fovea {
@@ -470,24 +472,23 @@ absl::StatusOr<PcdCloud> ReadPcdUnguarded(const std::string& path) {
   std::string head(std::min<uint64_t>(file_size, kMaxPcdHeaderBytes), '\0');
   in.read(head.data(), static_cast<std::streamsize>(head.size()));
   head.resize(static_cast<size_t>(in.gcount()));
-  absl::StatusOr<PcdHeader> header = ParseHeader(head, path);
-  if (!header.ok()) return header.status();
+  FOVEA_ASSIGN_OR_RETURN(PcdHeader header, ParseHeader(head, path));
 
   PcdCloud cloud;
-  cloud.width = static_cast<uint32_t>(header->width);
-  cloud.height = static_cast<uint32_t>(header->height);
-  cloud.point_step = static_cast<uint32_t>(header->point_step);
-  const uint64_t points = header->points;
-  const uint64_t data_bytes = points * header->point_step;
-  const uint64_t body_offset = header->body_offset;
+  cloud.width = static_cast<uint32_t>(header.width);
+  cloud.height = static_cast<uint32_t>(header.height);
+  cloud.point_step = static_cast<uint32_t>(header.point_step);
+  const uint64_t points = header.points;
+  const uint64_t data_bytes = points * header.point_step;
+  const uint64_t body_offset = header.body_offset;
   const uint64_t body = file_size - std::min(body_offset, file_size);
-  switch (header->encoding) {
+  switch (header.encoding) {
     case PcdEncoding::kAscii: {
       // Each value takes at least one character and a separator.
-      if (body + 1 < 2 * header->values * points) {
+      if (body + 1 < 2 * header.values * points) {
         return PcdError(path,
                         absl::StrCat(body, " bytes of ASCII data for ", points,
-                                     " points of ", header->values, " values"));
+                                     " points of ", header.values, " values"));
       }
       if (body > kMaxPcdAsciiBytes) {
         return PcdError(path, absl::StrCat(body, " bytes of ASCII data exceed ",
@@ -499,10 +500,9 @@ absl::StatusOr<PcdCloud> ReadPcdUnguarded(const std::string& path) {
       }
       absl::Status after_data = CheckNoHeaderAfterData(text, path);
       if (!after_data.ok()) return after_data;
-      absl::StatusOr<std::vector<uint8_t>> data =
-          DecodeAscii(text, *header, path);
-      if (!data.ok()) return data.status();
-      cloud.data = *std::move(data);
+      FOVEA_ASSIGN_OR_RETURN(std::vector<uint8_t> data,
+                             DecodeAscii(text, header, path));
+      cloud.data = std::move(data);
       break;
     }
     case PcdEncoding::kBinary: {
@@ -545,15 +545,15 @@ absl::StatusOr<PcdCloud> ReadPcdUnguarded(const std::string& path) {
       }
       absl::Status after_data = CheckNoHeaderAfterData(bytes, path);
       if (!after_data.ok()) return after_data;
-      absl::StatusOr<std::vector<uint8_t>> data =
+      FOVEA_ASSIGN_OR_RETURN(
+          std::vector<uint8_t> data,
           DecodeCompressed(absl::string_view(bytes).substr(sizeof(sizes_le)),
-                           body_offset + sizeof(sizes_le), *header, path);
-      if (!data.ok()) return data.status();
-      cloud.data = *std::move(data);
+                           body_offset + sizeof(sizes_le), header, path));
+      cloud.data = std::move(data);
       break;
     }
   }
-  cloud.fields = std::move(header->fields);
+  cloud.fields = std::move(header.fields);
   return cloud;
 }
 
@@ -587,14 +587,7 @@ const PcdField* FindPcdField(const PcdCloud& cloud, absl::string_view name) {
 }
 
 absl::StatusOr<PcdCloud> ReadPcd(const std::string& path) {
-  try {
-    return ReadPcdUnguarded(path);
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat(path, ": out of memory reading the PCD file"));
-  } catch (const std::exception& e) {
-    return absl::InternalError(absl::StrCat(path, ": ", e.what()));
-  }
+  return Guarded(path, [&] { return ReadPcdUnguarded(path); });
 }
 
 }  // namespace fovea

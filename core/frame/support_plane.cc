@@ -14,6 +14,7 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/frame/support_grid.h"
 
@@ -244,16 +245,11 @@ bool SupportPlane::ProjectsInsideHull(const Eigen::Vector3f& p,
 
 absl::Status Validate(const SupportHints& hints) {
   if (hints.gravity.has_value()) {
-    if (absl::Status s = ValidateUnit(*hints.gravity, "gravity"); !s.ok()) {
-      return s;
-    }
+    FOVEA_RETURN_IF_ERROR(ValidateUnit(*hints.gravity, "gravity"));
   }
   if (hints.plane.has_value()) {
-    if (absl::Status s =
-            ValidateUnit(hints.plane->head<3>(), "support_plane.normal");
-        !s.ok()) {
-      return s;
-    }
+    FOVEA_RETURN_IF_ERROR(
+        ValidateUnit(hints.plane->head<3>(), "support_plane.normal"));
     if (!std::isfinite((*hints.plane)[3])) {
       return absl::InvalidArgumentError(absl::StrCat(
           "support_plane.d: must be finite, got ", (*hints.plane)[3]));
@@ -347,8 +343,8 @@ absl::Status Validate(const SupportPlaneOptions& o) {
 absl::StatusOr<SupportSearch> SearchSupport(const OrganizedCloud& cloud,
                                             const SupportPlaneOptions& options,
                                             const SupportHints& hints) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
-  if (absl::Status s = Validate(hints); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
+  FOVEA_RETURN_IF_ERROR(Validate(hints));
   const Grid grid = support_internal::MakeGrid(cloud, options.grid_columns);
   const float min_cos = std::cos(options.max_normal_angle_deg * kDegToRad);
 
@@ -403,10 +399,10 @@ absl::StatusOr<SupportSearch> SearchSupport(const OrganizedCloud& cloud,
     search.candidates.push_back({c.plane.normal, c.plane.d, c.centroid, c.score,
                                  static_cast<int>(c.indices.size())});
   }
-  absl::StatusOr<SupportPlane> chosen = support_internal::MakeSupportRegion(
-      cloud, grid, candidates[0], options, min_cos);
-  if (!chosen.ok()) return chosen.status();
-  search.chosen = *std::move(chosen);
+  FOVEA_ASSIGN_OR_RETURN(SupportPlane chosen,
+                         support_internal::MakeSupportRegion(
+                             cloud, grid, candidates[0], options, min_cos));
+  search.chosen = std::move(chosen);
   search.chosen.candidate_count = static_cast<int>(candidates.size());
   search.chosen.score = candidates[0].score;
   search.chosen.given = hints.plane.has_value();
@@ -416,9 +412,9 @@ absl::StatusOr<SupportSearch> SearchSupport(const OrganizedCloud& cloud,
 absl::StatusOr<SupportPlane> FindSupportPlane(
     const OrganizedCloud& cloud, const SupportPlaneOptions& options,
     const SupportHints& hints) {
-  absl::StatusOr<SupportSearch> search = SearchSupport(cloud, options, hints);
-  if (!search.ok()) return search.status();
-  return std::move(search->chosen);
+  FOVEA_ASSIGN_OR_RETURN(SupportSearch search,
+                         SearchSupport(cloud, options, hints));
+  return std::move(search.chosen);
 }
 
 absl::StatusOr<SupportPlane> SupportPlaneFromInliers(

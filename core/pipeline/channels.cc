@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/pyramid/feature_pyramid.h"
 #include "core/pyramid/normalization.h"
@@ -90,9 +91,9 @@ absl::StatusOr<const CloudPyramid*> ChannelComputer::Pyramid() {
     if (options_.pyramid == PyramidKind::kNone) {
       levels.max_levels = std::min(levels.max_levels, options_.sym3d_level + 1);
     }
-    absl::StatusOr<CloudPyramid> built = BuildCloudPyramid(cloud_, levels);
-    if (!built.ok()) return built.status();
-    pyramid_ = *std::move(built);
+    FOVEA_ASSIGN_OR_RETURN(CloudPyramid built,
+                           BuildCloudPyramid(cloud_, levels));
+    pyramid_ = std::move(built);
     tables_.assign(pyramid_->size(), std::nullopt);
   }
   return &*pyramid_;
@@ -140,9 +141,8 @@ absl::StatusOr<cv::Mat> ChannelComputer::OperatorAt(SaliencyOp op, int level) {
 
 absl::StatusOr<cv::Mat> ChannelComputer::Compute(SaliencyOp op) {
   if (IsColorOperator(op)) {
-    absl::StatusOr<cv::Mat> map = ColorOperator(op);
-    if (!map.ok()) return map.status();
-    return NormalizeMap(*map, ToMapNormalization(options_.normalization),
+    FOVEA_ASSIGN_OR_RETURN(cv::Mat map, ColorOperator(op));
+    return NormalizeMap(map, ToMapNormalization(options_.normalization),
                         options_.normalization_options);
   }
   if (options_.pyramid != PyramidKind::kNone) {
@@ -153,10 +153,11 @@ absl::StatusOr<cv::Mat> ChannelComputer::Compute(SaliencyOp op) {
                    const OrganizedCloud& /*cloud*/) -> absl::StatusOr<cv::Mat> {
       return OperatorAt(op, level);
     };
-    absl::StatusOr<Conspicuity> conspicuity = BuildConspicuityMap(
-        **pyramid, feature, ToFeaturePyramidOptions(options_));
-    if (!conspicuity.ok()) return conspicuity.status();
-    return OnCandidates(std::move(conspicuity->map));
+    FOVEA_ASSIGN_OR_RETURN(
+        Conspicuity conspicuity,
+        BuildConspicuityMap(**pyramid, feature,
+                            ToFeaturePyramidOptions(options_)));
+    return OnCandidates(std::move(conspicuity.map));
   }
   // Single level: SYM3D needs a kernel the size of an object, so it runs on
   // a coarser level and is resampled to level 0.
@@ -169,10 +170,9 @@ absl::StatusOr<cv::Mat> ChannelComputer::Compute(SaliencyOp op) {
   absl::StatusOr<cv::Mat> map = OperatorAt(op, level);
   if (!map.ok()) return map.status();
   if (level > 0) {
-    absl::StatusOr<cv::Mat> up =
-        ResampleBetweenLevels(*map, level, 0, **Pyramid());
-    if (!up.ok()) return up.status();
-    map = *std::move(up);
+    FOVEA_ASSIGN_OR_RETURN(cv::Mat up,
+                           ResampleBetweenLevels(*map, level, 0, **Pyramid()));
+    map = std::move(up);
   }
   // Level-0 operators give zero off the candidates already; a resampled map
   // is smeared and masked again.

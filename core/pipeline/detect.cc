@@ -8,6 +8,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "core/base/guarded.h"
+#include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/pipeline/channels.h"
 #include "core/pipeline/sensor_adaptation.h"
@@ -202,7 +204,7 @@ absl::Status Validate(const SceneOptions& options) {
 }
 
 absl::Status Validate(const DetectOptions& options) {
-  if (absl::Status s = Validate(options.scene); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options.scene));
   if (options.channels.empty()) {
     return absl::InvalidArgumentError("options.saliency: no channel given");
   }
@@ -244,28 +246,26 @@ absl::Status Validate(const DetectOptions& options) {
         absl::StrCat("options.sym3d_level must be in [0, ", kMaxSym3dLevel,
                      "], got ", options.sym3d_level));
   }
-  if (absl::Status s = Validate(options.hole_filling); !s.ok()) return s;
-  if (absl::Status s = Validate(options.normals); !s.ok()) return s;
-  if (absl::Status s = Validate(options.support_plane); !s.ok()) return s;
-  if (absl::Status s = Validate(options.table_scene); !s.ok()) return s;
-  if (absl::Status s = Validate(options.ph); !s.ok()) return s;
-  if (absl::Status s = Validate(options.sh); !s.ok()) return s;
-  if (absl::Status s = Validate(options.rso); !s.ok()) return s;
-  if (absl::Status s = Validate(options.sym3d); !s.ok()) return s;
-  if (absl::Status s = Validate(options.itti); !s.ok()) return s;
-  if (absl::Status s = Validate(options.harel); !s.ok()) return s;
-  if (absl::Status s = Validate(options.hou); !s.ok()) return s;
-  if (absl::Status s = Validate(options.kootstra); !s.ok()) return s;
-  if (absl::Status s = Validate(options.target_color); !s.ok()) return s;
-  if (absl::Status s = Validate(options.location_prior); !s.ok()) return s;
-  if (absl::Status s = Validate(options.wta); !s.ok()) return s;
-  if (absl::Status s = Validate(options.tj); !s.ok()) return s;
-  if (absl::Status s = Validate(options.surface_edges); !s.ok()) return s;
-  if (absl::Status s = Validate(options.cloud_pyramid); !s.ok()) return s;
-  if (absl::Status s = Validate(options.feature_pyramid); !s.ok()) return s;
-  if (absl::Status s = Validate(options.normalization_options); !s.ok()) {
-    return s;
-  }
+  FOVEA_RETURN_IF_ERROR(Validate(options.hole_filling));
+  FOVEA_RETURN_IF_ERROR(Validate(options.normals));
+  FOVEA_RETURN_IF_ERROR(Validate(options.support_plane));
+  FOVEA_RETURN_IF_ERROR(Validate(options.table_scene));
+  FOVEA_RETURN_IF_ERROR(Validate(options.ph));
+  FOVEA_RETURN_IF_ERROR(Validate(options.sh));
+  FOVEA_RETURN_IF_ERROR(Validate(options.rso));
+  FOVEA_RETURN_IF_ERROR(Validate(options.sym3d));
+  FOVEA_RETURN_IF_ERROR(Validate(options.itti));
+  FOVEA_RETURN_IF_ERROR(Validate(options.harel));
+  FOVEA_RETURN_IF_ERROR(Validate(options.hou));
+  FOVEA_RETURN_IF_ERROR(Validate(options.kootstra));
+  FOVEA_RETURN_IF_ERROR(Validate(options.target_color));
+  FOVEA_RETURN_IF_ERROR(Validate(options.location_prior));
+  FOVEA_RETURN_IF_ERROR(Validate(options.wta));
+  FOVEA_RETURN_IF_ERROR(Validate(options.tj));
+  FOVEA_RETURN_IF_ERROR(Validate(options.surface_edges));
+  FOVEA_RETURN_IF_ERROR(Validate(options.cloud_pyramid));
+  FOVEA_RETURN_IF_ERROR(Validate(options.feature_pyramid));
+  FOVEA_RETURN_IF_ERROR(Validate(options.normalization_options));
   return Validate(options.msr);
 }
 
@@ -277,19 +277,6 @@ absl::StatusOr<DetectResult> DetectOnSceneUnguarded(
     const PreparedScene& scene, const DetectOptions& options,
     const InterruptCheck& interrupt);
 
-// Runs `body`, turning what a library underneath throws into a status
-// (nothing throws out of core/).
-template <typename Body>
-auto Guarded(std::string_view what, Body body) -> decltype(body()) {
-  try {
-    return body();
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat(AbslView(what), ": out of memory"));
-  } catch (const std::exception& e) {
-    return absl::InternalError(absl::StrCat(AbslView(what), ": ", e.what()));
-  }
-}
 }  // namespace
 
 absl::StatusOr<std::vector<AttentionPoint>> ExtractAttentionPoints(
@@ -344,27 +331,26 @@ absl::StatusOr<DetectResult> RunDetect(const RgbdFrame& frame,
                                        const DetectOptions& options,
                                        const InterruptCheck& interrupt) {
   const auto start = std::chrono::steady_clock::now();
-  absl::StatusOr<PreparedScene> scene = PrepareScene(frame, options, interrupt);
-  if (!scene.ok()) return scene.status();
-  absl::StatusOr<DetectResult> result =
-      DetectOnScene(*scene, options, interrupt);
-  if (!result.ok()) return result.status();
-  result->timings.insert(result->timings.begin(), scene->timings.begin(),
-                         scene->timings.end());
+  FOVEA_ASSIGN_OR_RETURN(PreparedScene scene,
+                         PrepareScene(frame, options, interrupt));
+  FOVEA_ASSIGN_OR_RETURN(DetectResult result,
+                         DetectOnScene(scene, options, interrupt));
+  result.timings.insert(result.timings.begin(), scene.timings.begin(),
+                        scene.timings.end());
   // Back to the frame as sent.
-  const FrameScale& scale = scene->scale;
+  const FrameScale& scale = scene.scale;
   if (scale.reduced()) {
-    for (AttentionPoint& p : result->points) {
+    for (AttentionPoint& p : result.points) {
       const cv::Point q = scale.ToInput({p.u, p.v});
       p.u = q.x;
       p.v = q.y;
     }
-    result->master = scale.MapToInput(result->master);
-    for (NamedMap& m : result->channel_maps) m.map = scale.MapToInput(m.map);
-    result->plane.inliers = scale.MaskToInput(result->plane.inliers);
-    result->plane.inlier_count = cv::countNonZero(result->plane.inliers);
+    result.master = scale.MapToInput(result.master);
+    for (NamedMap& m : result.channel_maps) m.map = scale.MapToInput(m.map);
+    result.plane.inliers = scale.MaskToInput(result.plane.inliers);
+    result.plane.inlier_count = cv::countNonZero(result.plane.inliers);
   }
-  result->total_seconds =
+  result.total_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
           .count();
   return result;
@@ -376,7 +362,7 @@ namespace {
 absl::StatusOr<PreparedScene> PrepareSceneUnguarded(
     const RgbdFrame& frame, const DetectOptions& options,
     const InterruptCheck& interrupt) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   PreparedScene scene;
   StageClock clock(scene.timings);
   scene.sensor = SensorModelFor(options.scene.sensor, frame.intrinsics);
@@ -388,11 +374,10 @@ absl::StatusOr<PreparedScene> PrepareSceneUnguarded(
   RgbdFrame filled_frame;
   const RgbdFrame* input = &reduced.frame;
   if (options.fill_holes) {
-    absl::StatusOr<FilledDepth> filled =
-        FillDepthHoles(reduced.frame, options.hole_filling);
-    if (!filled.ok()) return filled.status();
+    FOVEA_ASSIGN_OR_RETURN(FilledDepth filled,
+                           FillDepthHoles(reduced.frame, options.hole_filling));
     filled_frame.color = reduced.frame.color;  // shares the pixels
-    filled_frame.depth = std::move(filled->depth);
+    filled_frame.depth = std::move(filled.depth);
     filled_frame.intrinsics = reduced.frame.intrinsics;
     input = &filled_frame;
     clock.Lap("fill_holes");
@@ -402,19 +387,19 @@ absl::StatusOr<PreparedScene> PrepareSceneUnguarded(
   clock.Lap("cloud");
   EstimateNormals(options.normals, scene.cloud);
   clock.Lap("normals");
-  if (absl::Status s = Check(interrupt); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Check(interrupt));
 
   SupportPlaneOptions support_options = options.support_plane;
   AdaptToSensor(scene.sensor, support_options);
-  absl::StatusOr<SupportPlane> plane =
-      FindSupportPlane(scene.cloud, support_options, options.scene.support);
-  if (!plane.ok()) return plane.status();
-  scene.plane = *std::move(plane);
+  FOVEA_ASSIGN_OR_RETURN(
+      SupportPlane plane,
+      FindSupportPlane(scene.cloud, support_options, options.scene.support));
+  scene.plane = std::move(plane);
   TableSceneOptions table_options = options.table_scene;
   AdaptToSensor(scene.sensor, table_options);
   scene.table = PrepareTableScene(scene.cloud, scene.plane, table_options);
   clock.Lap("support_plane");
-  if (absl::Status s = Check(interrupt); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Check(interrupt));
   return scene;
 }
 
@@ -422,7 +407,7 @@ absl::StatusOr<PreparedScene> PrepareSceneUnguarded(
 absl::StatusOr<DetectResult> DetectOnSceneUnguarded(
     const PreparedScene& scene, const DetectOptions& options,
     const InterruptCheck& interrupt) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   const auto start = std::chrono::steady_clock::now();
   DetectResult result;
   StageClock clock(result.timings);
@@ -431,11 +416,10 @@ absl::StatusOr<DetectResult> DetectOnSceneUnguarded(
   ChannelComputer channels(cloud, scene.plane, scene.table, options);
   std::vector<NamedMap> maps;
   for (const WeightedChannel& c : options.channels) {
-    absl::StatusOr<cv::Mat> map = channels.Compute(c.op);
-    if (!map.ok()) return map.status();
-    maps.push_back({std::string(SaliencyOpName(c.op)), *std::move(map)});
+    FOVEA_ASSIGN_OR_RETURN(cv::Mat map, channels.Compute(c.op));
+    maps.push_back({std::string(SaliencyOpName(c.op)), std::move(map)});
     clock.Lap(absl::StrCat("saliency.", AbslView(SaliencyOpName(c.op))));
-    if (absl::Status s = Check(interrupt); !s.ok()) return s;
+    FOVEA_RETURN_IF_ERROR(Check(interrupt));
   }
   std::vector<cv::Mat> channel_maps;
   std::vector<float> weights;
@@ -443,12 +427,12 @@ absl::StatusOr<DetectResult> DetectOnSceneUnguarded(
     channel_maps.push_back(maps[i].map);
     weights.push_back(options.channels[i].weight);
   }
-  absl::StatusOr<cv::Mat> master =
+  FOVEA_ASSIGN_OR_RETURN(
+      cv::Mat master,
       FuseChannels(channel_maps, weights,
                    options.fusion == FusionKind::kMax ? ChannelFusion::kMax
-                                                      : ChannelFusion::kSum);
-  if (!master.ok()) return master.status();
-  result.master = *std::move(master);
+                                                      : ChannelFusion::kSum));
+  result.master = std::move(master);
   if (options.split_at_surface_edges) {
     result.master.setTo(0.0f, FindSurfaceEdges(cloud, options.surface_edges));
   }
@@ -460,10 +444,9 @@ absl::StatusOr<DetectResult> DetectOnSceneUnguarded(
   const double focal_ratio = cloud.intrinsics.fx / kReferenceFocalPx;
   extraction.tj.min_component_pixels = static_cast<int>(
       std::lround(options.min_region_pixels * focal_ratio * focal_ratio));
-  absl::StatusOr<std::vector<AttentionPoint>> points =
-      ExtractAttentionPoints(result.master, extraction);
-  if (!points.ok()) return points.status();
-  result.points = *std::move(points);
+  FOVEA_ASSIGN_OR_RETURN(std::vector<AttentionPoint> points,
+                         ExtractAttentionPoints(result.master, extraction));
+  result.points = std::move(points);
   FillPoints(cloud, result.points);
   clock.Lap(
       absl::StrCat("extract.", AbslView(ExtractionName(options.extraction))));

@@ -7,6 +7,8 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/guarded.h"
+#include "core/base/status_macros.h"
 
 namespace fovea {
 namespace {
@@ -26,7 +28,7 @@ absl::StatusOr<SegmentSummary> RunUnguarded(const RgbdFrame& frame,
                                             const SegmentSinks& sinks,
                                             const InterruptCheck& interrupt,
                                             SteadyClock::time_point start) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   for (const cv::Point& p : options.attention_points) {
     if (p.x < 0 || p.y < 0 || p.x >= frame.width() || p.y >= frame.height()) {
       return absl::InvalidArgumentError(absl::StrCat(
@@ -39,16 +41,12 @@ absl::StatusOr<SegmentSummary> RunUnguarded(const RgbdFrame& frame,
         "segment-incremental: no relation SVM is loaded");
   }
   SegmentSummary summary;
-  absl::StatusOr<PreparedScene> scene =
-      PrepareScene(frame, options.detect, interrupt);
-  if (!scene.ok()) return scene.status();
-  summary.timings = scene->timings;
+  FOVEA_ASSIGN_OR_RETURN(PreparedScene scene,
+                         PrepareScene(frame, options.detect, interrupt));
+  summary.timings = scene.timings;
   if (sinks.support) {
-    if (absl::Status s =
-            sinks.support(PlaneToInput(scene->scale, scene->plane));
-        !s.ok()) {
-      return s;
-    }
+    FOVEA_RETURN_IF_ERROR(
+        sinks.support(PlaneToInput(scene.scale, scene.plane)));
   }
 
   std::vector<AttentionPoint> points;
@@ -56,45 +54,41 @@ absl::StatusOr<SegmentSummary> RunUnguarded(const RgbdFrame& frame,
   if (!options.attention_points.empty()) {
     const float sigma =
         static_cast<float>(options.attention_sigma_px *
-                           scene->cloud.intrinsics.fx / kReferenceFocalPx);
+                           scene.cloud.intrinsics.fx / kReferenceFocalPx);
     std::vector<cv::Point> attention;
     for (const cv::Point& p : options.attention_points) {
-      attention.push_back(scene->scale.ToProcessing(p));
+      attention.push_back(scene.scale.ToProcessing(p));
     }
     saliency =
-        AttentionPointsSaliency(attention, scene->cloud.xyz.size(), sigma);
+        AttentionPointsSaliency(attention, scene.cloud.xyz.size(), sigma);
     for (const cv::Point& p : attention) {
       AttentionPoint a;
       a.u = p.x;
       a.v = p.y;
       a.saliency = saliency.at<float>(p);
-      const cv::Vec3f& q = scene->cloud.xyz.at<cv::Vec3f>(p);
+      const cv::Vec3f& q = scene.cloud.xyz.at<cv::Vec3f>(p);
       a.point = {q[0], q[1], q[2]};
       points.push_back(a);
     }
   } else {
-    absl::StatusOr<DetectResult> detect =
-        DetectOnScene(*scene, options.detect, interrupt);
-    if (!detect.ok()) return detect.status();
-    summary.timings.insert(summary.timings.end(), detect->timings.begin(),
-                           detect->timings.end());
-    saliency = std::move(detect->master);
-    points = std::move(detect->points);
+    FOVEA_ASSIGN_OR_RETURN(DetectResult detect,
+                           DetectOnScene(scene, options.detect, interrupt));
+    summary.timings.insert(summary.timings.end(), detect.timings.begin(),
+                           detect.timings.end());
+    saliency = std::move(detect.master);
+    points = std::move(detect.points);
   }
   if (sinks.points) {
-    if (absl::Status s = sinks.points(PointsToInput(scene->scale, points));
-        !s.ok()) {
-      return s;
-    }
+    FOVEA_RETURN_IF_ERROR(sinks.points(PointsToInput(scene.scale, points)));
   }
-  if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(CheckInterrupt(interrupt));
 
   SteadyClock::time_point lap = SteadyClock::now();
   const IncOptions& inc_options = options.inc;
-  absl::StatusOr<IncScene> inc = BuildIncScene(
-      scene->cloud, scene->plane, saliency, inc_options, scene->table.region);
-  if (!inc.ok()) return inc.status();
-  IncSegmenter segmenter(*inc, *svm, inc_options);
+  FOVEA_ASSIGN_OR_RETURN(IncScene inc,
+                         BuildIncScene(scene.cloud, scene.plane, saliency,
+                                       inc_options, scene.table.region));
+  IncSegmenter segmenter(inc, *svm, inc_options);
   summary.timings.push_back({"segment.prepare", SecondsSince(lap)});
 
   while (true) {
@@ -107,31 +101,31 @@ absl::StatusOr<SegmentSummary> RunUnguarded(const RgbdFrame& frame,
       summary.stop = SegmentStop::kTimeBudget;
       break;
     }
-    if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
+    FOVEA_RETURN_IF_ERROR(CheckInterrupt(interrupt));
     lap = SteadyClock::now();
-    absl::StatusOr<std::optional<IncObject>> next = segmenter.Next(interrupt);
-    if (!next.ok()) return next.status();
+    FOVEA_ASSIGN_OR_RETURN(std::optional<IncObject> next,
+                           segmenter.Next(interrupt));
     summary.timings.push_back({"segment.object", SecondsSince(lap)});
-    if (!next->has_value()) break;  // the scene is exhausted
-    if (VisibleArea(scene->cloud, (*next)->mask) < options.min_object_area_m2 ||
-        StandingShare(scene->table, (*next)->mask) < kMinStandingShare) {
+    if (!next.has_value()) break;  // the scene is exhausted
+    if (VisibleArea(scene.cloud, next->mask) < options.min_object_area_m2 ||
+        StandingShare(scene.table, next->mask) < kMinStandingShare) {
       continue;  // a fragment, or not on the table: it left the scene, but
                  // is not reported
     }
     SegmentedObject object;
-    object.seed.u = (*next)->seed.x;
-    object.seed.v = (*next)->seed.y;
-    object.seed.saliency = static_cast<float>((*next)->saliency);
-    const cv::Vec3f& q = scene->cloud.xyz.at<cv::Vec3f>((*next)->seed);
+    object.seed.u = next->seed.x;
+    object.seed.v = next->seed.y;
+    object.seed.saliency = static_cast<float>(next->saliency);
+    const cv::Vec3f& q = scene.cloud.xyz.at<cv::Vec3f>(next->seed);
     object.seed.point = {q[0], q[1], q[2]};
-    object.mask = std::move((*next)->mask);
-    object.score = (*next)->score;
-    DescribeObject(scene->cloud, object);
-    ObjectToInput(scene->scale, object);
+    object.mask = std::move(next->mask);
+    object.score = next->score;
+    DescribeObject(scene.cloud, object);
+    ObjectToInput(scene.scale, object);
     object.index = summary.objects++;
     object.seconds_since_start = SecondsSince(start);
     if (sinks.object) {
-      if (absl::Status s = sinks.object(std::move(object)); !s.ok()) return s;
+      FOVEA_RETURN_IF_ERROR(sinks.object(std::move(object)));
     }
   }
   summary.scene_coverage = segmenter.coverage();
@@ -204,31 +198,26 @@ absl::StatusOr<SegmentSummary> RunSegmentIncremental(
     const RbfSvm* relation_svm, const SegmentSinks& sinks,
     const InterruptCheck& interrupt, SteadyClock::time_point start) {
   // Nothing throws out of core/.
-  try {
-    return RunUnguarded(frame, options, relation_svm, sinks, interrupt, start);
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError("segment-incremental: out of memory");
-  } catch (const std::exception& e) {
-    return absl::InternalError(absl::StrCat("segment-incremental: ", e.what()));
-  }
+  return Guarded("segment-incremental",
+                 [&]() -> absl::StatusOr<SegmentSummary> {
+                   return RunUnguarded(frame, options, relation_svm, sinks,
+                                       interrupt, start);
+                 });
 }
 
 absl::StatusOr<std::vector<SvmSample>> CollectIncSamples(
     const LabelledFrame& frame, int group, const DetectOptions& detect,
     const IncOptions& inc) {
-  try {
-    absl::StatusOr<PreparedScene> scene = PrepareScene(frame.frame, detect);
-    if (!scene.ok()) return scene.status();
-    const cv::Mat flat(frame.frame.depth.size(), CV_32FC1, cv::Scalar(0));
-    absl::StatusOr<IncScene> inc_scene = BuildIncScene(
-        scene->cloud, scene->plane, flat, inc, scene->table.region);
-    if (!inc_scene.ok()) return inc_scene.status();
-    return IncTrainingSamples(*inc_scene, frame.labels, group);
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError("inc samples: out of memory");
-  } catch (const std::exception& e) {
-    return absl::InternalError(absl::StrCat("inc samples: ", e.what()));
-  }
+  return Guarded(
+      "inc samples", [&]() -> absl::StatusOr<std::vector<SvmSample>> {
+        FOVEA_ASSIGN_OR_RETURN(PreparedScene scene,
+                               PrepareScene(frame.frame, detect));
+        const cv::Mat flat(frame.frame.depth.size(), CV_32FC1, cv::Scalar(0));
+        FOVEA_ASSIGN_OR_RETURN(IncScene inc_scene,
+                               BuildIncScene(scene.cloud, scene.plane, flat,
+                                             inc, scene.table.region));
+        return IncTrainingSamples(inc_scene, frame.labels, group);
+      });
 }
 
 }  // namespace fovea

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/segmentation/relations.h"
 
@@ -58,10 +59,11 @@ absl::StatusOr<LoadedModels> LoadModels(const std::string& dir) {
   LoadedModels models;
   const std::filesystem::path cos_path =
       std::filesystem::path(dir) / kCosModelFile;
-  absl::StatusOr<std::string> cos_text = ReadModelFile(
-      cos_path, "fovea-train cos --data DIR --out models/cos_svm.txt");
-  if (!cos_text.ok()) return cos_text.status();
-  absl::StatusOr<LinearSvm> cos = LinearSvm::Parse(*cos_text, "cos");
+  FOVEA_ASSIGN_OR_RETURN(
+      std::string cos_text,
+      ReadModelFile(cos_path,
+                    "fovea-train cos --data DIR --out models/cos_svm.txt"));
+  absl::StatusOr<LinearSvm> cos = LinearSvm::Parse(cos_text, "cos");
   if (!cos.ok()) {
     return absl::InvalidArgumentError(
         absl::StrCat("model file ", cos_path.string(),
@@ -78,10 +80,11 @@ absl::StatusOr<LoadedModels> LoadModels(const std::string& dir) {
 
   const std::filesystem::path ebs_path =
       std::filesystem::path(dir) / kEbsModelFile;
-  absl::StatusOr<std::string> ebs_text = ReadModelFile(
-      ebs_path, "fovea-train ebs --data DIR --out models/ebs_edges.txt");
-  if (!ebs_text.ok()) return ebs_text.status();
-  absl::StatusOr<EbsModel> ebs = EbsModel::Parse(*ebs_text);
+  FOVEA_ASSIGN_OR_RETURN(
+      std::string ebs_text,
+      ReadModelFile(ebs_path,
+                    "fovea-train ebs --data DIR --out models/ebs_edges.txt"));
+  absl::StatusOr<EbsModel> ebs = EbsModel::Parse(ebs_text);
   if (!ebs.ok()) {
     return absl::InvalidArgumentError(
         absl::StrCat("model file ", ebs_path.string(),
@@ -92,10 +95,12 @@ absl::StatusOr<LoadedModels> LoadModels(const std::string& dir) {
 
   const std::filesystem::path inc_path =
       std::filesystem::path(dir) / kIncModelFile;
-  absl::StatusOr<std::string> inc_text = ReadModelFile(
-      inc_path, "fovea-train inc --data DIR --out models/inc_relations.txt");
-  if (!inc_text.ok()) return inc_text.status();
-  absl::StatusOr<RbfSvm> inc = RbfSvm::Parse(*inc_text, "inc");
+  FOVEA_ASSIGN_OR_RETURN(
+      std::string inc_text,
+      ReadModelFile(
+          inc_path,
+          "fovea-train inc --data DIR --out models/inc_relations.txt"));
+  absl::StatusOr<RbfSvm> inc = RbfSvm::Parse(inc_text, "inc");
   if (!inc.ok()) {
     return absl::InvalidArgumentError(absl::StrCat(
         "model file ", inc_path.string(),

@@ -12,6 +12,8 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/guarded.h"
+#include "core/base/status_macros.h"
 #include "core/base/strings.h"
 
 namespace fovea {
@@ -164,20 +166,19 @@ class CosCutter final : public ObjectCutter {
   static absl::StatusOr<std::unique_ptr<ObjectCutter>> Create(
       const PreparedScene& scene, const LinearSvm& svm,
       const CosOptions& options) {
-    absl::StatusOr<CosScene> cos =
-        BuildCosScene(scene.cloud, scene.plane, options, scene.table.region);
-    if (!cos.ok()) return cos.status();
+    FOVEA_ASSIGN_OR_RETURN(
+        CosScene cos,
+        BuildCosScene(scene.cloud, scene.plane, options, scene.table.region));
     return std::unique_ptr<ObjectCutter>(
-        new CosCutter(*std::move(cos), svm, options));
+        new CosCutter(std::move(cos), svm, options));
   }
 
   absl::StatusOr<std::optional<CutObject>> Cut(
       cv::Point seed, const InterruptCheck& interrupt) override {
-    absl::StatusOr<std::optional<CosObject>> object =
-        segmenter_.Segment(seed, interrupt);
-    if (!object.ok()) return object.status();
-    if (!object->has_value()) return std::nullopt;
-    return CutObject{std::move((*object)->mask), (*object)->score};
+    FOVEA_ASSIGN_OR_RETURN(std::optional<CosObject> object,
+                           segmenter_.Segment(seed, interrupt));
+    if (!object.has_value()) return std::nullopt;
+    return CutObject{std::move(object->mask), object->score};
   }
 
  private:
@@ -220,11 +221,11 @@ class EbsCutter final : public ObjectCutter {
   absl::StatusOr<std::optional<CutObject>> Cut(
       cv::Point seed, const InterruptCheck& interrupt) override {
     if (allowed_.at<unsigned char>(seed) == 0) return std::nullopt;
-    absl::StatusOr<PolarContour> contour =
-        FindPolarContour(probability_, seed, options_, interrupt);
-    if (!contour.ok()) return contour.status();
+    FOVEA_ASSIGN_OR_RETURN(
+        PolarContour contour,
+        FindPolarContour(probability_, seed, options_, interrupt));
     CutObject object;
-    object.mask = FillPolarContour(*contour, probability_.size()) & allowed_;
+    object.mask = FillPolarContour(contour, probability_.size()) & allowed_;
     const int area = cv::countNonZero(object.mask);
     if (area == 0) return std::nullopt;
     for (const cv::Mat& earlier : masks_) {
@@ -233,7 +234,7 @@ class EbsCutter final : public ObjectCutter {
       if (both > kSameObjectIou * either) return std::nullopt;
     }
     masks_.push_back(object.mask);
-    object.score = MeanAlongContour(*contour);
+    object.score = MeanAlongContour(contour);
     return object;
   }
 
@@ -286,18 +287,17 @@ absl::StatusOr<std::vector<AttentionPoint>> TakeSeeds(
     }
     return seeds;
   }
-  absl::StatusOr<DetectResult> detect =
-      DetectOnScene(scene, options.detect, interrupt);
-  if (!detect.ok()) return detect.status();
-  timings.insert(timings.end(), detect->timings.begin(), detect->timings.end());
-  return std::move(detect->points);
+  FOVEA_ASSIGN_OR_RETURN(DetectResult detect,
+                         DetectOnScene(scene, options.detect, interrupt));
+  timings.insert(timings.end(), detect.timings.begin(), detect.timings.end());
+  return std::move(detect.points);
 }
 
 absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
     const RgbdFrame& frame, const SegmentOptions& options,
     const SegmentModels& models, const SegmentSinks& sinks,
     const InterruptCheck& interrupt, SteadyClock::time_point start) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   for (const cv::Point& p : options.seeds) {
     if (p.x < 0 || p.y < 0 || p.x >= frame.width() || p.y >= frame.height()) {
       return absl::InvalidArgumentError(
@@ -312,80 +312,70 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
     return absl::FailedPreconditionError("segment: no EBS model is loaded");
   }
   SegmentSummary summary;
-  absl::StatusOr<PreparedScene> scene =
-      PrepareScene(frame, options.detect, interrupt);
-  if (!scene.ok()) return scene.status();
-  summary.timings = scene->timings;
+  FOVEA_ASSIGN_OR_RETURN(PreparedScene scene,
+                         PrepareScene(frame, options.detect, interrupt));
+  summary.timings = scene.timings;
   if (sinks.support) {
-    if (absl::Status s =
-            sinks.support(PlaneToInput(scene->scale, scene->plane));
-        !s.ok()) {
-      return s;
-    }
+    FOVEA_RETURN_IF_ERROR(
+        sinks.support(PlaneToInput(scene.scale, scene.plane)));
   }
 
-  absl::StatusOr<std::vector<AttentionPoint>> seeds =
-      TakeSeeds(*scene, options, interrupt, summary.timings);
-  if (!seeds.ok()) return seeds.status();
+  FOVEA_ASSIGN_OR_RETURN(std::vector<AttentionPoint> seeds,
+                         TakeSeeds(scene, options, interrupt, summary.timings));
   if (sinks.points) {
-    if (absl::Status s = sinks.points(PointsToInput(scene->scale, *seeds));
-        !s.ok()) {
-      return s;
-    }
+    FOVEA_RETURN_IF_ERROR(sinks.points(PointsToInput(scene.scale, seeds)));
   }
-  if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(CheckInterrupt(interrupt));
 
   SteadyClock::time_point lap = SteadyClock::now();
   std::unique_ptr<ObjectCutter> cutter;
   if (options.method == SegmentMethod::kCos) {
-    absl::StatusOr<std::unique_ptr<ObjectCutter>> cos =
-        CosCutter::Create(*scene, *models.cos, options.cos);
-    if (!cos.ok()) return cos.status();
-    cutter = *std::move(cos);
+    FOVEA_ASSIGN_OR_RETURN(std::unique_ptr<ObjectCutter> cos,
+                           CosCutter::Create(scene, *models.cos, options.cos));
+    cutter = std::move(cos);
   } else {
     cutter =
-        std::make_unique<EbsCutter>(*scene, *models.ebs, options.ebs_contour);
+        std::make_unique<EbsCutter>(scene, *models.ebs, options.ebs_contour);
   }
   summary.timings.push_back({"segment.prepare", SecondsSince(lap)});
 
   const cv::Mat region =
-      ObjectRegion(scene->table, options.detect.table_scene.min_object_height);
+      ObjectRegion(scene.table, options.detect.table_scene.min_object_height);
   cv::Mat covered(region.size(), CV_8UC1, cv::Scalar(0));
   // Cuts the object at `seed`; false when it yields none to report. A cover
   // seed's object is what no earlier mask holds.
   const auto cut_and_send = [&](const AttentionPoint& seed, bool cover,
                                 const char* stage) -> absl::StatusOr<bool> {
     const SteadyClock::time_point at = SteadyClock::now();
-    absl::StatusOr<std::optional<CutObject>> cut =
-        cutter->Cut({seed.u, seed.v}, interrupt);
-    if (!cut.ok()) return cut.status();
+    FOVEA_ASSIGN_OR_RETURN(std::optional<CutObject> cut,
+                           cutter->Cut({seed.u, seed.v}, interrupt));
     summary.timings.push_back({stage, SecondsSince(at)});
-    if (!cut->has_value()) return false;
-    if (cover) (*cut)->mask.setTo(0, covered);
-    if (VisibleArea(scene->cloud, (*cut)->mask) < options.min_object_area_m2 ||
-        StandingShare(scene->table, (*cut)->mask) < kMinStandingShare) {
+    if (!cut.has_value()) return false;
+    if (cover) cut->mask.setTo(0, covered);
+    if (VisibleArea(scene.cloud, cut->mask) < options.min_object_area_m2 ||
+        StandingShare(scene.table, cut->mask) < kMinStandingShare) {
       return false;  // a fragment, or not on the table
     }
     SegmentedObject object;
     object.seed = seed;
-    object.mask = std::move((*cut)->mask);
-    object.score = (*cut)->score;
-    DescribeObject(scene->cloud, object);
+    object.mask = std::move(cut->mask);
+    object.score = cut->score;
+    DescribeObject(scene.cloud, object);
     covered.setTo(255, object.mask);
-    ObjectToInput(scene->scale, object);
+    ObjectToInput(scene.scale, object);
     object.index = summary.objects++;
     object.seconds_since_start = SecondsSince(start);
     if (sinks.object) {
-      if (absl::Status s = sinks.object(std::move(object)); !s.ok()) return s;
+      FOVEA_RETURN_IF_ERROR(sinks.object(std::move(object)));
     }
     return true;
   };
   const auto full = [&] {
     return options.max_objects > 0 && summary.objects >= options.max_objects;
   };
-  for (const AttentionPoint& seed : *seeds) {
+  for (const AttentionPoint& seed : seeds) {
     if (full()) break;
-    if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
+    FOVEA_RETURN_IF_ERROR(CheckInterrupt(interrupt));
     if (absl::StatusOr<bool> sent = cut_and_send(seed, false, "segment.object");
         !sent.ok()) {
       return sent.status();
@@ -394,22 +384,21 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
   if (options.cover_scene.value_or(options.seeds.empty())) {
     // Standing pixels off surface edges; each cover seed's piece is tried
     // once, so this ends after at most one seed per piece.
-    cv::Mat tried =
-        FindSurfaceEdges(scene->cloud, options.detect.surface_edges);
-    tried.setTo(255, scene->table.standing == 0);
+    cv::Mat tried = FindSurfaceEdges(scene.cloud, options.detect.surface_edges);
+    tried.setTo(255, scene.table.standing == 0);
     int cover_seeds = 0;
     while (!full() && cover_seeds < kMaxAttentionPoints) {
-      if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
+      FOVEA_RETURN_IF_ERROR(CheckInterrupt(interrupt));
       cv::Mat piece;
       const std::optional<cv::Point> at = CoverSeed(
-          scene->cloud, ~(tried | covered), options.min_object_area_m2, piece);
+          scene.cloud, ~(tried | covered), options.min_object_area_m2, piece);
       if (!at.has_value()) break;
       ++cover_seeds;
       tried.setTo(255, piece);
       AttentionPoint seed;
       seed.u = at->x;
       seed.v = at->y;
-      const cv::Vec3f& q = scene->cloud.xyz.at<cv::Vec3f>(*at);
+      const cv::Vec3f& q = scene.cloud.xyz.at<cv::Vec3f>(*at);
       seed.point = {q[0], q[1], q[2]};
       if (absl::StatusOr<bool> sent = cut_and_send(seed, true, "segment.cover");
           !sent.ok()) {
@@ -478,30 +467,23 @@ absl::StatusOr<SegmentSummary> RunSegment(const RgbdFrame& frame,
                                           SteadyClock::time_point start) {
   // Nothing throws out of core/: OpenCV, qhull's wrapper and the standard
   // library can.
-  try {
+  return Guarded("segment", [&]() -> absl::StatusOr<SegmentSummary> {
     return RunSegmentUnguarded(frame, options, models, sinks, interrupt, start);
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError("segment: out of memory");
-  } catch (const std::exception& e) {
-    return absl::InternalError(absl::StrCat("segment: ", e.what()));
-  }
+  });
 }
 
 absl::StatusOr<std::vector<SvmSample>> CollectCosSamples(
     const LabelledFrame& frame, int group, const DetectOptions& detect,
     const CosOptions& cos) {
-  try {
-    absl::StatusOr<PreparedScene> scene = PrepareScene(frame.frame, detect);
-    if (!scene.ok()) return scene.status();
-    absl::StatusOr<CosScene> cos_scene =
-        BuildCosScene(scene->cloud, scene->plane, cos, scene->table.region);
-    if (!cos_scene.ok()) return cos_scene.status();
-    return CosTrainingSamples(*cos_scene, frame.labels, group, cos);
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError("cos samples: out of memory");
-  } catch (const std::exception& e) {
-    return absl::InternalError(absl::StrCat("cos samples: ", e.what()));
-  }
+  return Guarded(
+      "cos samples", [&]() -> absl::StatusOr<std::vector<SvmSample>> {
+        FOVEA_ASSIGN_OR_RETURN(PreparedScene scene,
+                               PrepareScene(frame.frame, detect));
+        FOVEA_ASSIGN_OR_RETURN(
+            CosScene cos_scene,
+            BuildCosScene(scene.cloud, scene.plane, cos, scene.table.region));
+        return CosTrainingSamples(cos_scene, frame.labels, group, cos);
+      });
 }
 
 }  // namespace fovea

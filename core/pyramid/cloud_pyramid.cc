@@ -11,6 +11,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
+#include "core/base/guarded.h"
+#include "core/base/status_macros.h"
 
 namespace fovea {
 namespace {
@@ -206,25 +208,21 @@ Intrinsics DownsampleIntrinsics(const Intrinsics& intrinsics) {
 }
 
 absl::StatusOr<OrganizedCloud> DownsampleCloud(const OrganizedCloud& cloud) {
-  if (absl::Status s = ValidateCloud(cloud); !s.ok()) return s;
-  try {
+  FOVEA_RETURN_IF_ERROR(ValidateCloud(cloud));
+  return Guarded("DownsampleCloud", [&]() -> absl::StatusOr<OrganizedCloud> {
     std::vector<float> scratch;
     return Downsample(cloud, scratch);
-  } catch (const cv::Exception& e) {
-    return absl::InternalError(absl::StrCat("DownsampleCloud: ", e.what()));
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError("DownsampleCloud: out of memory");
-  }
+  });
 }
 
 absl::StatusOr<CloudPyramid> BuildCloudPyramid(
     const OrganizedCloud& cloud, const CloudPyramidOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
-  if (absl::Status s = ValidateCloud(cloud); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
+  FOVEA_RETURN_IF_ERROR(ValidateCloud(cloud));
   CloudPyramid pyramid;
   pyramid.levels.reserve(options.max_levels);
   pyramid.levels.push_back(cloud);  // cv::Mat headers: shares the pixels
-  try {
+  return Guarded("BuildCloudPyramid", [&]() -> absl::StatusOr<CloudPyramid> {
     std::vector<float> scratch;
     while (pyramid.size() < options.max_levels) {
       const OrganizedCloud& last = pyramid.levels.back();
@@ -235,12 +233,8 @@ absl::StatusOr<CloudPyramid> BuildCloudPyramid(
       OrganizedCloud next = Downsample(last, scratch);
       pyramid.levels.push_back(std::move(next));
     }
-  } catch (const cv::Exception& e) {
-    return absl::InternalError(absl::StrCat("BuildCloudPyramid: ", e.what()));
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError("BuildCloudPyramid: out of memory");
-  }
-  return pyramid;
+    return std::move(pyramid);
+  });
 }
 
 }  // namespace fovea

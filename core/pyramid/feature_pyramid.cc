@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/guarded.h"
+#include "core/base/status_macros.h"
 
 namespace fovea {
 namespace {
@@ -44,17 +46,17 @@ class FeatureCache {
 
   absl::StatusOr<cv::Mat> Get(int level) {
     if (maps_[level].has_value()) return *maps_[level];
-    absl::StatusOr<cv::Mat> map = feature_(level, pyramid_.levels[level]);
-    if (!map.ok()) return map.status();
+    FOVEA_ASSIGN_OR_RETURN(cv::Mat map,
+                           feature_(level, pyramid_.levels[level]));
     const cv::Size expected = LevelSize(pyramid_, level);
-    if (map->type() != CV_32FC1 || map->size() != expected) {
+    if (map.type() != CV_32FC1 || map.size() != expected) {
       return absl::InvalidArgumentError(
           absl::StrCat("feature map of level ", level, " must be CV_32FC1 ",
                        expected.width, "x", expected.height, ", got type ",
-                       map->type(), " ", map->cols, "x", map->rows));
+                       map.type(), " ", map.cols, "x", map.rows));
     }
-    maps_[level] = *map;
-    return *std::move(map);
+    maps_[level] = map;
+    return std::move(map);
   }
 
  private:
@@ -87,13 +89,12 @@ absl::StatusOr<cv::Mat> FeatureMap(const FeatureScale& scale,
                                    FeatureCache& cache) {
   absl::StatusOr<cv::Mat> centre = cache.Get(scale.centre);
   if (!centre.ok() || scale.surround < 0) return centre;
-  absl::StatusOr<cv::Mat> surround = cache.Get(scale.surround);
-  if (!surround.ok()) return surround.status();
-  absl::StatusOr<cv::Mat> moved =
-      ResampleBetweenLevels(*surround, scale.surround, scale.centre, pyramid);
-  if (!moved.ok()) return moved.status();
+  FOVEA_ASSIGN_OR_RETURN(cv::Mat surround, cache.Get(scale.surround));
+  FOVEA_ASSIGN_OR_RETURN(
+      cv::Mat moved,
+      ResampleBetweenLevels(surround, scale.surround, scale.centre, pyramid));
   cv::Mat difference;
-  cv::absdiff(*centre, *moved, difference);
+  cv::absdiff(*centre, moved, difference);
   return difference;
 }
 
@@ -126,23 +127,22 @@ absl::StatusOr<Conspicuity> Build(const CloudPyramid& pyramid,
   FeatureCache cache(pyramid, feature);
   cv::Mat combined;
   for (const FeatureScale& scale : result.scales) {
-    absl::StatusOr<cv::Mat> map = FeatureMap(scale, pyramid, cache);
-    if (!map.ok()) return map.status();
-    absl::StatusOr<cv::Mat> normalised = NormalizeMap(
-        *map, options.normalization, options.normalization_options);
-    if (!normalised.ok()) return normalised.status();
-    absl::StatusOr<cv::Mat> moved = ResampleBetweenLevels(
-        *normalised, scale.centre, result.output_level, pyramid);
-    if (!moved.ok()) return moved.status();
-    Combine(*moved, options.combination, combined);
+    FOVEA_ASSIGN_OR_RETURN(cv::Mat map, FeatureMap(scale, pyramid, cache));
+    FOVEA_ASSIGN_OR_RETURN(cv::Mat normalised,
+                           NormalizeMap(map, options.normalization,
+                                        options.normalization_options));
+    FOVEA_ASSIGN_OR_RETURN(cv::Mat moved,
+                           ResampleBetweenLevels(normalised, scale.centre,
+                                                 result.output_level, pyramid));
+    Combine(moved, options.combination, combined);
   }
-  absl::StatusOr<cv::Mat> full =
-      ResampleBetweenLevels(combined, result.output_level, 0, pyramid);
-  if (!full.ok()) return full.status();
-  absl::StatusOr<cv::Mat> map = NormalizeMap(
-      cv::max(*full, 0.0f), MapNormalization::kLin, NormalizationOptions{});
-  if (!map.ok()) return map.status();
-  result.map = *std::move(map);
+  FOVEA_ASSIGN_OR_RETURN(
+      cv::Mat full,
+      ResampleBetweenLevels(combined, result.output_level, 0, pyramid));
+  FOVEA_ASSIGN_OR_RETURN(
+      cv::Mat map, NormalizeMap(cv::max(full, 0.0f), MapNormalization::kLin,
+                                NormalizationOptions{}));
+  result.map = std::move(map);
   return result;
 }
 
@@ -154,19 +154,11 @@ absl::Status Validate(const FeaturePyramidOptions& options) {
         absl::StrCat("feature_pyramid.output_level must be in [0, ", kMaxLevel,
                      "], got ", options.output_level));
   }
-  if (absl::Status s =
-          ValidateLevels(options.simple_levels, "simple_levels", 0);
-      !s.ok()) {
-    return s;
-  }
-  if (absl::Status s = ValidateLevels(options.itti_centres, "itti_centres", 0);
-      !s.ok()) {
-    return s;
-  }
-  if (absl::Status s = ValidateLevels(options.itti_deltas, "itti_deltas", 1);
-      !s.ok()) {
-    return s;
-  }
+  FOVEA_RETURN_IF_ERROR(
+      ValidateLevels(options.simple_levels, "simple_levels", 0));
+  FOVEA_RETURN_IF_ERROR(
+      ValidateLevels(options.itti_centres, "itti_centres", 0));
+  FOVEA_RETURN_IF_ERROR(ValidateLevels(options.itti_deltas, "itti_deltas", 1));
   return Validate(options.normalization_options);
 }
 
@@ -184,7 +176,7 @@ absl::StatusOr<cv::Mat> ResampleBetweenLevels(const cv::Mat& map, int from,
         absl::StrCat("map to resample must be CV_32FC1 ", size.width, "x",
                      size.height, " (level ", from, ")"));
   }
-  try {
+  return Guarded("ResampleBetweenLevels", [&]() -> absl::StatusOr<cv::Mat> {
     cv::Mat out = map;
     for (int l = from; l < to; ++l) {
       cv::Mat next;
@@ -197,29 +189,21 @@ absl::StatusOr<cv::Mat> ResampleBetweenLevels(const cv::Mat& map, int from,
       out = std::move(next);
     }
     return from == to ? map.clone() : out;
-  } catch (const cv::Exception& e) {
-    return absl::InternalError(
-        absl::StrCat("ResampleBetweenLevels: ", e.what()));
-  }
+  });
 }
 
 absl::StatusOr<Conspicuity> BuildConspicuityMap(
     const CloudPyramid& pyramid, const LevelFeature& feature,
     const FeaturePyramidOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   if (pyramid.levels.empty()) {
     return absl::InvalidArgumentError("the cloud pyramid has no levels");
   }
   if (!feature) {
     return absl::InvalidArgumentError("the level feature function is empty");
   }
-  try {
-    return Build(pyramid, feature, options);
-  } catch (const cv::Exception& e) {
-    return absl::InternalError(absl::StrCat("BuildConspicuityMap: ", e.what()));
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError("BuildConspicuityMap: out of memory");
-  }
+  return Guarded("BuildConspicuityMap",
+                 [&] { return Build(pyramid, feature, options); });
 }
 
 }  // namespace fovea

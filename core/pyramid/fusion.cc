@@ -6,6 +6,8 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "core/base/guarded.h"
+#include "core/base/status_macros.h"
 
 namespace fovea {
 namespace {
@@ -50,8 +52,8 @@ absl::Status ValidateInputs(const std::vector<cv::Mat>& maps,
 absl::StatusOr<cv::Mat> FuseChannels(const std::vector<cv::Mat>& maps,
                                      const std::vector<float>& weights,
                                      ChannelFusion fusion) {
-  if (absl::Status s = ValidateInputs(maps, weights); !s.ok()) return s;
-  try {
+  FOVEA_RETURN_IF_ERROR(ValidateInputs(maps, weights));
+  return Guarded("FuseChannels", [&]() -> absl::StatusOr<cv::Mat> {
     double norm = 0.0;
     for (float w : weights) {
       norm =
@@ -72,11 +74,7 @@ absl::StatusOr<cv::Mat> FuseChannels(const std::vector<cv::Mat>& maps,
       first = false;
     }
     return out;
-  } catch (const cv::Exception& e) {
-    return absl::InternalError(absl::StrCat("FuseChannels: ", e.what()));
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError("FuseChannels: out of memory");
-  }
+  });
 }
 
 }  // namespace fovea

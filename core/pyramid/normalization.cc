@@ -9,6 +9,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
+#include "core/base/guarded.h"
+#include "core/base/status_macros.h"
 
 namespace fovea {
 namespace {
@@ -161,13 +163,13 @@ std::vector<LocalMaximum> FindLocalMaxima(const cv::Mat& map, float min_value,
 
 absl::StatusOr<cv::Mat> NormalizeMap(const cv::Mat& map, MapNormalization kind,
                                      const NormalizationOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   if (map.empty()) return cv::Mat();
   if (map.type() != CV_32FC1) {
     return absl::InvalidArgumentError("map must be CV_32FC1");
   }
-  if (absl::Status s = CheckValues(map); !s.ok()) return s;
-  try {
+  FOVEA_RETURN_IF_ERROR(CheckValues(map));
+  return Guarded("NormalizeMap", [&]() -> absl::StatusOr<cv::Mat> {
     double max_value = 0.0;
     cv::minMaxLoc(map, nullptr, &max_value);
     if (max_value <= 0.0) return cv::Mat(cv::Mat::zeros(map.size(), CV_32FC1));
@@ -181,11 +183,7 @@ absl::StatusOr<cv::Mat> NormalizeMap(const cv::Mat& map, MapNormalization kind,
                              : NlmFactor(maxima, options.nlm_range);
     scaled *= factor;
     return scaled;
-  } catch (const cv::Exception& e) {
-    return absl::InternalError(absl::StrCat("NormalizeMap: ", e.what()));
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError("NormalizeMap: out of memory");
-  }
+  });
 }
 
 }  // namespace fovea

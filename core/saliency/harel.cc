@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/guarded.h"
+#include "core/base/status_macros.h"
 #include "core/saliency/saliency_map.h"
 
 namespace fovea {
@@ -294,7 +296,7 @@ absl::Status Validate(const HarelOptions& options) {
       {"gabor_sigma_px", options.gabor_sigma_px},
   };
   for (const auto& [field, value] : positive) {
-    if (absl::Status s = CheckPositiveFinite(field, value); !s.ok()) return s;
+    FOVEA_RETURN_IF_ERROR(CheckPositiveFinite(field, value));
   }
   if (options.max_iterations < 1) {
     return absl::InvalidArgumentError(absl::StrCat(
@@ -309,19 +311,17 @@ absl::Status Validate(const HarelOptions& options) {
         absl::StrCat("harel.gabor_wavelength_px must be >= 2, got ",
                      options.gabor_wavelength_px));
   }
-  if (absl::Status s = CheckGaborKernelSize("harel", options.gabor_kernel_size);
-      !s.ok()) {
-    return s;
-  }
+  FOVEA_RETURN_IF_ERROR(
+      CheckGaborKernelSize("harel", options.gabor_kernel_size));
   return CheckFeatureWeights("harel", options.intensity_weight,
                              options.color_weight, options.orientation_weight);
 }
 
 absl::StatusOr<cv::Mat> ComputeHarelSaliency(const cv::Mat& color,
                                              const HarelOptions& options) {
-  if (absl::Status s = CheckColorImage(color); !s.ok()) return s;
-  if (absl::Status s = Validate(options); !s.ok()) return s;
-  try {
+  FOVEA_RETURN_IF_ERROR(CheckColorImage(color));
+  FOVEA_RETURN_IF_ERROR(Validate(options));
+  return Guarded("harel", [&]() -> absl::StatusOr<cv::Mat> {
     const cv::Mat grid_map = ComputeGridMap(color, options);
     cv::Mat map;
     cv::resize(grid_map, map, color.size(), 0, 0, cv::INTER_LINEAR);
@@ -333,9 +333,7 @@ absl::StatusOr<cv::Mat> ComputeHarelSaliency(const cv::Mat& color,
     }
     StretchToUnit(map, kRelativeFlatTolerance);
     return map;
-  } catch (const cv::Exception& e) {
-    return absl::InternalError(absl::StrCat("harel: OpenCV: ", e.what()));
-  }
+  });
 }
 
 }  // namespace fovea

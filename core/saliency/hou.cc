@@ -6,6 +6,8 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/guarded.h"
+#include "core/base/status_macros.h"
 #include "core/saliency/saliency_map.h"
 
 namespace fovea {
@@ -81,9 +83,9 @@ absl::Status Validate(const HouOptions& options) {
 
 absl::StatusOr<cv::Mat> ComputeHouSaliency(const cv::Mat& color,
                                            const HouOptions& options) {
-  if (absl::Status s = CheckColorImage(color); !s.ok()) return s;
-  if (absl::Status s = Validate(options); !s.ok()) return s;
-  try {
+  FOVEA_RETURN_IF_ERROR(CheckColorImage(color));
+  FOVEA_RETURN_IF_ERROR(Validate(options));
+  return Guarded("hou", [&]() -> absl::StatusOr<cv::Mat> {
     const cv::Mat grey = WorkingGrey(color, options.working_width);
     cv::Mat signal = grey;
     if (options.mirror_border) {
@@ -98,9 +100,7 @@ absl::StatusOr<cv::Mat> ComputeHouSaliency(const cv::Mat& color,
                0, 0, cv::INTER_LINEAR);
     StretchToUnit(map, kRelativeFlatTolerance);
     return map;
-  } catch (const cv::Exception& e) {
-    return absl::InternalError(absl::StrCat("hou: OpenCV: ", e.what()));
-  }
+  });
 }
 
 }  // namespace fovea

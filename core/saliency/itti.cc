@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/guarded.h"
+#include "core/base/status_macros.h"
 #include "core/saliency/saliency_map.h"
 
 namespace fovea {
@@ -250,36 +252,26 @@ absl::Status Validate(const IttiOptions& options) {
     return absl::InvalidArgumentError(absl::StrCat(
         "itti.gabor_sigma_px must be > 0, got ", options.gabor_sigma_px));
   }
-  if (absl::Status s = CheckGaborKernelSize("itti", options.gabor_kernel_size);
-      !s.ok()) {
-    return s;
-  }
-  if (absl::Status s = CheckFraction("color_intensity_threshold",
-                                     options.color_intensity_threshold);
-      !s.ok()) {
-    return s;
-  }
-  if (absl::Status s =
-          CheckFraction("local_max_threshold", options.local_max_threshold);
-      !s.ok()) {
-    return s;
-  }
+  FOVEA_RETURN_IF_ERROR(
+      CheckGaborKernelSize("itti", options.gabor_kernel_size));
+  FOVEA_RETURN_IF_ERROR(CheckFraction("color_intensity_threshold",
+                                      options.color_intensity_threshold));
+  FOVEA_RETURN_IF_ERROR(
+      CheckFraction("local_max_threshold", options.local_max_threshold));
   return CheckFeatureWeights("itti", options.intensity_weight,
                              options.color_weight, options.orientation_weight);
 }
 
 absl::StatusOr<cv::Mat> ComputeIttiSaliency(const cv::Mat& color,
                                             const IttiOptions& options) {
-  if (absl::Status s = CheckColorImage(color); !s.ok()) return s;
-  if (absl::Status s = Validate(options); !s.ok()) return s;
-  try {
+  FOVEA_RETURN_IF_ERROR(CheckColorImage(color));
+  FOVEA_RETURN_IF_ERROR(Validate(options));
+  return Guarded("itti", [&]() -> absl::StatusOr<cv::Mat> {
     const cv::Mat master = ComputeMasterMap(color, options);
     cv::Mat map;
     cv::resize(master, map, color.size(), 0, 0, cv::INTER_LINEAR);
     return StretchToUnitAbsolute(map);
-  } catch (const cv::Exception& e) {
-    return absl::InternalError(absl::StrCat("itti: OpenCV: ", e.what()));
-  }
+  });
 }
 
 }  // namespace fovea

@@ -6,6 +6,8 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/guarded.h"
+#include "core/base/status_macros.h"
 #include "core/saliency/saliency_map.h"
 
 namespace fovea {
@@ -164,9 +166,9 @@ absl::Status Validate(const KootstraOptions& options) {
 
 absl::StatusOr<cv::Mat> ComputeKootstraSaliency(
     const cv::Mat& color, const KootstraOptions& options) {
-  if (absl::Status s = CheckColorImage(color); !s.ok()) return s;
-  if (absl::Status s = Validate(options); !s.ok()) return s;
-  try {
+  FOVEA_RETURN_IF_ERROR(CheckColorImage(color));
+  FOVEA_RETURN_IF_ERROR(Validate(options));
+  return Guarded("kootstra", [&]() -> absl::StatusOr<cv::Mat> {
     cv::Mat grey8, level;
     cv::cvtColor(color, grey8, cv::COLOR_RGB2GRAY);
     grey8.convertTo(level, CV_32F);
@@ -193,9 +195,7 @@ absl::StatusOr<cv::Mat> ComputeKootstraSaliency(
     }
     StretchToUnit(map, kRelativeFlatTolerance);
     return map;
-  } catch (const cv::Exception& e) {
-    return absl::InternalError(absl::StrCat("kootstra: OpenCV: ", e.what()));
-  }
+  });
 }
 
 }  // namespace fovea

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 #include "core/saliency/saliency_map.h"
 
 namespace fovea {
@@ -19,7 +20,7 @@ absl::Status Validate(const PhOptions& options) {
 
 absl::StatusOr<cv::Mat> ComputePhSaliency(const TableScene& scene,
                                           const PhOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   const int w = scene.height.cols, h = scene.height.rows;
   cv::Mat map(h, w, CV_32FC1, cv::Scalar(0));
   float tallest = 0.0f;

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 #include "core/saliency/saliency_map.h"
 
 namespace fovea {
@@ -26,7 +27,7 @@ absl::StatusOr<cv::Mat> ComputeRsoSaliency(const OrganizedCloud& cloud,
                                            const SupportPlane& plane,
                                            const TableScene& scene,
                                            const RsoOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   const int w = cloud.width(), h = cloud.height();
   cv::Mat map(h, w, CV_32FC1, cv::Scalar(0));
   const float preferred = options.preferred_angle_deg * kDegToRad;

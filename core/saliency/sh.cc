@@ -9,6 +9,7 @@
 
 #include "absl/container/flat_hash_map.h"
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 #include "core/saliency/saliency_map.h"
 
 namespace fovea {
@@ -137,7 +138,7 @@ absl::StatusOr<cv::Mat> ComputeShSaliency(const OrganizedCloud& cloud,
                                           const SupportPlane& plane,
                                           const TableScene& scene,
                                           const ShOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   const int w = cloud.width(), h = cloud.height();
   cv::Mat map(h, w, CV_32FC1, cv::Scalar(0));
   std::vector<PlanePoint> pts;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 #include "core/saliency/saliency_map.h"
 
 namespace fovea {
@@ -137,7 +138,7 @@ absl::Status Validate(const Sym3dOptions& options) {
 absl::StatusOr<cv::Mat> ComputeSym3dSaliency(const OrganizedCloud& cloud,
                                              const TableScene& scene,
                                              const Sym3dOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   if (scene.candidate.size() != cloud.xyz.size()) {
     return absl::InvalidArgumentError(
         "sym3d: table scene and cloud differ in size");

@@ -6,6 +6,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/lab.h"
+#include "core/base/status_macros.h"
 #include "core/saliency/saliency_map.h"
 
 namespace fovea {
@@ -20,7 +21,7 @@ absl::Status Validate(const TargetColorOptions& options) {
 
 absl::StatusOr<cv::Mat> ComputeTargetColorSaliency(
     const cv::Mat& color, const TargetColorOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   if (color.empty() || color.type() != CV_8UC3) {
     return absl::InvalidArgumentError("color: must be a non-empty CV_8UC3");
   }
@@ -63,7 +64,7 @@ absl::Status Validate(const LocationPriorOptions& options) {
 
 absl::StatusOr<cv::Mat> ComputeLocationPrior(
     int width, int height, const LocationPriorOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   if (width <= 0 || height <= 0) {
     return absl::InvalidArgumentError(
         absl::StrCat("location_prior: bad map size ", width, " x ", height));

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 #include "core/frame/osd_pcd.h"
 
 namespace fovea {
@@ -204,12 +205,11 @@ absl::StatusOr<CosScene> BuildCosScene(const OrganizedCloud& cloud,
                                        const SupportPlane& plane,
                                        const CosOptions& options,
                                        const cv::Mat& region) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
-  absl::StatusOr<PlanarPatches> patches =
-      FindPlanarPatches(cloud, region, options.patches);
-  if (!patches.ok()) return patches.status();
+  FOVEA_RETURN_IF_ERROR(Validate(options));
+  FOVEA_ASSIGN_OR_RETURN(PlanarPatches patches,
+                         FindPlanarPatches(cloud, region, options.patches));
   CosScene scene;
-  scene.patches = *std::move(patches);
+  scene.patches = std::move(patches);
   const int n = static_cast<int>(scene.patches.patches.size());
   scene.histograms =
       LabelColorHistograms(cloud.color, scene.patches.labels, n, options.color);
@@ -338,7 +338,7 @@ absl::StatusOr<std::optional<CosObject>> CosSegmenter::Segment(
   if (object.empty()) return std::nullopt;
   double min_margin = std::numeric_limits<double>::infinity();
   while (static_cast<int>(object.size()) < options_.max_object_patches) {
-    if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
+    FOVEA_RETURN_IF_ERROR(CheckInterrupt(interrupt));
     int best = -1;
     double best_margin = options_.min_decision;
     for (const int q : Frontier(scene_, object, owner_)) {

@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
+#include "core/base/status_macros.h"
 #include "core/base/strings.h"
 
 namespace fovea {
@@ -144,8 +145,8 @@ absl::Status Validate(const CueBins& bins) {
 }
 
 absl::Status Validate(const EbsTrainOptions& options) {
-  if (absl::Status s = Validate(options.edge_maps); !s.ok()) return s;
-  if (absl::Status s = Validate(options.normals); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options.edge_maps));
+  FOVEA_RETURN_IF_ERROR(Validate(options.normals));
   const std::pair<const char*, const CueBins*> bins[] = {
       {"color_bins", &options.color_bins},
       {"depth_bins", &options.depth_bins},
@@ -250,24 +251,25 @@ EbsTrainer::EbsTrainer(const EbsTrainOptions& options) : options_(options) {
 }
 
 absl::StatusOr<EbsTrainer> EbsTrainer::Create(const EbsTrainOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   return EbsTrainer(options);
 }
 
 absl::Status EbsTrainer::Add(const LabelledFrame& frame) {
-  absl::StatusOr<OrganizedCloud> cloud = CloudOf(&frame, options_.normals);
-  if (!cloud.ok()) return cloud.status();
-  return Add(*cloud, frame.labels);
+  FOVEA_ASSIGN_OR_RETURN(OrganizedCloud cloud,
+                         CloudOf(&frame, options_.normals));
+  return Add(cloud, frame.labels);
 }
 
 absl::Status EbsTrainer::Add(const OrganizedCloud& cloud,
                              const cv::Mat& labels) {
-  if (absl::Status s = CheckFrame(labels, cloud); !s.ok()) return s;
-  absl::StatusOr<cv::Mat> boundary = BoundaryLabels(
-      labels, cloud.xyz, options_.boundary_band_px, options_.ignore_band_px);
-  if (!boundary.ok()) return boundary.status();
+  FOVEA_RETURN_IF_ERROR(CheckFrame(labels, cloud));
+  FOVEA_ASSIGN_OR_RETURN(
+      cv::Mat boundary,
+      BoundaryLabels(labels, cloud.xyz, options_.boundary_band_px,
+                     options_.ignore_band_px));
   const EdgeMaps maps = ComputeEdgeMaps(cloud, options_.edge_maps);
-  CountPixels(maps, *boundary, cues_);
+  CountPixels(maps, boundary, cues_);
   return absl::OkStatus();
 }
 
@@ -294,15 +296,14 @@ absl::StatusOr<EbsModel> EbsTrainer::Finish() const {
 absl::StatusOr<EbsModel> EbsModel::Train(
     const std::vector<const LabelledFrame*>& frames,
     const EbsTrainOptions& options) {
-  absl::StatusOr<EbsTrainer> trainer = EbsTrainer::Create(options);
-  if (!trainer.ok()) return trainer.status();
+  FOVEA_ASSIGN_OR_RETURN(EbsTrainer trainer, EbsTrainer::Create(options));
   for (const LabelledFrame* frame : frames) {
     if (frame == nullptr) {
       return absl::InvalidArgumentError("ebs: a frame is null");
     }
-    if (absl::Status s = trainer->Add(*frame); !s.ok()) return s;
+    FOVEA_RETURN_IF_ERROR(trainer.Add(*frame));
   }
-  return trainer->Finish();
+  return trainer.Finish();
 }
 
 absl::StatusOr<EbsModel> EbsModel::Train(
@@ -316,7 +317,7 @@ absl::StatusOr<EbsModel> EbsModel::Train(
 
 absl::StatusOr<EbsModel> EbsModel::FromCounts(
     const EbsTrainOptions& options, const std::array<Cue, kCues>& cues) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   EbsModel model;
   model.options_ = options;
   model.cues_ = cues;
@@ -401,17 +402,18 @@ cv::Mat EbsModel::EdgeProbability(const OrganizedCloud& cloud) const {
 
 absl::StatusOr<EbsEvaluation> EbsModel::Evaluate(const OrganizedCloud& cloud,
                                                  const cv::Mat& labels) const {
-  if (absl::Status s = CheckFrame(labels, cloud); !s.ok()) return s;
-  absl::StatusOr<cv::Mat> boundary = BoundaryLabels(
-      labels, cloud.xyz, options_.boundary_band_px, options_.ignore_band_px);
-  if (!boundary.ok()) return boundary.status();
+  FOVEA_RETURN_IF_ERROR(CheckFrame(labels, cloud));
+  FOVEA_ASSIGN_OR_RETURN(
+      cv::Mat boundary,
+      BoundaryLabels(labels, cloud.xyz, options_.boundary_band_px,
+                     options_.ignore_band_px));
   const EdgeMaps maps = ComputeEdgeMaps(cloud, options_.edge_maps);
   const cv::Mat p = EdgeProbability(maps);
   EbsEvaluation result;
   EdgeCounts* per_cue[kCues] = {&result.color, &result.depth,
                                 &result.curvature};
   for (int v = 0; v < p.rows; ++v) {
-    const uint8_t* b = boundary->ptr<uint8_t>(v);
+    const uint8_t* b = boundary.ptr<uint8_t>(v);
     const float* fused = p.ptr<float>(v);
     for (int u = 0; u < p.cols; ++u) {
       if (b[u] == kLeftOut) continue;
@@ -432,14 +434,13 @@ absl::StatusOr<EbsEvaluation> EbsModel::Evaluate(
     const std::vector<const LabelledFrame*>& frames) const {
   EbsEvaluation total;
   for (const LabelledFrame* frame : frames) {
-    absl::StatusOr<OrganizedCloud> cloud = CloudOf(frame, options_.normals);
-    if (!cloud.ok()) return cloud.status();
-    absl::StatusOr<EbsEvaluation> one = Evaluate(*cloud, frame->labels);
-    if (!one.ok()) return one.status();
+    FOVEA_ASSIGN_OR_RETURN(OrganizedCloud cloud,
+                           CloudOf(frame, options_.normals));
+    FOVEA_ASSIGN_OR_RETURN(EbsEvaluation one, Evaluate(cloud, frame->labels));
     EdgeCounts* sums[] = {&total.color, &total.depth, &total.curvature,
                           &total.fused};
-    const EdgeCounts* parts[] = {&one->color, &one->depth, &one->curvature,
-                                 &one->fused};
+    const EdgeCounts* parts[] = {&one.color, &one.depth, &one.curvature,
+                                 &one.fused};
     for (int i = 0; i < 4; ++i) {
       sums[i]->true_edge += parts[i]->true_edge;
       sums[i]->missed_edge += parts[i]->missed_edge;

@@ -10,6 +10,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/segmentation/ebs.h"
 
@@ -68,18 +69,17 @@ class LineReader {
   // returns the values.
   absl::StatusOr<std::vector<std::string_view>> NextFields(
       std::string_view keyword, const std::vector<std::string_view>& keys) {
-    absl::StatusOr<std::vector<std::string_view>> tokens = Next(keyword);
-    if (!tokens.ok()) return tokens.status();
-    if (tokens->size() != 1 + 2 * keys.size()) {
+    FOVEA_ASSIGN_OR_RETURN(std::vector<std::string_view> tokens, Next(keyword));
+    if (tokens.size() != 1 + 2 * keys.size()) {
       return Error(absl::StrCat("expected ", keys.size(), " fields"));
     }
     std::vector<std::string_view> values;
     for (size_t i = 0; i < keys.size(); ++i) {
-      if ((*tokens)[1 + 2 * i] != keys[i]) {
+      if ((tokens)[1 + 2 * i] != keys[i]) {
         return Error(
             absl::StrCat("expected field \"", AbslView(keys[i]), "\""));
       }
-      values.push_back((*tokens)[2 + 2 * i]);
+      values.push_back((tokens)[2 + 2 * i]);
     }
     return values;
   }
@@ -128,15 +128,15 @@ absl::Status ParseBool(const LineReader& in, std::string_view text,
 // One histogram line "keyword c_0 ... c_{bins-1}".
 absl::Status ParseCounts(LineReader& in, std::string_view keyword, int bins,
                          std::vector<int64_t>& counts) {
-  absl::StatusOr<std::vector<std::string_view>> tokens = in.Next(keyword);
-  if (!tokens.ok()) return tokens.status();
-  if (tokens->size() != static_cast<size_t>(bins) + 1) {
+  FOVEA_ASSIGN_OR_RETURN(std::vector<std::string_view> tokens,
+                         in.Next(keyword));
+  if (tokens.size() != static_cast<size_t>(bins) + 1) {
     return in.Error(absl::StrCat(AbslView(keyword), ": expected ", bins,
-                                 " counts, got ", tokens->size() - 1));
+                                 " counts, got ", tokens.size() - 1));
   }
   counts.assign(bins, 0);
   for (int i = 0; i < bins; ++i) {
-    const std::string_view t = (*tokens)[i + 1];
+    const std::string_view t = (tokens)[i + 1];
     if (t[0] == '-') {
       return in.Error(
           absl::StrCat(AbslView(keyword), " count ", i, " is negative"));
@@ -197,9 +197,9 @@ absl::StatusOr<EbsModel> EbsModel::Parse(std::string_view text) {
         absl::StrCat("ebs model: the first line must be \"", kMagic,
                      "\"; this is not an EBS model"));
   }
-  absl::StatusOr<std::vector<std::string_view>> version = in.Next("version");
-  if (!version.ok()) return version.status();
-  if (version->size() != 2 || (*version)[1] != "1") {
+  FOVEA_ASSIGN_OR_RETURN(std::vector<std::string_view> version,
+                         in.Next("version"));
+  if (version.size() != 2 || (version)[1] != "1") {
     return in.Error(
         absl::StrCat("unsupported format version; this reads "
                      "version ",
@@ -246,35 +246,28 @@ absl::StatusOr<EbsModel> EbsModel::Parse(std::string_view text) {
   CueBins* option_bins[kCues] = {&options.color_bins, &options.depth_bins,
                                  &options.curvature_bins};
   for (int c = 0; c < kCues; ++c) {
-    absl::StatusOr<std::vector<std::string_view>> t = in.Next("cue");
-    if (!t.ok()) return t.status();
-    if (t->size() != 8 || (*t)[1] != EbsModel::kCueNames[c] ||
-        (*t)[2] != "bins" || (*t)[4] != "max_value" || (*t)[6] != "signed") {
+    FOVEA_ASSIGN_OR_RETURN(std::vector<std::string_view> t, in.Next("cue"));
+    if (t.size() != 8 || (t)[1] != EbsModel::kCueNames[c] || (t)[2] != "bins" ||
+        (t)[4] != "max_value" || (t)[6] != "signed") {
       return in.Error(absl::StrCat("expected \"cue ", EbsModel::kCueNames[c],
                                    " bins <n> max_value <x> signed <0|1>\""));
     }
     CueBins& bins = cues[c].bins;
-    for (absl::Status s : {ParseInt(in, (*t)[3], "bins", bins.bins),
-                           ParseFloat(in, (*t)[5], "max_value", bins.max_value),
-                           ParseBool(in, (*t)[7], "signed", bins.signed_cue)}) {
+    for (absl::Status s : {ParseInt(in, (t)[3], "bins", bins.bins),
+                           ParseFloat(in, (t)[5], "max_value", bins.max_value),
+                           ParseBool(in, (t)[7], "signed", bins.signed_cue)}) {
       if (!s.ok()) return s;
     }
     if (absl::Status s = Validate(bins); !s.ok()) {
       return in.Error(absl::StrCat(EbsModel::kCueNames[c], " ", s.message()));
     }
     *option_bins[c] = bins;
-    if (absl::Status s = ParseCounts(in, "edge", bins.bins, cues[c].edge);
-        !s.ok()) {
-      return s;
-    }
-    if (absl::Status s = ParseCounts(in, "no_edge", bins.bins, cues[c].no_edge);
-        !s.ok()) {
-      return s;
-    }
+    FOVEA_RETURN_IF_ERROR(ParseCounts(in, "edge", bins.bins, cues[c].edge));
+    FOVEA_RETURN_IF_ERROR(
+        ParseCounts(in, "no_edge", bins.bins, cues[c].no_edge));
   }
-  absl::StatusOr<std::vector<std::string_view>> end = in.Next("end");
-  if (!end.ok()) return end.status();
-  if (end->size() != 1 || !in.AtEnd()) {
+  FOVEA_ASSIGN_OR_RETURN(std::vector<std::string_view> end, in.Next("end"));
+  if (end.size() != 1 || !in.AtEnd()) {
     return in.Error("text after \"end\"");
   }
   absl::StatusOr<EbsModel> model = FromCounts(options, cues);

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 
 namespace fovea {
 namespace {
@@ -75,17 +76,16 @@ absl::StatusOr<IncScene> BuildIncScene(const OrganizedCloud& cloud,
                                        const cv::Mat& saliency_map,
                                        const IncOptions& options,
                                        const cv::Mat& region) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   if (saliency_map.type() != CV_32FC1 ||
       saliency_map.size() != cloud.xyz.size()) {
     return absl::InvalidArgumentError(
         "saliency map must be CV_32FC1 of the cloud's size");
   }
-  absl::StatusOr<CosScene> surfaces =
-      BuildCosScene(cloud, plane, options.surfaces, region);
-  if (!surfaces.ok()) return surfaces.status();
+  FOVEA_ASSIGN_OR_RETURN(CosScene surfaces,
+                         BuildCosScene(cloud, plane, options.surfaces, region));
   IncScene scene;
-  scene.surfaces = *std::move(surfaces);
+  scene.surfaces = std::move(surfaces);
   const cv::Mat& labels = scene.surfaces.patches.labels;
   const int n = static_cast<int>(scene.surfaces.patches.patches.size());
   scene.relations = std::make_unique<RelationComputer>(
@@ -283,7 +283,7 @@ absl::StatusOr<std::optional<IncObject>> IncSegmenter::Next(
     std::vector<int> selection = {seed};
     std::vector<int> group = {seed};
     for (int step = 0; step < options_.max_growth_steps; ++step) {
-      if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
+      FOVEA_RETURN_IF_ERROR(CheckInterrupt(interrupt));
       std::set<int> grown(selection.begin(), selection.end());
       for (const int s : selection) {
         for (const int t : scene_.surfaces.neighbours[s]) {

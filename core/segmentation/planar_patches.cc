@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 
 namespace fovea {
 namespace {
@@ -96,7 +97,7 @@ absl::Status Validate(const PlanarPatchOptions& options) {
 absl::StatusOr<PlanarPatches> FindPlanarPatches(
     const OrganizedCloud& cloud, const cv::Mat& mask,
     const PlanarPatchOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   const int w = cloud.width(), h = cloud.height();
   if (!mask.empty() &&
       (mask.type() != CV_8UC1 || mask.rows != h || mask.cols != w)) {

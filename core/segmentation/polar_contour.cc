@@ -10,6 +10,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
+#include "core/base/guarded.h"
+#include "core/base/status_macros.h"
 
 namespace fovea {
 namespace {
@@ -110,7 +112,7 @@ absl::StatusOr<std::vector<float>> RunPass(
   from.assign(static_cast<size_t>(steps) * n, 0);
   for (int s = 0; s < steps; ++s) {
     if (s % options.interrupt_every_angles == 0) {
-      if (absl::Status st = CheckInterrupt(interrupt); !st.ok()) return st;
+      FOVEA_RETURN_IF_ERROR(CheckInterrupt(interrupt));
     }
     const float* cost = costs.ptr<float>((first + s + 1) % grid.angles);
     int16_t* back = from.data() + static_cast<size_t>(s) * n;
@@ -160,7 +162,7 @@ absl::StatusOr<PolarContour> SolveClosedContour(
                            options.radial_step_px);
   grid.dtheta = static_cast<float>(2.0 * M_PI / options.angles);
   FOVEA_CHECK(grid.radii >= 1 && grid.radii <= 32767);
-  if (absl::Status s = CheckInterrupt(interrupt); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(CheckInterrupt(interrupt));
   const cv::Mat costs = SampleCosts(edge_probability, seed, grid, options);
   const std::vector<int> jumps = MaxJumps(grid, options);
   const cv::Mat factors = LengthFactors(grid, jumps, options);
@@ -253,7 +255,7 @@ absl::Status Validate(const PolarContourOptions& options) {
 absl::StatusOr<PolarContour> FindPolarContour(
     const cv::Mat& edge_probability, cv::Point seed,
     const PolarContourOptions& options, const InterruptCheck& interrupt) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   if (edge_probability.empty() || edge_probability.type() != CV_32FC1) {
     return absl::InvalidArgumentError(
         "polar_contour: edge_probability must be a non-empty CV_32FC1 map");
@@ -264,13 +266,9 @@ absl::StatusOr<PolarContour> FindPolarContour(
         "polar_contour: seed (", seed.x, ", ", seed.y, ") is outside the ",
         edge_probability.cols, " x ", edge_probability.rows, " map"));
   }
-  try {
+  return Guarded("polar_contour", [&]() -> absl::StatusOr<PolarContour> {
     return SolveClosedContour(edge_probability, seed, options, interrupt);
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError("polar_contour: out of memory");
-  } catch (const std::exception& e) {
-    return absl::InternalError(absl::StrCat("polar_contour: ", e.what()));
-  }
+  });
 }
 
 cv::Mat FillPolarContour(const PolarContour& contour, cv::Size size) {
@@ -296,10 +294,10 @@ absl::StatusOr<cv::Mat> SegmentAtFixation(const cv::Mat& edge_probability,
                                           cv::Point seed,
                                           const PolarContourOptions& options,
                                           const InterruptCheck& interrupt) {
-  absl::StatusOr<PolarContour> contour =
-      FindPolarContour(edge_probability, seed, options, interrupt);
-  if (!contour.ok()) return contour.status();
-  return FillPolarContour(*contour, edge_probability.size());
+  FOVEA_ASSIGN_OR_RETURN(
+      PolarContour contour,
+      FindPolarContour(edge_probability, seed, options, interrupt));
+  return FillPolarContour(contour, edge_probability.size());
 }
 
 }  // namespace fovea

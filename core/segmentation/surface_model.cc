@@ -12,6 +12,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
+#include "core/base/status_macros.h"
 #include "core/segmentation/cubic_bspline.h"
 
 namespace fovea {
@@ -501,12 +502,9 @@ class SplineProblem {
     model.spline = frame_;
     model.spline.nu = nu;
     model.spline.nv = nv;
-    if (absl::Status st = SolveControl(fit_, Basis(fit_u_, fit_.u, nu, 0),
+    FOVEA_RETURN_IF_ERROR(SolveControl(fit_, Basis(fit_u_, fit_.u, nu, 0),
                                        Basis(fit_v_, fit_.v, nv, 1), nu, nv,
-                                       options_, model.spline.control);
-        !st.ok()) {
-      return st;
-    }
+                                       options_, model.spline.control));
     const DirectionBasis& bu = Basis(eval_u_, eval_.u, nu, 0);
     const DirectionBasis& bv = Basis(eval_v_, eval_.v, nv, 1);
     // As AddResidual, from the tabulated bases and in squares: with
@@ -611,9 +609,8 @@ absl::StatusOr<SurfaceModel> BSplineOf(
               bound) {
         continue;
       }
-      absl::StatusOr<SurfaceModel> m = problem.Fit(gu, gv);
-      if (!m.ok()) return m.status();
-      if (!grown.ok() || m->description_length < grown->description_length) {
+      FOVEA_ASSIGN_OR_RETURN(SurfaceModel m, problem.Fit(gu, gv));
+      if (!grown.ok() || m.description_length < grown->description_length) {
         grown = std::move(m);
       }
     }
@@ -743,28 +740,25 @@ float SurfaceModel::Distance(const Eigen::Vector3f& p) const {
 absl::StatusOr<SurfaceModel> FitPlaneModel(
     const std::vector<Eigen::Vector3f>& points,
     const SurfaceModelOptions& options) {
-  if (absl::Status st = Validate(options); !st.ok()) return st;
-  absl::StatusOr<Samples> s = BuildSamples({&points}, options);
-  if (!s.ok()) return s.status();
-  return PlaneOf(*s, options);
+  FOVEA_RETURN_IF_ERROR(Validate(options));
+  FOVEA_ASSIGN_OR_RETURN(Samples s, BuildSamples({&points}, options));
+  return PlaneOf(s, options);
 }
 
 absl::StatusOr<SurfaceModel> FitBSplineModel(
     const std::vector<Eigen::Vector3f>& points,
     const SurfaceModelOptions& options) {
-  if (absl::Status st = Validate(options); !st.ok()) return st;
-  absl::StatusOr<Samples> s = BuildSamples({&points}, options);
-  if (!s.ok()) return s.status();
-  return BSplineOf(*s, options);
+  FOVEA_RETURN_IF_ERROR(Validate(options));
+  FOVEA_ASSIGN_OR_RETURN(Samples s, BuildSamples({&points}, options));
+  return BSplineOf(s, options);
 }
 
 absl::StatusOr<SurfaceModel> FitSurface(
     const std::vector<Eigen::Vector3f>& points,
     const SurfaceModelOptions& options) {
-  if (absl::Status st = Validate(options); !st.ok()) return st;
-  absl::StatusOr<Samples> s = BuildSamples({&points}, options);
-  if (!s.ok()) return s.status();
-  return ChooseModel(*s, options);
+  FOVEA_RETURN_IF_ERROR(Validate(options));
+  FOVEA_ASSIGN_OR_RETURN(Samples s, BuildSamples({&points}, options));
+  return ChooseModel(s, options);
 }
 
 absl::StatusOr<FusionVerdict> ShouldFuse(const std::vector<Eigen::Vector3f>& a,
@@ -772,25 +766,23 @@ absl::StatusOr<FusionVerdict> ShouldFuse(const std::vector<Eigen::Vector3f>& a,
                                          const std::vector<Eigen::Vector3f>& b,
                                          const SurfaceModel& model_b,
                                          const SurfaceModelOptions& options) {
-  if (absl::Status st = Validate(options); !st.ok()) return st;
-  absl::StatusOr<Samples> s = BuildSamples({&a, &b}, options);
-  if (!s.ok()) return s.status();
-  absl::StatusOr<SurfaceModel> fused = ChooseModel(*s, options);
-  if (!fused.ok()) return fused.status();
+  FOVEA_RETURN_IF_ERROR(Validate(options));
+  FOVEA_ASSIGN_OR_RETURN(Samples s, BuildSamples({&a, &b}, options));
+  FOVEA_ASSIGN_OR_RETURN(SurfaceModel fused, ChooseModel(s, options));
   // The two models apart, measured on the same held-out points.
   DataCode apart(options);
-  for (size_t i = 0; i < s->eval.size(); ++i) {
-    AddResidual(s->eval_stratum[i] == 0 ? model_a : model_b, s->eval[i],
-                s->eval_weight[i], apart);
+  for (size_t i = 0; i < s.eval.size(); ++i) {
+    AddResidual(s.eval_stratum[i] == 0 ? model_a : model_b, s.eval[i],
+                s.eval_weight[i], apart);
   }
   const double apart_bits =
-      ParameterBits(s->stratum_finite[0], model_a.parameters, options) +
-      ParameterBits(s->stratum_finite[1], model_b.parameters, options) +
+      ParameterBits(s.stratum_finite[0], model_a.parameters, options) +
+      ParameterBits(s.stratum_finite[1], model_b.parameters, options) +
       apart.bits();
   FusionVerdict verdict;
-  verdict.saving_bits = apart_bits - fused->description_length;
+  verdict.saving_bits = apart_bits - fused.description_length;
   verdict.fuse = verdict.saving_bits > options.fusion_bias_bits;
-  verdict.fused = *std::move(fused);
+  verdict.fused = std::move(fused);
   return verdict;
 }
 

@@ -19,6 +19,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
+#include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/synth/random.h"
 
@@ -246,7 +247,7 @@ absl::Status Validate(const RoomOptions& options) {
                      "1920x1080, got ",
                      options.width, "x", options.height));
   }
-  if (absl::Status s = Validate(options.clutter); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options.clutter));
   for (const float p :
        {options.second_table_probability, options.same_height_probability}) {
     if (!(p >= 0.0f && p <= 1.0f)) {

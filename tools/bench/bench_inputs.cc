@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/frame/image_codec.h"
 #include "core/frame/osd_pcd.h"
@@ -223,11 +224,10 @@ void AddPileScenes(int objects, int count, uint64_t first_seed,
 
 absl::Status AddOsdScenes(const std::string& osd_dir, int max_scenes,
                           SceneList& scenes) {
-  absl::StatusOr<std::vector<std::string>> files =
-      ListPcdFiles(osd_dir + "/learn");
-  if (!files.ok()) return files.status();
+  FOVEA_ASSIGN_OR_RETURN(std::vector<std::string> files,
+                         ListPcdFiles(osd_dir + "/learn"));
   int added = 0;
-  for (const std::string& path : *files) {
+  for (const std::string& path : files) {
     if (max_scenes > 0 && added >= max_scenes) break;
     absl::StatusOr<LabelledFrame> loaded = LoadOsdPcd(path);
     if (!loaded.ok()) {

@@ -11,6 +11,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/time.h"
+#include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/pipeline/detect.h"
 #include "fovea/v1/perception.grpc.pb.h"
@@ -45,18 +46,17 @@ absl::StatusOr<Loopback*> StartLoopback() {
   server::ServerConfig config;
   config.listen = "127.0.0.1:0";
   config.concurrency = 1;
-  absl::StatusOr<std::unique_ptr<server::FoveaServer>> started =
-      server::FoveaServer::Start(config);
-  if (!started.ok()) return started.status();
+  FOVEA_ASSIGN_OR_RETURN(std::unique_ptr<server::FoveaServer> started,
+                         server::FoveaServer::Start(config));
   const auto deadline = std::chrono::steady_clock::now() + kWarmUpTimeout;
-  while (!(*started)->warmed_up()) {
+  while (!started->warmed_up()) {
     if (std::chrono::steady_clock::now() > deadline) {
       return absl::DeadlineExceededError("server warm-up did not finish");
     }
     std::this_thread::sleep_for(kWarmUpPoll);
   }
   auto made = std::make_unique<Loopback>();
-  made->server = *std::move(started);
+  made->server = std::move(started);
   made->stub = v1::Perception::NewStub(
       grpc::CreateChannel(absl::StrCat("127.0.0.1:", made->server->port()),
                           grpc::InsecureChannelCredentials()));

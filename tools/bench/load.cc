@@ -16,6 +16,7 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/string_view.h"
 #include "client/channel.h"
+#include "core/base/status_macros.h"
 #include "core/synth/synth_scene.h"
 #include "fovea/v1/perception.grpc.pb.h"
 #include "server/convert.h"
@@ -115,10 +116,10 @@ absl::StatusOr<LoadReport> RunLoad(const LoadOptions& options) {
   // would have.
   std::vector<std::unique_ptr<v1::Perception::Stub>> stubs;
   for (int i = 0; i < options.clients; ++i) {
-    absl::StatusOr<std::shared_ptr<grpc::Channel>> channel =
-        client::CreateBalancedChannel(options.server, client::ClientOptions());
-    if (!channel.ok()) return channel.status();
-    stubs.push_back(v1::Perception::NewStub(*channel));
+    FOVEA_ASSIGN_OR_RETURN(
+        std::shared_ptr<grpc::Channel> channel,
+        client::CreateBalancedChannel(options.server, client::ClientOptions()));
+    stubs.push_back(v1::Perception::NewStub(channel));
   }
   auto client = [&](int index) {
     v1::Perception::Stub* stub = stubs[index].get();

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/baseline/scene_segmenters.h"
 #include "core/frame/frame_decode.h"
@@ -70,16 +71,13 @@ void Register(const std::string& name, const SceneList* scenes,
 // frame: decode, back-projection and normals, support plane, table scene.
 absl::Status PrepareFrame(const BenchScene& scene,
                           const DetectOptions& options) {
-  absl::StatusOr<RgbdFrame> frame =
-      DecodeFrame(scene.raw_wire, BenchFrameLimits());
-  if (!frame.ok()) return frame.status();
-  absl::StatusOr<OrganizedCloud> cloud =
-      BuildOrganizedCloud(*frame, options.normals);
-  if (!cloud.ok()) return cloud.status();
-  absl::StatusOr<SupportPlane> plane =
-      FindSupportPlane(*cloud, options.support_plane);
-  if (!plane.ok()) return plane.status();
-  TableScene table = PrepareTableScene(*cloud, *plane, options.table_scene);
+  FOVEA_ASSIGN_OR_RETURN(RgbdFrame frame,
+                         DecodeFrame(scene.raw_wire, BenchFrameLimits()));
+  FOVEA_ASSIGN_OR_RETURN(OrganizedCloud cloud,
+                         BuildOrganizedCloud(frame, options.normals));
+  FOVEA_ASSIGN_OR_RETURN(SupportPlane plane,
+                         FindSupportPlane(cloud, options.support_plane));
+  TableScene table = PrepareTableScene(cloud, plane, options.table_scene);
   benchmark::DoNotOptimize(table.candidate_count);
   return absl::OkStatus();
 }
@@ -122,11 +120,11 @@ void RegisterFramePrepCases(const SceneList* scenes, const std::string& set,
            });
   Register("BM_SupportPlane" + suffix, scenes, set, sweep, kSupportPlaneMs,
            [defaults](const BenchScene& scene) {
-             absl::StatusOr<SupportPlane> plane =
-                 FindSupportPlane(scene.cloud, defaults.support_plane);
-             if (!plane.ok()) return plane.status();
+             FOVEA_ASSIGN_OR_RETURN(
+                 SupportPlane plane,
+                 FindSupportPlane(scene.cloud, defaults.support_plane));
              TableScene table =
-                 PrepareTableScene(scene.cloud, *plane, defaults.table_scene);
+                 PrepareTableScene(scene.cloud, plane, defaults.table_scene);
              benchmark::DoNotOptimize(table.candidate_count);
              return absl::OkStatus();
            });
@@ -223,12 +221,12 @@ void RegisterSaliencyCases(const SceneList* scenes, const std::string& set,
 // incremental segmentation would hand them to FitSurface.
 absl::StatusOr<std::vector<std::vector<Eigen::Vector3f>>> PatchPoints(
     const OrganizedCloud& cloud, const PlanarPatchOptions& options) {
-  absl::StatusOr<PlanarPatches> patches = FindPlanarPatches(cloud, {}, options);
-  if (!patches.ok()) return patches.status();
-  std::vector<std::vector<Eigen::Vector3f>> points(patches->patches.size());
+  FOVEA_ASSIGN_OR_RETURN(PlanarPatches patches,
+                         FindPlanarPatches(cloud, {}, options));
+  std::vector<std::vector<Eigen::Vector3f>> points(patches.patches.size());
   for (int v = 0; v < cloud.height(); ++v) {
     for (int u = 0; u < cloud.width(); ++u) {
-      const int id = patches->labels.at<int>(v, u);
+      const int id = patches.labels.at<int>(v, u);
       if (id < 0) continue;
       const cv::Vec3f& p = cloud.xyz.at<cv::Vec3f>(v, u);
       points[id].emplace_back(p[0], p[1], p[2]);
@@ -283,9 +281,9 @@ void RegisterSurfaceModelCases(const SceneList* scenes, const std::string& set,
           }
           SweepScenes(state, *scenes, set, [&](const BenchScene& scene) {
             for (const auto& points : patches.at(&scene)) {
-              absl::StatusOr<SurfaceModel> model = FitSurface(points, options);
-              if (!model.ok()) return model.status();
-              benchmark::DoNotOptimize(model->description_length);
+              FOVEA_ASSIGN_OR_RETURN(SurfaceModel model,
+                                     FitSurface(points, options));
+              benchmark::DoNotOptimize(model.description_length);
             }
             return absl::OkStatus();
           });
@@ -473,11 +471,11 @@ void RegisterFrameCases(
     if (scenes->empty()) continue;
     Register("BM_Frame/detect/" + name, scenes, name, sweep, kDetectMs,
              [](const BenchScene& scene) {
-               absl::StatusOr<RgbdFrame> frame =
-                   DecodeFrame(scene.raw_wire, BenchFrameLimits());
-               if (!frame.ok()) return frame.status();
+               FOVEA_ASSIGN_OR_RETURN(
+                   RgbdFrame frame,
+                   DecodeFrame(scene.raw_wire, BenchFrameLimits()));
                absl::StatusOr<DetectResult> result =
-                   RunDetect(*frame, DetectOptions{});
+                   RunDetect(frame, DetectOptions{});
                benchmark::DoNotOptimize(result);
                return result.status();
              });
@@ -485,11 +483,11 @@ void RegisterFrameCases(
              [](const BenchScene& scene) {
                const absl::StatusOr<LoadedModels>& models = BenchModels();
                if (!models.ok()) return models.status();
-               absl::StatusOr<RgbdFrame> frame =
-                   DecodeFrame(scene.raw_wire, BenchFrameLimits());
-               if (!frame.ok()) return frame.status();
+               FOVEA_ASSIGN_OR_RETURN(
+                   RgbdFrame frame,
+                   DecodeFrame(scene.raw_wire, BenchFrameLimits()));
                absl::StatusOr<SegmentSummary> summary = RunSegmentIncremental(
-                   *frame, IncrementalOptions{}, &*models->inc, SegmentSinks{});
+                   frame, IncrementalOptions{}, &*models->inc, SegmentSinks{});
                benchmark::DoNotOptimize(summary);
                return summary.status();
              });

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/attention/tj.h"
+#include "core/base/status_macros.h"
 #include "core/frame/organized_cloud.h"
 #include "core/frame/osd_pcd.h"
 #include "core/frame/support_plane.h"
@@ -90,21 +91,20 @@ void WriteScenePng(const std::string& out_dir, const LabelledFrame& scene,
 // map is the candidate mask, for the PNGs).
 absl::StatusOr<DetectResult> RunPclClusters(const RgbdFrame& frame,
                                             const DetectEvalOptions& options) {
-  absl::StatusOr<OrganizedCloud> cloud =
-      BuildOrganizedCloud(frame, options.detect.normals);
-  if (!cloud.ok()) return cloud.status();
-  absl::StatusOr<SupportPlane> plane =
-      FindSupportPlane(*cloud, options.detect.support_plane);
-  if (!plane.ok()) return plane.status();
+  FOVEA_ASSIGN_OR_RETURN(OrganizedCloud cloud,
+                         BuildOrganizedCloud(frame, options.detect.normals));
+  FOVEA_ASSIGN_OR_RETURN(SupportPlane plane,
+                         FindSupportPlane(cloud, options.detect.support_plane));
   const TableScene scene =
-      PrepareTableScene(*cloud, *plane, options.detect.table_scene);
-  absl::StatusOr<std::vector<AttentionPoint>> points = DetectPclClusters(
-      *cloud, scene, options.detect.max_points, options.clusters);
-  if (!points.ok()) return points.status();
+      PrepareTableScene(cloud, plane, options.detect.table_scene);
+  FOVEA_ASSIGN_OR_RETURN(
+      std::vector<AttentionPoint> points,
+      DetectPclClusters(cloud, scene, options.detect.max_points,
+                        options.clusters));
   DetectResult result;
-  result.points = *std::move(points);
+  result.points = std::move(points);
   scene.candidate.convertTo(result.master, CV_32FC1, 1.0 / 255.0);
-  result.plane = *std::move(plane);
+  result.plane = std::move(plane);
   return result;
 }
 
@@ -142,18 +142,16 @@ DetectEvalSummary Summarize(const std::vector<SceneResult>& scenes,
 
 absl::StatusOr<std::vector<LabelledFrame>> LoadScenes(
     const std::string& data_dir) {
-  absl::StatusOr<std::vector<std::string>> files =
-      ListPcdFiles(ResolveDataDir(data_dir));
-  if (!files.ok()) return files.status();
-  if (files->empty()) {
+  FOVEA_ASSIGN_OR_RETURN(std::vector<std::string> files,
+                         ListPcdFiles(ResolveDataDir(data_dir)));
+  if (files.empty()) {
     return absl::NotFoundError("no .pcd files in " + data_dir);
   }
   std::vector<LabelledFrame> scenes;
-  scenes.reserve(files->size());
-  for (const std::string& path : *files) {
-    absl::StatusOr<LabelledFrame> scene = LoadOsdPcd(path);
-    if (!scene.ok()) return scene.status();
-    scenes.push_back(*std::move(scene));
+  scenes.reserve(files.size());
+  for (const std::string& path : files) {
+    FOVEA_ASSIGN_OR_RETURN(LabelledFrame scene, LoadOsdPcd(path));
+    scenes.push_back(std::move(scene));
   }
   return scenes;
 }
@@ -161,7 +159,7 @@ absl::StatusOr<std::vector<LabelledFrame>> LoadScenes(
 absl::StatusOr<DetectEvalSummary> EvaluateDetectOn(
     const std::vector<LabelledFrame>& scenes,
     const DetectEvalOptions& options) {
-  if (absl::Status s = Validate(options.detect); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options.detect));
   if (!options.out_dir.empty()) {
     std::filesystem::create_directories(options.out_dir);
   }
@@ -204,11 +202,10 @@ absl::StatusOr<DetectEvalSummary> EvaluateDetectOn(
 
 absl::StatusOr<DetectEvalSummary> EvaluateDetect(
     const DetectEvalOptions& options) {
-  if (absl::Status s = Validate(options.detect); !s.ok()) return s;
-  absl::StatusOr<std::vector<LabelledFrame>> scenes =
-      LoadScenes(options.data_dir);
-  if (!scenes.ok()) return scenes.status();
-  return EvaluateDetectOn(*scenes, options);
+  FOVEA_RETURN_IF_ERROR(Validate(options.detect));
+  FOVEA_ASSIGN_OR_RETURN(std::vector<LabelledFrame> scenes,
+                         LoadScenes(options.data_dir));
+  return EvaluateDetectOn(scenes, options);
 }
 
 }  // namespace fovea::eval

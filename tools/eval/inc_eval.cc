@@ -14,6 +14,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "core/base/status_macros.h"
 #include "core/baseline/scene_segmenters.h"
 #include "core/frame/organized_cloud.h"
 #include "tools/eval/scene_kind.h"
@@ -63,11 +64,11 @@ absl::StatusOr<WholeRun> RunToTheEnd(const LabelledFrame& scene,
     run.masks.push_back({{object.seed.u, object.seed.v}, object.mask});
     return absl::OkStatus();
   };
-  absl::StatusOr<SegmentSummary> summary =
-      RunSegmentIncremental(scene.frame, options, &svm, sinks);
-  if (!summary.ok()) return summary.status();
-  run.first_ms = first.value_or(summary->total_seconds) * 1e3;
-  run.total_ms = summary->total_seconds * 1e3;
+  FOVEA_ASSIGN_OR_RETURN(
+      SegmentSummary summary,
+      RunSegmentIncremental(scene.frame, options, &svm, sinks));
+  run.first_ms = first.value_or(summary.total_seconds) * 1e3;
+  run.total_ms = summary.total_seconds * 1e3;
   return run;
 }
 
@@ -106,9 +107,9 @@ absl::StatusOr<std::vector<SeededMask>> RandomPointMasks(
         mask = SeededMask{run.attention_points[0], o.mask};
         return absl::OkStatus();
       };
-      absl::StatusOr<SegmentSummary> summary =
-          RunSegmentIncremental(scene.frame, run, &svm, sinks);
-      if (!summary.ok()) return summary.status();
+      FOVEA_ASSIGN_OR_RETURN(
+          SegmentSummary summary,
+          RunSegmentIncremental(scene.frame, run, &svm, sinks));
       if (mask) masks.push_back(*std::move(mask));
     }
   }
@@ -251,7 +252,7 @@ absl::StatusOr<IncEvalSummary> EvaluateInc(
   }
   IncrementalOptions run = options.incremental;
   run.attention_points.clear();
-  if (absl::Status s = Validate(run); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(run));
   std::vector<std::vector<SvmSample>> samples(scenes.size());
   for (size_t i = 0; i < scenes.size(); ++i) {
     absl::StatusOr<std::vector<SvmSample>> s =
@@ -271,12 +272,12 @@ absl::StatusOr<IncEvalSummary> EvaluateInc(
       if (static_cast<int>(i) % options.folds == fold) continue;
       train.insert(train.end(), samples[i].begin(), samples[i].end());
     }
-    absl::StatusOr<RbfSvm> svm =
-        TrainRbfSvm(train, RelationFeatureNames(), "inc", options.svm);
-    if (!svm.ok()) return svm.status();
+    FOVEA_ASSIGN_OR_RETURN(
+        RbfSvm svm,
+        TrainRbfSvm(train, RelationFeatureNames(), "inc", options.svm));
     for (size_t i = fold; i < scenes.size(); i += options.folds) {
       const LabelledFrame& scene = scenes[i];
-      absl::StatusOr<WholeRun> whole = RunToTheEnd(scene, run, *svm);
+      absl::StatusOr<WholeRun> whole = RunToTheEnd(scene, run, svm);
       if (!whole.ok()) {
         return InScene(scene.name, whole.status());
       }
@@ -292,10 +293,9 @@ absl::StatusOr<IncEvalSummary> EvaluateInc(
         r.score =
             ScoreSegmentation(scene.labels, whole->masks, kMinObjectPixels);
       } else {
-        absl::StatusOr<std::vector<SeededMask>> masks =
-            RandomPointMasks(scene, options, *svm, 1000 + i);
-        if (!masks.ok()) return masks.status();
-        r.score = ScoreSegmentation(scene.labels, *masks, kMinObjectPixels);
+        FOVEA_ASSIGN_OR_RETURN(std::vector<SeededMask> masks,
+                               RandomPointMasks(scene, options, svm, 1000 + i));
+        r.score = ScoreSegmentation(scene.labels, masks, kMinObjectPixels);
       }
       if (options.verbose) {
         std::fprintf(stderr,
@@ -314,9 +314,7 @@ absl::StatusOr<IncEvalSummary> EvaluateInc(
     }
   }
   if (!options.out_dir.empty()) {
-    if (absl::Status s = WriteComplexity(results, options.out_dir); !s.ok()) {
-      return s;
-    }
+    FOVEA_RETURN_IF_ERROR(WriteComplexity(results, options.out_dir));
   }
   return SummarizeInc(results, "");
 }

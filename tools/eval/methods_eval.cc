@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/pipeline/incremental.h"
 #include "core/pipeline/segment.h"
@@ -137,22 +138,21 @@ absl::StatusOr<MethodResults> EvaluateMethods(
         frames.push_back(&scenes[i]);
       }
       if (Uses(options, SceneMethod::kCos)) {
-        absl::StatusOr<LinearSvm> svm = TrainLinearSvm(
-            cos_train, CosFeatureNames(), "cos", options.cos_svm);
-        if (!svm.ok()) return svm.status();
-        trained.cos = *std::move(svm);
+        FOVEA_ASSIGN_OR_RETURN(
+            LinearSvm svm, TrainLinearSvm(cos_train, CosFeatureNames(), "cos",
+                                          options.cos_svm));
+        trained.cos = std::move(svm);
       }
       if (Uses(options, SceneMethod::kEbs)) {
-        absl::StatusOr<EbsModel> ebs =
-            EbsModel::Train(frames, EbsTrainOptions{});
-        if (!ebs.ok()) return ebs.status();
-        trained.ebs = *std::move(ebs);
+        FOVEA_ASSIGN_OR_RETURN(EbsModel ebs,
+                               EbsModel::Train(frames, EbsTrainOptions{}));
+        trained.ebs = std::move(ebs);
       }
       if (Uses(options, SceneMethod::kInc)) {
-        absl::StatusOr<RbfSvm> svm = TrainRbfSvm(
-            inc_train, RelationFeatureNames(), "inc", options.inc_svm);
-        if (!svm.ok()) return svm.status();
-        trained.inc = *std::move(svm);
+        FOVEA_ASSIGN_OR_RETURN(
+            RbfSvm svm, TrainRbfSvm(inc_train, RelationFeatureNames(), "inc",
+                                    options.inc_svm));
+        trained.inc = std::move(svm);
       }
       models = trained.View();
     } else {

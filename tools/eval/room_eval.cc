@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/eval/hungarian.h"
 #include "tools/eval/stats.h"
@@ -163,7 +164,7 @@ absl::StatusOr<std::vector<RoomResult>> EvaluateRooms(
       room.sensor = sensor;
       room.width = size.width;
       room.height = size.height;
-      if (absl::Status s = synth::Validate(room); !s.ok()) return s;
+      FOVEA_RETURN_IF_ERROR(synth::Validate(room));
       const std::string group =
           absl::StrCat(AbslView(synth::RoomSensorName(sensor)), " ", size.width,
                        "x", size.height);

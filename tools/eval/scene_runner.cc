@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/baseline/scene_segmenters.h"
 #include "core/frame/organized_cloud.h"
@@ -55,18 +56,17 @@ absl::StatusOr<SceneRun> RunPeer(const LabelledFrame& scene,
                                  SceneMethod method) {
   SceneRun run;
   const Clock::time_point start = Clock::now();
-  absl::StatusOr<OrganizedCloud> cloud =
-      BuildOrganizedCloud(scene.frame, NormalOptions{});
-  if (!cloud.ok()) return cloud.status();
-  absl::StatusOr<SceneSegmentation> segmentation =
+  FOVEA_ASSIGN_OR_RETURN(OrganizedCloud cloud,
+                         BuildOrganizedCloud(scene.frame, NormalOptions{}));
+  FOVEA_ASSIGN_OR_RETURN(
+      SceneSegmentation segmentation,
       method == SceneMethod::kPclEuclidean
-          ? SegmentSceneEuclidean(*cloud, EuclideanSceneOptions{})
-          : SegmentSceneLccp(*cloud, LccpSceneOptions{});
-  if (!segmentation.ok()) return segmentation.status();
+          ? SegmentSceneEuclidean(cloud, EuclideanSceneOptions{})
+          : SegmentSceneLccp(cloud, LccpSceneOptions{}));
   run.total_ms = run.first_ms = MsSince(start);
   run.segments = cv::Mat(scene.labels.size(), CV_32SC1, cv::Scalar(-1));
-  for (int s = 0; s < segmentation->segments; ++s) {
-    cv::Mat mask = segmentation->labels == s;
+  for (int s = 0; s < segmentation.segments; ++s) {
+    cv::Mat mask = segmentation.labels == s;
     if (cv::countNonZero(mask) == 0) continue;
     run.segments.setTo(static_cast<int>(run.masks.size()), mask);
     run.masks.push_back({CentralPixel(mask), mask});
