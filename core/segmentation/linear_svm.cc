@@ -12,47 +12,18 @@
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
+#include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/segmentation/svm_common.h"
-
-extern "C" {
-#include "libsvm/svm.h"
-}
 
 namespace fovea {
 namespace {
 
-using svm_internal::CheckSamples;
 using svm_internal::ParseNumber;
 
 constexpr std::string_view kMagic = "fovea-linear-svm 1";
 // Longest model text Parse reads, bytes (a model is a few hundred).
 constexpr size_t kMaxModelBytes = 1 << 20;
-
-// libsvm's training on `samples`; w and b read back from the model.
-std::pair<std::vector<double>, double> TrainWeights(
-    const std::vector<SvmSample>& samples,
-    const LinearSvmTrainingOptions& options) {
-  svm_parameter param{};
-  param.kernel_type = LINEAR;
-  param.cache_size = 100;
-  param.eps = options.epsilon;
-  param.C = options.c;
-  param.shrinking = 1;
-  const std::unique_ptr<svm_internal::TrainedModel> trained =
-      svm_internal::Train(samples, param, options.balance_classes);
-  const svm_model& model = *trained->model;
-  std::vector<double> w(samples[0].x.size(), 0.0);
-  for (int i = 0; i < model.l; ++i) {
-    for (const svm_node* node = model.SV[i]; node->index != -1; ++node) {
-      w[node->index - 1] += model.sv_coef[0][i] * node->value;
-    }
-  }
-  // libsvm's decision is positive for its first label.
-  const double sign = svm_internal::PositiveSign(model);
-  for (double& v : w) v *= sign;
-  return {std::move(w), -model.rho[0] * sign};
-}
 
 }  // namespace
 
@@ -143,17 +114,18 @@ absl::StatusOr<LinearSvm> LinearSvm::Parse(std::string_view text,
         break;
       case 2:
         for (absl::string_view w : words) {
-          absl::StatusOr<double> v =
-              ParseNumber(std::string_view(w.data(), w.size()), line);
-          if (!v.ok()) return v.status();
-          weights.push_back(*v);
+          FOVEA_ASSIGN_OR_RETURN(
+              double v,
+              ParseNumber(std::string_view(w.data(), w.size()), line));
+          weights.push_back(v);
         }
         break;
       case 3: {
-        absl::StatusOr<double> v = ParseNumber(
-            std::string_view(kv.second.data(), kv.second.size()), line);
-        if (!v.ok()) return v.status();
-        bias = *v;
+        FOVEA_ASSIGN_OR_RETURN(
+            double v,
+            ParseNumber(std::string_view(kv.second.data(), kv.second.size()),
+                        line));
+        bias = v;
         break;
       }
       default:
@@ -177,47 +149,6 @@ absl::StatusOr<LinearSvm> LinearSvm::Parse(std::string_view text,
   }
   return LinearSvm(std::move(kind), std::move(features), std::move(weights),
                    bias, std::move(provenance));
-}
-
-absl::Status Validate(const LinearSvmTrainingOptions& options) {
-  if (!(options.c > 0.0) || !std::isfinite(options.c)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("c must be positive, got ", options.c));
-  }
-  if (!(options.epsilon > 0.0) || !std::isfinite(options.epsilon)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("epsilon must be positive, got ", options.epsilon));
-  }
-  return absl::OkStatus();
-}
-
-absl::StatusOr<LinearSvm> TrainLinearSvm(
-    const std::vector<SvmSample>& samples,
-    const std::vector<std::string>& feature_names, std::string kind,
-    const LinearSvmTrainingOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
-  if (absl::Status s = CheckSamples(samples); !s.ok()) return s;
-  if (feature_names.size() != samples[0].x.size()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(feature_names.size(), " feature names for samples of ",
-                     samples[0].x.size(), " values"));
-  }
-  auto [w, b] = TrainWeights(samples, options);
-  return LinearSvm(std::move(kind), feature_names, std::move(w), b, "");
-}
-
-absl::StatusOr<CrossValidation> CrossValidateLinearSvm(
-    const std::vector<SvmSample>& samples, int folds,
-    const LinearSvmTrainingOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
-  return svm_internal::CrossValidate(
-      samples, folds, [&options](const std::vector<SvmSample>& training) {
-        auto [w, b] = TrainWeights(training, options);
-        const LinearSvm svm("cv", std::vector<std::string>(w.size()),
-                            std::move(w), b, "");
-        return svm_internal::DecisionFunction(
-            [svm](const std::vector<double>& x) { return svm.Decision(x); });
-      });
 }
 
 }  // namespace fovea

@@ -59,18 +59,6 @@ class LinearSvm {
   std::string provenance_;
 };
 
-struct LinearSvmTrainingOptions {
-  // Soft-margin penalty (libsvm -c), > 0.
-  double c = 1.0;
-  // Weight each class by the inverse of its share, so that the rarer class
-  // (accepted patches are the minority) counts as much as the other.
-  bool balance_classes = true;
-  // libsvm's stopping tolerance (-e), > 0.
-  double epsilon = 1e-3;
-};
-
-absl::Status Validate(const LinearSvmTrainingOptions& options);
-
 // One training example: features, class (+1 accept, -1 reject) and the
 // group it comes from (the scene), for grouped cross-validation.
 struct SvmSample {
@@ -78,27 +66,6 @@ struct SvmSample {
   int label = 0;
   int group = 0;
 };
-
-// Trains on every sample. INVALID_ARGUMENT for no samples, one class only,
-// samples of different lengths or labels other than +1 / -1.
-absl::StatusOr<LinearSvm> TrainLinearSvm(
-    const std::vector<SvmSample>& samples,
-    const std::vector<std::string>& feature_names, std::string kind,
-    const LinearSvmTrainingOptions& options);
-
-struct CrossValidation {
-  double accuracy = 0.0;           // correct / samples
-  double balanced_accuracy = 0.0;  // mean of the two classes' recalls
-  int folds = 0;
-  int samples = 0;
-};
-
-// k-fold cross-validation by group: group g is in fold g mod k, so a
-// scene's samples are never both trained and tested on. Errors as
-// TrainLinearSvm's, and for k < 2.
-absl::StatusOr<CrossValidation> CrossValidateLinearSvm(
-    const std::vector<SvmSample>& samples, int folds,
-    const LinearSvmTrainingOptions& options);
 
 }  // namespace fovea
 

@@ -61,32 +61,6 @@ class RbfSvm {
 // Most support vectors a model file may hold.
 inline constexpr int kMaxSupportVectors = 200000;
 
-struct RbfSvmTrainingOptions {
-  // Soft-margin penalty and RBF width, > 0. The thesis found C = 512,
-  // gamma = 2 by 10-fold cross-validation; redone on the learn scenes by
-  // scene folds (fovea-train inc --grid), C = 32, gamma = 0.5 scores best
-  // (balanced accuracy 0.770 against 0.734).
-  double c = 32.0;
-  double gamma = 0.5;
-  bool balance_classes = true;  // weight classes by inverse frequency
-  double epsilon = 1e-3;        // libsvm's stopping tolerance, > 0
-};
-
-absl::Status Validate(const RbfSvmTrainingOptions& options);
-
-// Trains on every sample (labels +1 / -1) with probability outputs.
-// Errors as TrainLinearSvm's.
-absl::StatusOr<RbfSvm> TrainRbfSvm(const std::vector<SvmSample>& samples,
-                                   const std::vector<std::string>& names,
-                                   std::string kind,
-                                   const RbfSvmTrainingOptions& options);
-
-// Grouped k-fold cross-validation (group g in fold g mod k), as
-// CrossValidateLinearSvm.
-absl::StatusOr<CrossValidation> CrossValidateRbfSvm(
-    const std::vector<SvmSample>& samples, int folds,
-    const RbfSvmTrainingOptions& options);
-
 }  // namespace fovea
 
 #endif  // FOVEA_CORE_SEGMENTATION_RBF_SVM_H_

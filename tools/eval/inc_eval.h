@@ -8,6 +8,7 @@
 #include "core/eval/segmentation_metrics.h"
 #include "core/frame/osd_pcd.h"
 #include "core/pipeline/incremental.h"
+#include "core/segmentation/svm_training.h"
 
 namespace fovea::eval {
 

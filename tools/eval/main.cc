@@ -21,6 +21,7 @@
 #include "absl/strings/str_split.h"
 #include "core/pipeline/detect.h"
 #include "core/pipeline/models.h"
+#include "core/segmentation/svm_training.h"
 #include "core/synth/synth_scene.h"
 #include "tools/eval/detect_eval.h"
 #include "tools/eval/inc_eval.h"

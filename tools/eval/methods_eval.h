@@ -13,6 +13,7 @@
 #include "core/pipeline/models.h"
 #include "core/segmentation/linear_svm.h"
 #include "core/segmentation/rbf_svm.h"
+#include "core/segmentation/svm_training.h"
 #include "tools/eval/scene_runner.h"
 
 namespace fovea::eval {

@@ -23,6 +23,7 @@
 #include "core/segmentation/cos.h"
 #include "core/segmentation/ebs.h"
 #include "core/segmentation/linear_svm.h"
+#include "core/segmentation/svm_training.h"
 #include "core/synth/synth_scene.h"
 #include "tools/eval/detect_eval.h"
 

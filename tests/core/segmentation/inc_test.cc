@@ -6,6 +6,7 @@
 
 #include "core/pipeline/detect.h"
 #include "core/pipeline/incremental.h"
+#include "core/segmentation/svm_training.h"
 #include "core/synth/synth_scene.h"
 #include "tests/core/testing/scenes.h"
 

@@ -4,6 +4,8 @@
 
 #include <random>
 
+#include "core/segmentation/svm_training.h"
+
 namespace fovea {
 namespace {
 

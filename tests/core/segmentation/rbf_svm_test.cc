@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <random>
 
+#include "core/segmentation/svm_training.h"
+
 namespace fovea {
 namespace {
 
