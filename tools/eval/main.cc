@@ -16,8 +16,6 @@
 #include "absl/flags/usage.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
-#include "absl/strings/str_format.h"
-#include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "core/pipeline/detect.h"
 #include "core/pipeline/models.h"
@@ -25,6 +23,7 @@
 #include "core/synth/synth_scene.h"
 #include "tools/eval/detect_eval.h"
 #include "tools/eval/inc_eval.h"
+#include "tools/eval/json_lines.h"
 #include "tools/eval/methods_eval.h"
 #include "tools/eval/raw_frame_eval.h"
 #include "tools/eval/room_eval.h"
@@ -92,8 +91,11 @@ ABSL_FLAG(std::string, sensor,
 ABSL_FLAG(int, processing_width, fovea::SceneOptions().processing_width,
           "Frames wider than this are processed reduced, pixels.");
 ABSL_FLAG(bool, json, false,
-          "Print a last line of JSON: scenes, hit_ratio, distance_to_center, "
-          "hit_ratio_at, detect_ms_median.");
+          "Also print JSON, one object per line: detect a last line with "
+          "scenes, hit_ratio, distance_to_center, hit_ratio_at, "
+          "detect_ms_median, ...; segment one per method, rooms one per "
+          "group, raw one per frame (keys: tools/eval/json_lines.h). A number "
+          "that is not finite (NaN, infinity) is null, as JSON has neither.");
 ABSL_FLAG(std::string, out, "",
           "Write <scene>.png (colour with object outlines | saliency map, "
           "points numbered) into this folder.");
@@ -178,21 +180,11 @@ void PrintTable(const std::vector<SceneResult>& scenes) {
     row(absl::StrCat(kManyObjects, "+ objects"), Summarize(many, ""));
 }
 
+// The detect --json line; its 10plus keys are of the kManyObjects row.
 std::string Json(const DetectEvalSummary& s) {
-  std::vector<std::string> at;
-  for (double h : s.hit_ratio_at) at.push_back(absl::StrCat(h));
-  const DetectEvalSummary many =
-      Summarize(WithObjects(s.scenes, kManyObjects), "");
-  return absl::StrCat(
-      "{\"scenes\": ", s.scenes.size(), ", \"hit_ratio\": ", s.hit_ratio,
-      ", \"distance_to_center\": ", s.distance_to_center,
-      ", \"distance_to_center_thesis\": ", s.distance_to_center_thesis,
-      ", \"hit_ratio_at\": [", absl::StrJoin(at, ", "),
-      "], \"scenes_10plus\": ", many.scenes.size(),
-      ", \"hit_ratio_10plus\": ", many.hit_ratio,
-      ", \"repeated_points\": ", s.repeated_points,
-      ", \"off_object_points\": ", s.off_object_points,
-      ", \"detect_ms_median\": ", s.detect_ms_median, "}");
+  static_assert(kManyObjects == 10, "the JSON keys say 10plus");
+  return DetectSummaryJson(s,
+                           Summarize(WithObjects(s.scenes, kManyObjects), ""));
 }
 
 // The Detect options of the flags shared by detect and segment; nullopt
@@ -346,13 +338,7 @@ int RunRandomPointsEval(const DetectOptions& detect,
       summary->scenes.size(), options.folds);
   PrintIncTable(summary->scenes);
   if (absl::GetFlag(FLAGS_json)) {
-    std::printf(
-        "{\"scenes\": %zu, \"f_all\": %.4f, \"f_best\": %.4f, "
-        "\"f_first\": %.4f, \"object_recall\": %.4f, \"false_masks\": "
-        "%.4f, \"whole_scene_f\": %.4f}\n",
-        summary->scenes.size(), summary->f_all, summary->f_best,
-        summary->f_first, summary->object_recall, summary->false_masks,
-        summary->whole_scene_f);
+    std::printf("%s\n", IncSummaryJson(*summary).c_str());
   }
   return 0;
 }
@@ -410,23 +396,6 @@ std::vector<std::string> KindsOf(const MethodResults& results) {
     }
   }
   return kinds;
-}
-
-std::string MethodJson(const MethodSummary& s, bool cross_validated,
-                       int folds) {
-  return absl::StrFormat(
-      "{\"method\": \"%s\", \"evaluation\": \"%s\", \"folds\": %d, "
-      "\"scenes\": %d, \"f_all\": %.4f, \"f_best\": %.4f, \"f_first\": "
-      "%.4f, \"object_recall\": %.4f, \"false_masks\": %.4f, "
-      "\"whole_scene_f\": %.4f, \"overlap_p\": %.4f, \"overlap_r\": %.4f, "
-      "\"overlap_f\": %.4f, \"boundary_p\": %.4f, \"boundary_r\": %.4f, "
-      "\"boundary_f\": %.4f, \"objects_075\": %.4f, "
-      "\"first_mask_ms_median\": %.1f, \"all_masks_ms_median\": %.1f}",
-      s.method, cross_validated ? "cross-validated" : "held-out",
-      cross_validated ? folds : 0, s.scenes, s.f_all, s.f_best, s.f_first,
-      s.object_recall, s.false_masks, s.whole_scene_f, s.overlap_p, s.overlap_r,
-      s.overlap_f, s.boundary_p, s.boundary_r, s.boundary_f, s.objects_075,
-      s.first_ms_median, s.total_ms_median);
 }
 
 int RunSegmentEval() {
@@ -527,10 +496,10 @@ int RunSegmentEval() {
   }
   if (absl::GetFlag(FLAGS_json)) {
     for (const SceneMethod method : options.methods) {
-      std::printf("%s\n",
-                  MethodJson(SummarizeMethod(method, results->at(method), ""),
-                             cross_validated, options.folds)
-                      .c_str());
+      std::printf("%s\n", MethodSummaryJson(
+                              SummarizeMethod(method, results->at(method), ""),
+                              cross_validated, options.folds)
+                              .c_str());
     }
   }
   return 0;
@@ -538,16 +507,7 @@ int RunSegmentEval() {
 
 void PrintRoomSummary(const RoomSummary& s, bool json) {
   if (json) {
-    std::printf(
-        "{\"group\": \"%s\", \"rooms\": %d, \"support_correct\": %.4f, "
-        "\"object_recall\": %.4f, \"false_objects_per_frame\": %.4f, "
-        "\"overlap_p\": %.4f, \"overlap_r\": %.4f, \"overlap_f\": %.4f, "
-        "\"boundary_f\": %.4f, \"objects_075\": %.4f, \"whole_scene_f\": "
-        "%.4f, \"first_ms_median\": %.1f, \"total_ms_median\": %.1f}\n",
-        s.group.empty() ? "all" : s.group.c_str(), s.rooms, s.support_correct,
-        s.object_recall, s.false_objects_per_frame, s.overlap_p, s.overlap_r,
-        s.overlap_f, s.boundary_f, s.objects_075, s.whole_scene_f,
-        s.first_ms_median, s.total_ms_median);
+    std::printf("%s\n", RoomSummaryJson(s).c_str());
     return;
   }
   std::printf(
@@ -688,12 +648,7 @@ int RunRawCommand() {
                   s.false_objects, s.uois.overlap_f, s.uois.boundary_f,
                   s.uois.objects_075, s.total_ms);
       if (absl::GetFlag(FLAGS_json)) {
-        std::printf(
-            "{\"scene\": \"%s\", \"frame\": \"%s\", \"masks\": %d, "
-            "\"precision\": %.4f, \"recall\": %.4f, \"false_objects\": %d, "
-            "\"overlap_f\": %.4f}\n",
-            r.name.c_str(), kind, s.masks, s.precision, s.recall,
-            s.false_objects, s.uois.overlap_f);
+        std::printf("%s\n", RawFrameJson(r.name, kind, s).c_str());
       }
     }
   }
