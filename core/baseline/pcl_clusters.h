@@ -13,7 +13,7 @@
 namespace fovea {
 
 // The detector a robotics engineer writes first, as the peer the attention
-// system is measured against (issue 3): with the support plane removed,
+// system is measured against: with the support plane removed,
 // cluster what stands on it with PCL's Euclidean clustering and attend to
 // each cluster's point nearest its centroid, largest cluster first.
 struct PclClustersOptions {

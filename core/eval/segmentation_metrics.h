@@ -39,7 +39,7 @@ SegmentationScore ScoreSegmentation(const cv::Mat& labels,
                                     const std::vector<SeededMask>& masks,
                                     int min_object_pixels = 1);
 
-// Whole-scene F (issue 5, after the thesis's section 3.3.3): for each
+// Whole-scene F (after the thesis's section 3.3.3): for each
 // ground-truth object, the output segment that overlaps it most and F of
 // that pair; 0 for an object no segment touches; averaged over the objects
 // (of at least `min_object_pixels`). `segments` is CV_32SC1, segment id >=

@@ -439,7 +439,7 @@ TEST(CapabilitiesTest, ListWhatCoreValidates) {
   const v1::Capabilities capabilities = BuildCapabilities(FrameLimits(), 1000);
   std::vector<int> ops(capabilities.saliency_operators().begin(),
                        capabilities.saliency_operators().end());
-  // The operators of this issue; each one listed passes core's Validate.
+  // Every operator; each one listed passes core's Validate.
   EXPECT_THAT(ops, ::testing::IsSupersetOf({v1::PH, v1::SH, v1::RSO, v1::SYM3D,
                                             v1::ITTI, v1::HAREL, v1::HOU,
                                             v1::KOOTSTRA}));

@@ -387,7 +387,7 @@ void RegisterDetectCases(const SceneList* scenes, const std::string& set,
   }
 }
 
-// The attention strategies of chapter 2 whose time the issue asks for:
+// The attention strategies of chapter 2 whose times are reported:
 // SYM3D with T-junctions on one level and on both pyramids, and each colour
 // operator with MSR.
 struct AttentionCase {
