@@ -14,6 +14,7 @@
 // failure (unreadable file, cannot write --out), 2 the call failed (the gRPC
 // code name and message go to stderr), 64 usage error.
 
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <fstream>
@@ -102,6 +103,15 @@ ABSL_FLAG(std::string, norm, "", "map normalisation: lin | nms | nlm");
 ABSL_FLAG(std::string, combine, "", "pyramid level combination: sum | max");
 ABSL_FLAG(std::string, fusion, "", "channel fusion: sum | max");
 ABSL_FLAG(bool, maps, false, "ask for each channel's saliency map");
+ABSL_FLAG(std::string, target_color, "",
+          "target_color operator: the colour looked for, R,G,B (0-255), "
+          "e.g. 200,30,30");
+ABSL_FLAG(std::string, location_prior, "",
+          "location_prior operator: the pixel the prior is centred on, U,V "
+          "(column,row)");
+ABSL_FLAG(double, location_sigma, 0.0,
+          "location_prior operator: its standard deviation, pixels (0: the "
+          "server's default)");
 ABSL_FLAG(std::optional<bool>, split_edges, std::nullopt,
           "split the master map at surface edges before extraction "
           "(unset: the server's default; false: the thesis's map)");
@@ -361,6 +371,23 @@ absl::StatusOr<fovea::v1::DetectOptions> DetectOptionsFromFlags() {
   }
   options.set_max_points(static_cast<uint32_t>(points));
   options.set_return_channel_maps(absl::GetFlag(FLAGS_maps));
+  if (const std::string text = absl::GetFlag(FLAGS_target_color);
+      !text.empty()) {
+    FOVEA_ASSIGN_OR_RETURN(const auto rgb, ParseRgb("--target_color", text));
+    for (const uint32_t value : rgb) options.add_target_color_rgb(value);
+  }
+  if (const std::string text = absl::GetFlag(FLAGS_location_prior);
+      !text.empty()) {
+    FOVEA_ASSIGN_OR_RETURN(*options.mutable_location_prior(),
+                           ParsePixel("--location_prior", text));
+  }
+  if (const double sigma = absl::GetFlag(FLAGS_location_sigma); sigma != 0.0) {
+    if (!(sigma > 0.0) || !std::isfinite(sigma)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "--location_sigma: ", sigma, " is not a number of pixels > 0"));
+    }
+    options.set_location_prior_sigma_px(sigma);
+  }
   if (const std::optional<bool> split = absl::GetFlag(FLAGS_split_edges)) {
     options.set_split_at_surface_edges(*split);
   }

@@ -1,7 +1,11 @@
 #include "client/option_names.h"
 
+#include <google/protobuf/descriptor.h>
+
 #include <cmath>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "absl/strings/ascii.h"
@@ -18,19 +22,30 @@ namespace {
 template <typename Enum>
 using NameTable = std::vector<std::pair<absl::string_view, Enum>>;
 
+// The names of an enum's values, from its proto descriptor: each value's
+// name in lower case ("target_color" for TARGET_COLOR), the spelling of
+// core's registries (core/pipeline/saliency_registry.h, SegmentMethods in
+// core/pipeline/segment.h) and of the server; the UNSPECIFIED value (0)
+// has none. Never freed.
+template <typename Enum>
+const NameTable<Enum>* DescriptorNames(
+    const google::protobuf::EnumDescriptor* values) {
+  auto* spellings = new std::vector<std::string>();
+  spellings->reserve(values->value_count());  // the views below stay valid
+  auto* names = new NameTable<Enum>();
+  for (int i = 0; i < values->value_count(); ++i) {
+    const google::protobuf::EnumValueDescriptor* value = values->value(i);
+    if (value->number() == 0) continue;
+    spellings->push_back(absl::AsciiStrToLower(value->name()));
+    names->emplace_back(spellings->back(), static_cast<Enum>(value->number()));
+  }
+  return names;
+}
+
 const NameTable<fovea::v1::SaliencyOperator>& SaliencyNames() {
-  static const auto* const kNames = new NameTable<fovea::v1::SaliencyOperator>{
-      {"ph", fovea::v1::PH},
-      {"sh", fovea::v1::SH},
-      {"rso", fovea::v1::RSO},
-      {"sym3d", fovea::v1::SYM3D},
-      {"itti", fovea::v1::ITTI},
-      {"harel", fovea::v1::HAREL},
-      {"hou", fovea::v1::HOU},
-      {"kootstra", fovea::v1::KOOTSTRA},
-      {"target_color", fovea::v1::TARGET_COLOR},
-      {"location_prior", fovea::v1::LOCATION_PRIOR},
-  };
+  static const auto* const kNames =
+      DescriptorNames<fovea::v1::SaliencyOperator>(
+          fovea::v1::SaliencyOperator_descriptor());
   return *kNames;
 }
 
@@ -86,8 +101,8 @@ absl::StatusOr<std::vector<fovea::v1::WeightedOperator>> ParseSaliency(
 }
 
 absl::StatusOr<fovea::v1::Extraction> ParseExtraction(absl::string_view text) {
-  static const auto* const kNames = new NameTable<fovea::v1::Extraction>{
-      {"msr", fovea::v1::MSR}, {"wta", fovea::v1::WTA}, {"tj", fovea::v1::TJ}};
+  static const auto* const kNames = DescriptorNames<fovea::v1::Extraction>(
+      fovea::v1::Extraction_descriptor());
   return Lookup("extract", text, *kNames);
 }
 
@@ -124,9 +139,55 @@ absl::StatusOr<fovea::v1::Fusion> ParseFusion(absl::string_view text) {
 absl::StatusOr<fovea::v1::SegmentationMethod> ParseSegmentationMethod(
     absl::string_view text) {
   static const auto* const kNames =
-      new NameTable<fovea::v1::SegmentationMethod>{{"cos", fovea::v1::COS},
-                                                   {"ebs", fovea::v1::EBS}};
+      DescriptorNames<fovea::v1::SegmentationMethod>(
+          fovea::v1::SegmentationMethod_descriptor());
   return Lookup("method", text, *kNames);
+}
+
+namespace {
+
+// `text` as `count` comma-separated integers in [0, max].
+absl::StatusOr<std::vector<uint32_t>> ParseIntegers(absl::string_view flag,
+                                                    absl::string_view text,
+                                                    size_t count, uint32_t max,
+                                                    absl::string_view form) {
+  const std::vector<absl::string_view> parts = absl::StrSplit(text, ',');
+  std::vector<uint32_t> values;
+  for (absl::string_view part : parts) {
+    uint32_t value = 0;
+    if (!absl::SimpleAtoi(absl::StripAsciiWhitespace(part), &value) ||
+        value > max) {
+      values.clear();
+      break;
+    }
+    values.push_back(value);
+  }
+  if (values.size() != count) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(flag, ": \"", text, "\" is not ", form));
+  }
+  return values;
+}
+
+}  // namespace
+
+absl::StatusOr<std::array<uint32_t, 3>> ParseRgb(absl::string_view flag,
+                                                 absl::string_view text) {
+  FOVEA_ASSIGN_OR_RETURN(
+      const std::vector<uint32_t> values,
+      ParseIntegers(flag, text, 3, 255, "R,G,B (three integers 0-255)"));
+  return std::array<uint32_t, 3>{values[0], values[1], values[2]};
+}
+
+absl::StatusOr<fovea::v1::AttentionPixel> ParsePixel(absl::string_view flag,
+                                                     absl::string_view text) {
+  FOVEA_ASSIGN_OR_RETURN(const std::vector<uint32_t> values,
+                         ParseIntegers(flag, text, 2, 1u << 20,
+                                       "U,V (column,row, integers >= 0)"));
+  fovea::v1::AttentionPixel pixel;
+  pixel.set_u(values[0]);
+  pixel.set_v(values[1]);
+  return pixel;
 }
 
 std::string SaliencyName(fovea::v1::SaliencyOperator op) {

@@ -1,6 +1,8 @@
 #ifndef FOVEA_CLIENT_OPTION_NAMES_H_
 #define FOVEA_CLIENT_OPTION_NAMES_H_
 
+#include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -40,6 +42,15 @@ absl::StatusOr<fovea::v1::Fusion> ParseFusion(absl::string_view text);
 // "cos", "ebs".
 absl::StatusOr<fovea::v1::SegmentationMethod> ParseSegmentationMethod(
     absl::string_view text);
+
+// The colour the target_color operator looks for: "R,G,B", three integers
+// 0-255 ("200,30,30"); INVALID_ARGUMENT naming `flag` otherwise.
+absl::StatusOr<std::array<uint32_t, 3>> ParseRgb(absl::string_view flag,
+                                                 absl::string_view text);
+// A pixel "U,V" (column, row; integers >= 0), e.g. the location prior's
+// centre; INVALID_ARGUMENT naming `flag` otherwise.
+absl::StatusOr<fovea::v1::AttentionPixel> ParsePixel(absl::string_view flag,
+                                                     absl::string_view text);
 
 // The short name of an operator ("rso" for RSO), the inverse of the names
 // ParseSaliency accepts; the proto enum name in lower case for others.

@@ -1,7 +1,11 @@
 #include "server/capabilities.h"
 
 #include <array>
+#include <iterator>
+#include <type_traits>
+#include <vector>
 
+#include "core/pipeline/saliency_registry.h"
 #include "server/convert.h"
 
 #ifndef FOVEA_VERSION
@@ -11,24 +15,16 @@
 namespace fovea::server {
 namespace {
 
-constexpr std::array kAllSaliencyOps = {
-    SaliencyOp::kPh,          SaliencyOp::kSh,
-    SaliencyOp::kRso,         SaliencyOp::kSym3d,
-    SaliencyOp::kItti,        SaliencyOp::kHarel,
-    SaliencyOp::kHou,         SaliencyOp::kKootstra,
-    SaliencyOp::kTargetColor, SaliencyOp::kLocationPrior,
-};
 constexpr std::array kAllPyramids = {PyramidKind::kNone, PyramidKind::kSimple,
                                      PyramidKind::kItti};
 constexpr std::array kAllNormalizations = {
     NormalizationKind::kLin, NormalizationKind::kNms, NormalizationKind::kNlm};
-constexpr std::array kAllExtractions = {
-    ExtractionKind::kMsr, ExtractionKind::kWta, ExtractionKind::kTj};
 
 // The values of `all` for which `set(options, value)` on default options
 // passes Validate.
-template <typename T, size_t N, typename Setter>
-std::vector<T> Accepted(const std::array<T, N>& all, Setter set) {
+template <typename Range, typename Setter>
+auto Accepted(const Range& all, Setter set) {
+  using T = std::decay_t<decltype(*std::begin(all))>;
   std::vector<T> accepted;
   for (T value : all) {
     DetectOptions options;
@@ -43,7 +39,9 @@ std::vector<T> Accepted(const std::array<T, N>& all, Setter set) {
 std::string_view ServerVersion() { return FOVEA_VERSION; }
 
 std::vector<SaliencyOp> ImplementedSaliencyOps() {
-  return Accepted(kAllSaliencyOps, [](DetectOptions& options, SaliencyOp op) {
+  std::vector<SaliencyOp> all;
+  for (const SaliencyOperator& row : SaliencyOperators()) all.push_back(row.op);
+  return Accepted(all, [](DetectOptions& options, SaliencyOp op) {
     options.channels = {{op, 1.0f}};
   });
 }
@@ -62,10 +60,11 @@ std::vector<NormalizationKind> ImplementedNormalizations() {
 }
 
 std::vector<ExtractionKind> ImplementedExtractions() {
-  return Accepted(kAllExtractions,
-                  [](DetectOptions& options, ExtractionKind kind) {
-                    options.extraction = kind;
-                  });
+  std::vector<ExtractionKind> all;
+  for (const Extraction& row : Extractions()) all.push_back(row.kind);
+  return Accepted(all, [](DetectOptions& options, ExtractionKind kind) {
+    options.extraction = kind;
+  });
 }
 
 v1::Capabilities BuildCapabilities(
@@ -94,8 +93,9 @@ v1::Capabilities BuildCapabilities(
   for (ExtractionKind kind : ImplementedExtractions()) {
     out.add_extractions(ToProtoEnum(kind));
   }
-  out.add_segmentation_methods(v1::COS);
-  out.add_segmentation_methods(v1::EBS);
+  for (const SegmentMethodRow& row : SegmentMethods()) {
+    out.add_segmentation_methods(ToProtoEnum(row.method));
+  }
   for (const auto& [name, version] : model_versions) {
     v1::ModelVersion* model = out.add_models();
     model->set_name(name);

@@ -6,10 +6,12 @@
 #include <exception>
 #include <vector>
 
+#include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/frame/image_codec.h"
+#include "core/pipeline/saliency_registry.h"
 
 namespace fovea::server {
 namespace {
@@ -61,35 +63,21 @@ absl::Status UnknownEnumValue(const std::string& field, int value) {
       absl::StrCat(field, ": unknown value ", value));
 }
 
+// By name: the wire value whose name is the registry row's in upper case
+// (saliency_registry.h).
 absl::StatusOr<SaliencyOp> FromProto(v1::SaliencyOperator op,
                                      const std::string& field) {
-  switch (op) {
-    case v1::PH:
-      return SaliencyOp::kPh;
-    case v1::SH:
-      return SaliencyOp::kSh;
-    case v1::RSO:
-      return SaliencyOp::kRso;
-    case v1::SYM3D:
-      return SaliencyOp::kSym3d;
-    case v1::ITTI:
-      return SaliencyOp::kItti;
-    case v1::HAREL:
-      return SaliencyOp::kHarel;
-    case v1::HOU:
-      return SaliencyOp::kHou;
-    case v1::KOOTSTRA:
-      return SaliencyOp::kKootstra;
-    case v1::TARGET_COLOR:
-      return SaliencyOp::kTargetColor;
-    case v1::LOCATION_PRIOR:
-      return SaliencyOp::kLocationPrior;
-    case v1::SALIENCY_OPERATOR_UNSPECIFIED:
-      return absl::InvalidArgumentError(
-          absl::StrCat(field, ": an operator is required"));
-    default:
-      return UnknownEnumValue(field, op);
+  if (op == v1::SALIENCY_OPERATOR_UNSPECIFIED) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ": an operator is required"));
   }
+  const SaliencyOperator* row = nullptr;
+  if (v1::SaliencyOperator_IsValid(op)) {
+    row = FindSaliencyOperator(
+        absl::AsciiStrToLower(v1::SaliencyOperator_Name(op)));
+  }
+  if (row == nullptr) return UnknownEnumValue(field, op);
+  return row->op;
 }
 
 // The FromProto overloads below leave `out` alone for UNSPECIFIED, so the
@@ -160,22 +148,17 @@ absl::Status FromProto(v1::Fusion in, FusionKind& out) {
   }
 }
 
+// By name (Extractions() in core/pipeline/detect.h).
 absl::Status FromProto(v1::Extraction in, ExtractionKind& out) {
-  switch (in) {
-    case v1::EXTRACTION_UNSPECIFIED:
-      return absl::OkStatus();
-    case v1::MSR:
-      out = ExtractionKind::kMsr;
-      return absl::OkStatus();
-    case v1::WTA:
-      out = ExtractionKind::kWta;
-      return absl::OkStatus();
-    case v1::TJ:
-      out = ExtractionKind::kTj;
-      return absl::OkStatus();
-    default:
-      return UnknownEnumValue("options.extraction", in);
+  if (in == v1::EXTRACTION_UNSPECIFIED) return absl::OkStatus();
+  if (!v1::Extraction_IsValid(in)) {
+    return UnknownEnumValue("options.extraction", in);
   }
+  absl::StatusOr<ExtractionKind> kind =
+      ParseExtraction(absl::AsciiStrToLower(v1::Extraction_Name(in)));
+  if (!kind.ok()) return UnknownEnumValue("options.extraction", in);
+  out = *kind;
+  return absl::OkStatus();
 }
 
 absl::StatusOr<std::vector<WeightedChannel>> ToChannels(
@@ -439,29 +422,20 @@ absl::StatusOr<DetectOptions> ToDetectOptions(
 }
 
 v1::SaliencyOperator ToProtoEnum(SaliencyOp op) {
-  switch (op) {
-    case SaliencyOp::kPh:
-      return v1::PH;
-    case SaliencyOp::kSh:
-      return v1::SH;
-    case SaliencyOp::kRso:
-      return v1::RSO;
-    case SaliencyOp::kSym3d:
-      return v1::SYM3D;
-    case SaliencyOp::kItti:
-      return v1::ITTI;
-    case SaliencyOp::kHarel:
-      return v1::HAREL;
-    case SaliencyOp::kHou:
-      return v1::HOU;
-    case SaliencyOp::kKootstra:
-      return v1::KOOTSTRA;
-    case SaliencyOp::kTargetColor:
-      return v1::TARGET_COLOR;
-    case SaliencyOp::kLocationPrior:
-      return v1::LOCATION_PRIOR;
+  v1::SaliencyOperator value = v1::SALIENCY_OPERATOR_UNSPECIFIED;
+  const SaliencyOperator* row = FindSaliencyOperator(op);
+  if (row != nullptr) {
+    v1::SaliencyOperator_Parse(absl::AsciiStrToUpper(AbslView(row->name)),
+                               &value);
   }
-  return v1::SALIENCY_OPERATOR_UNSPECIFIED;
+  return value;
+}
+
+v1::SegmentationMethod ToProtoEnum(SegmentMethod method) {
+  v1::SegmentationMethod value = v1::SEGMENTATION_METHOD_UNSPECIFIED;
+  v1::SegmentationMethod_Parse(
+      absl::AsciiStrToUpper(AbslView(SegmentMethodName(method))), &value);
+  return value;
 }
 
 v1::Pyramid ToProtoEnum(PyramidKind pyramid) {
@@ -509,15 +483,10 @@ v1::Fusion ToProtoEnum(FusionKind fusion) {
 }
 
 v1::Extraction ToProtoEnum(ExtractionKind extraction) {
-  switch (extraction) {
-    case ExtractionKind::kMsr:
-      return v1::MSR;
-    case ExtractionKind::kWta:
-      return v1::WTA;
-    case ExtractionKind::kTj:
-      return v1::TJ;
-  }
-  return v1::EXTRACTION_UNSPECIFIED;
+  v1::Extraction value = v1::EXTRACTION_UNSPECIFIED;
+  v1::Extraction_Parse(
+      absl::AsciiStrToUpper(AbslView(ExtractionName(extraction))), &value);
+  return value;
 }
 
 v1::DetectOptions ToProtoDetectOptions(const DetectOptions& options) {
@@ -650,17 +619,19 @@ absl::StatusOr<SegmentOptions> ToSegmentOptions(
   FOVEA_ASSIGN_OR_RETURN(DetectOptions detect,
                          ToNestedDetectOptions(request.detect_options()));
   options.detect = std::move(detect);
-  switch (request.method()) {
-    case v1::SEGMENTATION_METHOD_UNSPECIFIED:
-    case v1::COS:
-      options.method = SegmentMethod::kCos;
-      break;
-    case v1::EBS:
-      options.method = SegmentMethod::kEbs;
-      break;
-    default:
+  // By name: the value whose name is a segment method row's in upper case
+  // (core/pipeline/segment.h); UNSPECIFIED is the default method.
+  if (request.method() != v1::SEGMENTATION_METHOD_UNSPECIFIED) {
+    absl::StatusOr<SegmentMethod> method = absl::InvalidArgumentError("");
+    if (v1::SegmentationMethod_IsValid(request.method())) {
+      method = ParseSegmentMethod(
+          absl::AsciiStrToLower(v1::SegmentationMethod_Name(request.method())));
+    }
+    if (!method.ok()) {
       return absl::InvalidArgumentError(absl::StrCat(
           "method: unknown value ", static_cast<int>(request.method())));
+    }
+    options.method = *method;
   }
   FOVEA_ASSIGN_OR_RETURN(std::vector<cv::Point> seeds,
                          ToPixels(request.seeds(), "seeds"));

@@ -67,6 +67,7 @@ v1::LevelCombination ToProtoEnum(LevelCombination combination);
 v1::Normalization ToProtoEnum(NormalizationKind normalization);
 v1::Fusion ToProtoEnum(FusionKind fusion);
 v1::Extraction ToProtoEnum(ExtractionKind extraction);
+v1::SegmentationMethod ToProtoEnum(SegmentMethod method);
 
 // A saliency map (CV_32FC1, values in [0, 1]) as a 16-bit grey PNG file:
 // pixel = round(value * 65535), clamped to [0, 65535], NaN as 0. INTERNAL

@@ -3,15 +3,13 @@
 #include <algorithm>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/check.h"
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
+#include "core/pipeline/saliency_registry.h"
 #include "core/pyramid/feature_pyramid.h"
 #include "core/pyramid/normalization.h"
-#include "core/saliency/ph.h"
-#include "core/saliency/rso.h"
 #include "core/saliency/saliency_map.h"
-#include "core/saliency/sh.h"
-#include "core/saliency/sym3d.h"
 
 namespace fovea {
 namespace {
@@ -40,43 +38,7 @@ FeaturePyramidOptions ToFeaturePyramidOptions(const DetectOptions& options) {
   return f;
 }
 
-bool IsColorOperator(SaliencyOp op) {
-  switch (op) {
-    case SaliencyOp::kItti:
-    case SaliencyOp::kHarel:
-    case SaliencyOp::kHou:
-    case SaliencyOp::kKootstra:
-    case SaliencyOp::kTargetColor:
-    case SaliencyOp::kLocationPrior:
-      return true;
-    default:
-      return false;
-  }
-}
-
 }  // namespace
-
-absl::StatusOr<cv::Mat> ChannelComputer::ColorOperator(SaliencyOp op) const {
-  const cv::Mat& color = cloud_.color;
-  switch (op) {
-    case SaliencyOp::kItti:
-      return ComputeIttiSaliency(color, options_.itti);
-    case SaliencyOp::kHarel:
-      return ComputeHarelSaliency(color, options_.harel);
-    case SaliencyOp::kHou:
-      return ComputeHouSaliency(color, options_.hou);
-    case SaliencyOp::kKootstra:
-      return ComputeKootstraSaliency(color, options_.kootstra);
-    case SaliencyOp::kTargetColor:
-      return ComputeTargetColorSaliency(color, options_.target_color);
-    case SaliencyOp::kLocationPrior:
-      return ComputeLocationPrior(color.cols, color.rows,
-                                  options_.location_prior);
-    default:
-      return absl::InternalError(absl::StrCat("'", AbslView(SaliencyOpName(op)),
-                                              "' is not a colour operator"));
-  }
-}
 
 ChannelComputer::ChannelComputer(const OrganizedCloud& cloud,
                                  const SupportPlane& plane,
@@ -114,6 +76,12 @@ absl::StatusOr<const TableScene*> ChannelComputer::TableAt(int level) {
   return &*tables_[level];
 }
 
+const SaliencyOperator& ChannelComputer::Row(SaliencyOp op) {
+  const SaliencyOperator* row = FindSaliencyOperator(op);
+  FOVEA_CHECK(row != nullptr);  // Validate(DetectOptions) refused it
+  return *row;
+}
+
 absl::StatusOr<cv::Mat> ChannelComputer::OperatorAt(SaliencyOp op, int level) {
   const OrganizedCloud* cloud = &cloud_;
   if (level > 0) {
@@ -121,27 +89,15 @@ absl::StatusOr<cv::Mat> ChannelComputer::OperatorAt(SaliencyOp op, int level) {
     if (!pyramid.ok()) return pyramid.status();
     cloud = &(*pyramid)->levels[level];
   }
-  absl::StatusOr<const TableScene*> table = TableAt(level);
-  if (!table.ok()) return table.status();
-  switch (op) {
-    case SaliencyOp::kPh:
-      return ComputePhSaliency(**table, options_.ph);
-    case SaliencyOp::kSh:
-      return ComputeShSaliency(*cloud, plane_, **table, options_.sh);
-    case SaliencyOp::kRso:
-      return ComputeRsoSaliency(*cloud, plane_, **table, options_.rso);
-    case SaliencyOp::kSym3d:
-      return ComputeSym3dSaliency(*cloud, **table, options_.sym3d);
-    default:
-      return absl::UnimplementedError(absl::StrCat("saliency '",
-                                                   AbslView(SaliencyOpName(op)),
-                                                   "' is not implemented yet"));
-  }
+  FOVEA_ASSIGN_OR_RETURN(const TableScene* table, TableAt(level));
+  return Row(op).compute({*cloud, plane_, *table, options_});
 }
 
 absl::StatusOr<cv::Mat> ChannelComputer::Compute(SaliencyOp op) {
-  if (IsColorOperator(op)) {
-    FOVEA_ASSIGN_OR_RETURN(cv::Mat map, ColorOperator(op));
+  const SaliencyOperator& row = Row(op);
+  if (row.domain == OperatorDomain::kImage) {
+    FOVEA_ASSIGN_OR_RETURN(cv::Mat map,
+                           row.compute({cloud_, plane_, table_, options_}));
     return NormalizeMap(map, ToMapNormalization(options_.normalization),
                         options_.normalization_options);
   }
@@ -159,13 +115,12 @@ absl::StatusOr<cv::Mat> ChannelComputer::Compute(SaliencyOp op) {
                             ToFeaturePyramidOptions(options_)));
     return OnCandidates(std::move(conspicuity.map));
   }
-  // Single level: SYM3D needs a kernel the size of an object, so it runs on
-  // a coarser level and is resampled to level 0.
+  // Single level: an operator may run on a coarser level (SYM3D needs a
+  // kernel the size of an object) and be resampled to level 0.
   int level = 0;
-  if (op == SaliencyOp::kSym3d) {
-    absl::StatusOr<const CloudPyramid*> pyramid = Pyramid();
-    if (!pyramid.ok()) return pyramid.status();
-    level = std::min(options_.sym3d_level, (*pyramid)->size() - 1);
+  if (row.level_without_pyramid != nullptr) {
+    FOVEA_ASSIGN_OR_RETURN(const CloudPyramid* pyramid, Pyramid());
+    level = std::min(row.level_without_pyramid(options_), pyramid->size() - 1);
   }
   absl::StatusOr<cv::Mat> map = OperatorAt(op, level);
   if (!map.ok()) return map.status();

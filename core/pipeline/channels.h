@@ -10,6 +10,7 @@
 #include "core/frame/support_plane.h"
 #include "core/frame/table_scene.h"
 #include "core/pipeline/detect.h"
+#include "core/pipeline/saliency_registry.h"
 #include "core/pyramid/cloud_pyramid.h"
 
 namespace fovea {
@@ -38,9 +39,9 @@ class ChannelComputer {
  private:
   absl::StatusOr<const CloudPyramid*> Pyramid();
   absl::StatusOr<const TableScene*> TableAt(int level);
-  // A colour or top-down operator on the colour image.
-  absl::StatusOr<cv::Mat> ColorOperator(SaliencyOp op) const;
-  // The 3D operator on pyramid level `level`, at that level's size.
+  // The registry's row of `op` (saliency_registry.h).
+  static const SaliencyOperator& Row(SaliencyOp op);
+  // A kGeometry operator on pyramid level `level`, at that level's size.
   absl::StatusOr<cv::Mat> OperatorAt(SaliencyOp op, int level);
   // `map` (level 0) zeroed off level 0's candidates, where resampling and
   // pyramids smear it (only points on the table get saliency), then

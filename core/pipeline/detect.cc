@@ -12,6 +12,7 @@
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/pipeline/channels.h"
+#include "core/pipeline/saliency_registry.h"
 #include "core/pipeline/sensor_adaptation.h"
 #include "core/pyramid/fusion.h"
 #include "core/saliency/saliency_map.h"
@@ -25,31 +26,24 @@ constexpr double kReferenceFocalPx = 525.0;
 // 8 levels, 0..7).
 constexpr int kMaxSym3dLevel = 7;
 
-struct NamedOp {
-  SaliencyOp op;
-  std::string_view name;
-};
-constexpr NamedOp kOps[] = {
-    {SaliencyOp::kPh, "ph"},
-    {SaliencyOp::kSh, "sh"},
-    {SaliencyOp::kRso, "rso"},
-    {SaliencyOp::kSym3d, "sym3d"},
-    {SaliencyOp::kItti, "itti"},
-    {SaliencyOp::kHarel, "harel"},
-    {SaliencyOp::kHou, "hou"},
-    {SaliencyOp::kKootstra, "kootstra"},
-    {SaliencyOp::kTargetColor, "target-color"},
-    {SaliencyOp::kLocationPrior, "location-prior"},
-};
-
-// Every operator of the wire contract is built; kept so that a new one can
-// be added to the enum before its implementation.
-bool IsImplemented(SaliencyOp op) {
-  for (const NamedOp& n : kOps) {
-    if (n.op == op) return true;
-  }
-  return false;
+absl::StatusOr<std::vector<AttentionPoint>> Msr(const cv::Mat& master,
+                                                const DetectOptions& options) {
+  return ExtractMsrPoints(master, options.max_points, options.msr);
 }
+absl::StatusOr<std::vector<AttentionPoint>> Wta(const cv::Mat& master,
+                                                const DetectOptions& options) {
+  return ExtractWtaPoints(master, options.max_points, options.wta);
+}
+absl::StatusOr<std::vector<AttentionPoint>> Tj(const cv::Mat& master,
+                                               const DetectOptions& options) {
+  return ExtractTjPoints(master, options.max_points, options.tj);
+}
+
+constexpr Extraction kExtractions[] = {
+    {ExtractionKind::kMsr, "msr", &Msr},
+    {ExtractionKind::kWta, "wta", &Wta},
+    {ExtractionKind::kTj, "tj", &Tj},
+};
 
 // Wall-clock stage timer that appends to the result's timings.
 class StageClock {
@@ -84,20 +78,15 @@ void FillPoints(const OrganizedCloud& cloud,
 }  // namespace
 
 std::string_view SaliencyOpName(SaliencyOp op) {
-  for (const NamedOp& n : kOps) {
-    if (n.op == op) return n.name;
-  }
-  return "unknown";
+  const SaliencyOperator* row = FindSaliencyOperator(op);
+  return row != nullptr ? row->name : "unknown";
 }
 
+absl::Span<const Extraction> Extractions() { return kExtractions; }
+
 std::string_view ExtractionName(ExtractionKind kind) {
-  switch (kind) {
-    case ExtractionKind::kMsr:
-      return "msr";
-    case ExtractionKind::kWta:
-      return "wta";
-    case ExtractionKind::kTj:
-      return "tj";
+  for (const Extraction& row : kExtractions) {
+    if (row.kind == kind) return row.name;
   }
   return "unknown";
 }
@@ -127,30 +116,26 @@ absl::StatusOr<std::vector<SaliencyOp>> ParseSaliencyOps(
     std::string_view text) {
   std::vector<SaliencyOp> ops;
   for (absl::string_view part : absl::StrSplit(AbslView(text), '+')) {
-    bool found = false;
-    for (const NamedOp& n : kOps) {
-      if (AbslView(n.name) == part) {
-        ops.push_back(n.op);
-        found = true;
-        break;
-      }
-    }
-    if (!found) {
+    const SaliencyOperator* row =
+        FindSaliencyOperator(std::string_view(part.data(), part.size()));
+    if (row == nullptr) {
       return absl::InvalidArgumentError(absl::StrCat(
           "saliency: unknown operator '", part,
-          "' (known: ph sh rso sym3d itti harel hou kootstra target-color "
-          "location-prior, combined with '+')"));
+          "' (known: ", SaliencyOperatorNames(), ", combined with '+')"));
     }
+    ops.push_back(row->op);
   }
   return ops;
 }
 
 absl::StatusOr<ExtractionKind> ParseExtraction(std::string_view text) {
-  if (text == "msr") return ExtractionKind::kMsr;
-  if (text == "wta") return ExtractionKind::kWta;
-  if (text == "tj") return ExtractionKind::kTj;
+  std::string known;
+  for (const Extraction& row : kExtractions) {
+    if (row.name == text) return row.kind;
+    absl::StrAppend(&known, known.empty() ? "" : " ", AbslView(row.name));
+  }
   return absl::InvalidArgumentError(absl::StrCat(
-      "extract: unknown strategy '", AbslView(text), "' (known: msr wta tj)"));
+      "extract: unknown strategy '", AbslView(text), "' (known: ", known, ")"));
 }
 
 absl::StatusOr<PyramidKind> ParsePyramid(std::string_view text) {
@@ -225,7 +210,7 @@ absl::Status Validate(const DetectOptions& options) {
           "options.saliency: weight of '", AbslView(SaliencyOpName(c.op)),
           "' must be finite and >= 0, got ", c.weight));
     }
-    if (!IsImplemented(c.op)) {
+    if (FindSaliencyOperator(c.op) == nullptr) {
       return absl::UnimplementedError(
           absl::StrCat("options.saliency: '", AbslView(SaliencyOpName(c.op)),
                        "' is not implemented yet"));
@@ -281,31 +266,23 @@ absl::StatusOr<DetectResult> DetectOnSceneUnguarded(
 
 absl::StatusOr<std::vector<AttentionPoint>> ExtractAttentionPoints(
     const cv::Mat& master, const DetectOptions& options) {
-  switch (options.extraction) {
-    case ExtractionKind::kWta:
-      return ExtractWtaPoints(master, options.max_points, options.wta);
-    case ExtractionKind::kTj:
-      return ExtractTjPoints(master, options.max_points, options.tj);
-    case ExtractionKind::kMsr:
-      break;
+  for (const Extraction& row : kExtractions) {
+    if (row.kind == options.extraction) return row.extract(master, options);
   }
-  return ExtractMsrPoints(master, options.max_points, options.msr);
+  return absl::InvalidArgumentError("options.extraction: unknown strategy");
 }
 
 std::vector<std::string> DetectStageNames() {
   std::vector<std::string> names = {"reduce",  "fill_holes",    "cloud",
                                     "normals", "support_plane", "fusion"};
-  for (const NamedOp& n : kOps) {
-    if (IsImplemented(n.op)) {
-      names.push_back(absl::StrCat("saliency.", AbslView(n.name)));
-    }
+  for (const SaliencyOperator& row : SaliencyOperators()) {
+    names.push_back(absl::StrCat("saliency.", AbslView(row.name)));
   }
-  for (ExtractionKind kind :
-       {ExtractionKind::kMsr, ExtractionKind::kWta, ExtractionKind::kTj}) {
+  for (const Extraction& row : kExtractions) {
     DetectOptions probe;
-    probe.extraction = kind;
+    probe.extraction = row.kind;
     if (Validate(probe).ok()) {
-      names.push_back(absl::StrCat("extract.", AbslView(ExtractionName(kind))));
+      names.push_back(absl::StrCat("extract.", AbslView(row.name)));
     }
   }
   return names;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "absl/types/span.h"
 #include "core/attention/attention_point.h"
 #include "core/attention/msr.h"
 #include "core/attention/tj.h"
@@ -56,6 +57,22 @@ enum class LevelCombination { kSum, kMax };
 enum class NormalizationKind { kLin, kNms, kNlm };
 enum class FusionKind { kSum, kMax };
 enum class ExtractionKind { kMsr, kWta, kTj };
+
+// The one table of attention-point extractions, read like the saliency
+// registry (saliency_registry.h): the wire value is the Extraction value
+// whose name is the row's name in upper case. Adding one: its files in
+// core/attention/ and their test, an ExtractionKind value, one row in
+// detect.cc, one Extraction value in detect.proto.
+struct DetectOptions;
+struct AttentionPoint;
+struct Extraction {
+  ExtractionKind kind;
+  std::string_view name;  // "msr": lower case, the one spelling
+  // The points on the master map, most salient first.
+  absl::StatusOr<std::vector<AttentionPoint>> (*extract)(
+      const cv::Mat& master, const DetectOptions& options);
+};
+absl::Span<const Extraction> Extractions();
 
 std::string_view SaliencyOpName(SaliencyOp op);        // "ph", "sym3d", ...
 std::string_view ExtractionName(ExtractionKind kind);  // "msr", "wta", "tj"

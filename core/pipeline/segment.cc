@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "core/base/guarded.h"
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
@@ -148,6 +149,8 @@ cv::Mat ObjectRegion(const TableScene& table, float min_height) {
   return region;
 }
 
+}  // namespace
+
 // One object per seed, by one method; remembers what earlier seeds took.
 struct CutObject {
   cv::Mat mask;  // CV_8UC1, 255 on the object
@@ -160,6 +163,8 @@ class ObjectCutter {
   virtual absl::StatusOr<std::optional<CutObject>> Cut(
       cv::Point seed, const InterruptCheck& interrupt) = 0;
 };
+
+namespace {
 
 class CosCutter final : public ObjectCutter {
  public:
@@ -269,6 +274,33 @@ class EbsCutter final : public ObjectCutter {
   std::vector<cv::Mat> masks_;  // of the objects cut so far
 };
 
+// The rows' cutters. Without a scene (null), only the model is checked.
+absl::StatusOr<std::unique_ptr<ObjectCutter>> MakeCosCutter(
+    const PreparedScene* scene, const SegmentOptions& options,
+    const SegmentModels& models) {
+  if (models.cos == nullptr) {
+    return absl::FailedPreconditionError("segment: no COS model is loaded");
+  }
+  if (scene == nullptr) return nullptr;
+  return CosCutter::Create(*scene, *models.cos, options.cos);
+}
+
+absl::StatusOr<std::unique_ptr<ObjectCutter>> MakeEbsCutter(
+    const PreparedScene* scene, const SegmentOptions& options,
+    const SegmentModels& models) {
+  if (models.ebs == nullptr) {
+    return absl::FailedPreconditionError("segment: no EBS model is loaded");
+  }
+  if (scene == nullptr) return nullptr;
+  return std::unique_ptr<ObjectCutter>(
+      std::make_unique<EbsCutter>(*scene, *models.ebs, options.ebs_contour));
+}
+
+constexpr SegmentMethodRow kSegmentMethods[] = {
+    {SegmentMethod::kCos, "cos", &MakeCosCutter},
+    {SegmentMethod::kEbs, "ebs", &MakeEbsCutter},
+};
+
 // The seeds in the scene's (processing) pixels: the given ones mapped
 // there, or Detect's.
 absl::StatusOr<std::vector<AttentionPoint>> TakeSeeds(
@@ -305,12 +337,11 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
                        frame.width(), "x", frame.height(), " frame"));
     }
   }
-  if (options.method == SegmentMethod::kCos && models.cos == nullptr) {
-    return absl::FailedPreconditionError("segment: no COS model is loaded");
+  const SegmentMethodRow* method = FindSegmentMethod(options.method);
+  if (method == nullptr) {
+    return absl::InvalidArgumentError("segment: unknown method");
   }
-  if (options.method == SegmentMethod::kEbs && models.ebs == nullptr) {
-    return absl::FailedPreconditionError("segment: no EBS model is loaded");
-  }
+  FOVEA_RETURN_IF_ERROR(method->create(nullptr, options, models).status());
   SegmentSummary summary;
   FOVEA_ASSIGN_OR_RETURN(PreparedScene scene,
                          PrepareScene(frame, options.detect, interrupt));
@@ -328,15 +359,8 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
   FOVEA_RETURN_IF_ERROR(CheckInterrupt(interrupt));
 
   SteadyClock::time_point lap = SteadyClock::now();
-  std::unique_ptr<ObjectCutter> cutter;
-  if (options.method == SegmentMethod::kCos) {
-    FOVEA_ASSIGN_OR_RETURN(std::unique_ptr<ObjectCutter> cos,
-                           CosCutter::Create(scene, *models.cos, options.cos));
-    cutter = std::move(cos);
-  } else {
-    cutter =
-        std::make_unique<EbsCutter>(scene, *models.ebs, options.ebs_contour);
-  }
+  FOVEA_ASSIGN_OR_RETURN(std::unique_ptr<ObjectCutter> cutter,
+                         method->create(&scene, options, models));
   summary.timings.push_back({"segment.prepare", SecondsSince(lap)});
 
   const cv::Mat region =
@@ -419,15 +443,29 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
 
 }  // namespace
 
+absl::Span<const SegmentMethodRow> SegmentMethods() { return kSegmentMethods; }
+
+const SegmentMethodRow* FindSegmentMethod(SegmentMethod method) {
+  for (const SegmentMethodRow& row : kSegmentMethods) {
+    if (row.method == method) return &row;
+  }
+  return nullptr;
+}
+
 std::string_view SegmentMethodName(SegmentMethod method) {
-  return method == SegmentMethod::kEbs ? "ebs" : "cos";
+  const SegmentMethodRow* row = FindSegmentMethod(method);
+  return row != nullptr ? row->name : "unknown";
 }
 
 absl::StatusOr<SegmentMethod> ParseSegmentMethod(std::string_view text) {
-  if (text == "cos") return SegmentMethod::kCos;
-  if (text == "ebs") return SegmentMethod::kEbs;
-  return absl::InvalidArgumentError(absl::StrCat(
-      "unknown segmentation method '", AbslView(text), "' (known: cos, ebs)"));
+  std::vector<absl::string_view> known;
+  for (const SegmentMethodRow& row : kSegmentMethods) {
+    if (row.name == text) return row.method;
+    known.push_back(AbslView(row.name));
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat("unknown segmentation method '", AbslView(text),
+                   "' (known: ", absl::StrJoin(known, ", "), ")"));
 }
 
 absl::Status Validate(const SegmentOptions& options) {

@@ -4,12 +4,14 @@
 #include <Eigen/Core>
 #include <chrono>
 #include <functional>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string_view>
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "absl/types/span.h"
 #include "core/attention/attention_point.h"
 #include "core/base/interrupt.h"
 #include "core/frame/osd_pcd.h"
@@ -36,8 +38,33 @@ inline constexpr double kMinObjectAreaM2 = 4e-4;
 // the table.
 inline constexpr double kMinStandingShare = 0.5;
 
+struct SegmentOptions;
+struct SegmentModels;
+struct PreparedScene;
+class ObjectCutter;  // segment.cc: cuts one object at a seed
+
+// The one table of segmentation methods. The server's conversion and
+// capabilities (the wire value is the SegmentationMethod value whose name
+// is the row's name in upper case), fovea-client's names (from the proto
+// descriptor) and fovea-eval read it. Adding a method: its files in
+// core/segmentation/ and their test, a SegmentMethod value, a cutter and
+// one row in segment.cc, one SegmentationMethod value in segment.proto.
+struct SegmentMethodRow {
+  SegmentMethod method;
+  std::string_view name;  // "cos": lower case, the one spelling
+  // The method's cutter over a prepared scene; FAILED_PRECONDITION when its
+  // model is not loaded. With a null scene only the model is checked (and
+  // the cutter is null).
+  absl::StatusOr<std::unique_ptr<ObjectCutter>> (*create)(
+      const PreparedScene* scene, const SegmentOptions& options,
+      const SegmentModels& models);
+};
+absl::Span<const SegmentMethodRow> SegmentMethods();
+// The row of `method`; null when there is none.
+const SegmentMethodRow* FindSegmentMethod(SegmentMethod method);
+
 std::string_view SegmentMethodName(SegmentMethod method);  // "cos", "ebs"
-// "cos" or "ebs"; INVALID_ARGUMENT naming the known ones otherwise.
+// A row's name; INVALID_ARGUMENT naming the known ones otherwise.
 absl::StatusOr<SegmentMethod> ParseSegmentMethod(std::string_view text);
 
 struct SegmentOptions {

@@ -7,8 +7,10 @@
 #include <string>
 #include <vector>
 
+#include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "absl/strings/strip.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
 #include "client/fovea_client.h"
@@ -104,6 +106,60 @@ TEST_F(FoveaClientCliE2eTest, DetectSyntheticJsonHasPoints) {
   EXPECT_EQ(response.points(0).rank(), 0u);
   EXPECT_LT(response.points(0).u(), 640u);
   EXPECT_LT(response.points(0).v(), 480u);
+}
+
+// Every operator of the wire contract, by the name fovea-client takes for
+// it (the proto value's name in lower case), runs through the CLI: the
+// response's timings hold that operator's stage. The two top-down cues
+// get their flags.
+TEST_F(FoveaClientCliE2eTest, EveryOperatorRunsFromTheCommandLine) {
+  const google::protobuf::EnumDescriptor* values =
+      fovea::v1::SaliencyOperator_descriptor();
+  int operators = 0;
+  for (int i = 0; i < values->value_count(); ++i) {
+    if (values->value(i)->number() == 0) continue;
+    const std::string name = absl::AsciiStrToLower(values->value(i)->name());
+    std::string extra;
+    if (name == "target_color") extra = " --target_color 200,30,30";
+    if (name == "location_prior") {
+      extra = " --location_prior 320,240 --location_sigma 60";
+    }
+    const CliRun run = RunCli(absl::StrCat("--server ", address_,
+                                           " detect --synthetic 3 --json "
+                                           "--saliency ",
+                                           name, extra));
+    ASSERT_EQ(run.exit_code, 0) << name << ": " << run.err;
+    fovea::v1::DetectResponse response;
+    ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(
+                    std::string(absl::StripAsciiWhitespace(run.out)), &response)
+                    .ok())
+        << name << ": " << run.out;
+    bool timed = false;
+    for (const fovea::v1::StageTiming& timing : response.timings()) {
+      timed |= timing.stage() == "saliency." + name;
+    }
+    EXPECT_TRUE(timed) << name << " did not run:\n" << run.out;
+    ++operators;
+  }
+  EXPECT_GE(operators, 10);
+
+  // A cue operator without its cue is the server's INVALID_ARGUMENT; a
+  // malformed cue is a usage error naming the flag.
+  CliRun run = RunCli(absl::StrCat("--server ", address_,
+                                   " detect --synthetic 3 --saliency "
+                                   "target_color"));
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.err, HasSubstr("target_color_rgb"));
+  run = RunCli(absl::StrCat("--server ", address_,
+                            " detect --synthetic 3 --saliency target_color "
+                            "--target_color 300,0,0"));
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_THAT(run.err, HasSubstr("--target_color"));
+  run = RunCli(absl::StrCat("--server ", address_,
+                            " detect --synthetic 3 --saliency location_prior "
+                            "--location_prior 320"));
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_THAT(run.err, HasSubstr("--location_prior"));
 }
 
 TEST_F(FoveaClientCliE2eTest, SplitEdgesFlagIsSentEitherWay) {

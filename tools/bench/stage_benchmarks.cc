@@ -19,6 +19,7 @@
 #include "core/pipeline/detect.h"
 #include "core/pipeline/incremental.h"
 #include "core/pipeline/models.h"
+#include "core/pipeline/saliency_registry.h"
 #include "core/pipeline/segment.h"
 #include "core/saliency/ph.h"
 #include "core/saliency/rso.h"
@@ -427,6 +428,21 @@ void RegisterAttentionCases(const SceneList* scenes, const std::string& set,
     options.extraction = c.extraction;
     Register(absl::StrCat("BM_DetectAttention/", AbslView(c.name), suffix),
              scenes, set, sweep, kDetectMs, [options](const BenchScene& scene) {
+               absl::StatusOr<DetectResult> result =
+                   RunDetect(scene.frame, options);
+               benchmark::DoNotOptimize(result);
+               return result.status();
+             });
+  }
+  // Every operator of the registry alone (one level, MSR; the cues'
+  // defaults), so that a new row gets its benchmark.
+  for (const SaliencyOperator& row : SaliencyOperators()) {
+    DetectOptions options;
+    options.channels = {{row.op, 1.0f}};
+    options.pyramid = PyramidKind::kNone;
+    options.extraction = ExtractionKind::kMsr;
+    Register(absl::StrCat("BM_Operator/", AbslView(row.name), suffix), scenes,
+             set, sweep, kDetectMs, [options](const BenchScene& scene) {
                absl::StatusOr<DetectResult> result =
                    RunDetect(scene.frame, options);
                benchmark::DoNotOptimize(result);

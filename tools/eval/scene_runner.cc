@@ -125,8 +125,8 @@ absl::StatusOr<SceneRun> RunOnScene(const LabelledFrame& scene,
         RunSegmentIncremental(scene.frame, inc, options.models.inc, sinks);
   } else {
     SegmentOptions segment;
-    segment.method = options.method == SceneMethod::kCos ? SegmentMethod::kCos
-                                                         : SegmentMethod::kEbs;
+    FOVEA_ASSIGN_OR_RETURN(segment.method,
+                           ParseSegmentMethod(SceneMethodName(options.method)));
     segment.detect = options.detect;
     segment.cover_scene = options.cover_scene;
     summary = RunSegment(scene.frame, segment, options.models, sinks);
