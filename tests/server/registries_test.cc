@@ -3,8 +3,6 @@
 // the server's conversion and capabilities, and fovea-client's names, and
 // every operator of the wire contract has a row.
 
-#include "core/pipeline/saliency_registry.h"
-
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -14,6 +12,7 @@
 #include "absl/strings/ascii.h"
 #include "client/option_names.h"
 #include "core/frame/frame_decode.h"
+#include "core/pipeline/saliency_registry.h"
 #include "fovea/v1/detect.pb.h"
 #include "fovea/v1/segment.pb.h"
 #include "server/capabilities.h"
