@@ -63,15 +63,14 @@ absl::StatusOr<const CloudPyramid*> ChannelComputer::Pyramid() {
 
 absl::StatusOr<const TableScene*> ChannelComputer::TableAt(int level) {
   if (level == 0) return &table_;
-  absl::StatusOr<const CloudPyramid*> pyramid = Pyramid();
-  if (!pyramid.ok()) return pyramid.status();
-  if (level >= (*pyramid)->size()) {
+  FOVEA_ASSIGN_OR_RETURN(const CloudPyramid* pyramid, Pyramid());
+  if (level >= pyramid->size()) {
     return absl::InvalidArgumentError(
         absl::StrCat("pyramid level ", level, " does not exist"));
   }
   if (!tables_[level].has_value()) {
-    tables_[level] = PrepareTableScene((*pyramid)->levels[level], plane_,
-                                       options_.table_scene);
+    tables_[level] =
+        PrepareTableScene(pyramid->levels[level], plane_, options_.table_scene);
   }
   return &*tables_[level];
 }
@@ -85,9 +84,8 @@ const SaliencyOperator& ChannelComputer::Row(SaliencyOp op) {
 absl::StatusOr<cv::Mat> ChannelComputer::OperatorAt(SaliencyOp op, int level) {
   const OrganizedCloud* cloud = &cloud_;
   if (level > 0) {
-    absl::StatusOr<const CloudPyramid*> pyramid = Pyramid();
-    if (!pyramid.ok()) return pyramid.status();
-    cloud = &(*pyramid)->levels[level];
+    FOVEA_ASSIGN_OR_RETURN(const CloudPyramid* pyramid, Pyramid());
+    cloud = &pyramid->levels[level];
   }
   FOVEA_ASSIGN_OR_RETURN(const TableScene* table, TableAt(level));
   return Row(op).compute({*cloud, plane_, *table, options_});
@@ -102,8 +100,7 @@ absl::StatusOr<cv::Mat> ChannelComputer::Compute(SaliencyOp op) {
                         options_.normalization_options);
   }
   if (options_.pyramid != PyramidKind::kNone) {
-    absl::StatusOr<const CloudPyramid*> pyramid = Pyramid();
-    if (!pyramid.ok()) return pyramid.status();
+    FOVEA_ASSIGN_OR_RETURN(const CloudPyramid* pyramid, Pyramid());
     const LevelFeature feature =
         [this, op](int level,
                    const OrganizedCloud& /*cloud*/) -> absl::StatusOr<cv::Mat> {
@@ -111,7 +108,7 @@ absl::StatusOr<cv::Mat> ChannelComputer::Compute(SaliencyOp op) {
     };
     FOVEA_ASSIGN_OR_RETURN(
         Conspicuity conspicuity,
-        BuildConspicuityMap(**pyramid, feature,
+        BuildConspicuityMap(*pyramid, feature,
                             ToFeaturePyramidOptions(options_)));
     return OnCandidates(std::move(conspicuity.map));
   }
@@ -122,16 +119,14 @@ absl::StatusOr<cv::Mat> ChannelComputer::Compute(SaliencyOp op) {
     FOVEA_ASSIGN_OR_RETURN(const CloudPyramid* pyramid, Pyramid());
     level = std::min(row.level_without_pyramid(options_), pyramid->size() - 1);
   }
-  absl::StatusOr<cv::Mat> map = OperatorAt(op, level);
-  if (!map.ok()) return map.status();
+  FOVEA_ASSIGN_OR_RETURN(cv::Mat map, OperatorAt(op, level));
   if (level > 0) {
-    FOVEA_ASSIGN_OR_RETURN(cv::Mat up,
-                           ResampleBetweenLevels(*map, level, 0, **Pyramid()));
-    map = std::move(up);
+    FOVEA_ASSIGN_OR_RETURN(const CloudPyramid* pyramid, Pyramid());
+    FOVEA_ASSIGN_OR_RETURN(map, ResampleBetweenLevels(map, level, 0, *pyramid));
   }
   // Level-0 operators give zero off the candidates already; a resampled map
   // is smeared and masked again.
-  return NormalizeMap(level > 0 ? OnCandidates(*std::move(map)) : *map,
+  return NormalizeMap(level > 0 ? OnCandidates(std::move(map)) : map,
                       ToMapNormalization(options_.normalization),
                       options_.normalization_options);
 }
