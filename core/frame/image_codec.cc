@@ -13,6 +13,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/base/strings.h"
 #include "core/frame/image_codec_internal.h"
+#include "core/frame/image_header.h"
 
 namespace fovea {
 namespace image_codec_internal {
@@ -102,12 +103,10 @@ absl::StatusOr<cv::Mat> DecodeImage(std::string_view file,
   if (!status.ok()) return status;
   const absl::string_view bytes = AbslView(file);
   const absl::string_view field = AbslView(field_name);
-  if (bytes.substr(0, image_codec_internal::kPngSignature.size()) ==
-      image_codec_internal::kPngSignature) {
+  if (IsPngFile(file)) {
     return image_codec_internal::DecodePng(bytes, options, field);
   }
-  if (bytes.size() >= 2 && static_cast<unsigned char>(bytes[0]) == 0xFF &&
-      static_cast<unsigned char>(bytes[1]) == 0xD8) {
+  if (IsJpegFile(file)) {
     return image_codec_internal::DecodeJpeg(bytes, options, field);
   }
   return absl::InvalidArgumentError(absl::StrCat(

@@ -4,7 +4,7 @@
 // What the pieces of the image codec (image_codec.h) share: the PNG
 // decoder (png_decode.cc), the JPEG decoder (jpeg_decode.cc), the PNG
 // encoder (png_encode.cc) and the entry points that validate the options
-// and tell the formats apart (image_codec.cc).
+// and tell the formats apart (image_codec.cc, with image_header.h).
 // Internal to core/frame.
 //
 // How these files use setjmp/longjmp: libpng and libjpeg report errors by
@@ -31,9 +31,6 @@
 #include "core/frame/image_codec.h"
 
 namespace fovea::image_codec_internal {
-
-// The eight bytes every PNG file starts with.
-inline constexpr absl::string_view kPngSignature("\x89PNG\r\n\x1a\n", 8);
 
 // Longest library message kept; libjpeg's format_message writes up to
 // JMSG_LENGTH_MAX bytes.

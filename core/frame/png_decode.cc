@@ -16,6 +16,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/base/status_macros.h"
 #include "core/frame/image_codec_internal.h"
+#include "core/frame/image_header.h"
 
 namespace fovea::image_codec_internal {
 namespace {
