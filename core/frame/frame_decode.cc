@@ -23,6 +23,7 @@
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/frame/image_codec.h"
+#include "core/frame/image_header.h"
 
 namespace fovea {
 namespace {
@@ -35,10 +36,6 @@ constexpr uint32_t kLargestLimit = 1u << 15;
 // Longest prefix of a client-supplied encoding quoted in an error.
 constexpr size_t kQuotedEncodingChars = 32;
 
-constexpr absl::string_view kPngSignature("\x89PNG\r\n\x1a\n", 8);
-// Signature (8) + IHDR length (4) + type (4) + width, height, bit depth,
-// colour type (10): the bytes ReadPngHeader looks at.
-constexpr size_t kPngHeaderBytes = 26;
 constexpr int kPngColorTypeGrey = 0;
 
 enum class Slot { kColor, kDepth };
@@ -68,14 +65,6 @@ struct Layout {
   uint32_t step = 0;  // bytes per row; raw formats only
 };
 
-// Width, height and sample layout from a compressed file's header.
-struct FileHeader {
-  uint32_t width = 0;
-  uint32_t height = 0;
-  int bit_depth = 0;  // bits per sample
-  int channels = 0;   // PNG: colour type; JPEG: number of components
-};
-
 absl::string_view SlotName(Slot slot) {
   return slot == Slot::kColor ? "colour" : "depth";
 }
@@ -89,21 +78,6 @@ std::string Quoted(absl::string_view text) {
       "\"", absl::CHexEscape(text.substr(0, kQuotedEncodingChars)), "\"");
   if (text.size() > kQuotedEncodingChars) quoted += "...";
   return quoted;
-}
-
-uint32_t ReadBigEndian32(const unsigned char* p) {
-  return (uint32_t{p[0]} << 24) | (uint32_t{p[1]} << 16) |
-         (uint32_t{p[2]} << 8) | uint32_t{p[3]};
-}
-
-uint32_t ReadBigEndian16(const unsigned char* p) {
-  return (uint32_t{p[0]} << 8) | uint32_t{p[1]};
-}
-
-bool IsJpegStartOfFrame(unsigned char marker) {
-  // SOF0-SOF15 except DHT (C4), JPG (C8) and DAC (CC).
-  return marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 &&
-         marker != 0xCC;
 }
 
 // Looks up a non-empty encoding and checks it belongs in `slot`.
@@ -145,62 +119,10 @@ absl::Status CheckDimensions(uint64_t width, uint64_t height,
   return absl::OkStatus();
 }
 
-absl::StatusOr<FileHeader> ReadPngHeader(absl::string_view file,
-                                         absl::string_view field) {
-  const auto* p = reinterpret_cast<const unsigned char*>(file.data());
-  if (file.size() < kPngHeaderBytes || std::memcmp(p + 12, "IHDR", 4) != 0 ||
-      ReadBigEndian32(p + 8) != 13) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(field, ".compressed: not a decodable PNG (no IHDR in ",
-                     file.size(), " bytes)"));
-  }
-  FileHeader header;
-  header.width = ReadBigEndian32(p + 16);
-  header.height = ReadBigEndian32(p + 20);
-  header.bit_depth = p[24];
-  header.channels = p[25];
-  return header;
-}
-
-// Walks the JPEG markers up to the first start-of-frame segment.
-absl::StatusOr<FileHeader> ReadJpegHeader(absl::string_view file,
-                                          absl::string_view field) {
-  const auto* p = reinterpret_cast<const unsigned char*>(file.data());
-  const size_t size = file.size();
-  size_t pos = 2;  // after FF D8
-  while (pos + 4 <= size) {
-    if (p[pos] != 0xFF) break;
-    const unsigned char marker = p[pos + 1];
-    if (marker == 0xFF) {  // fill byte
-      ++pos;
-      continue;
-    }
-    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD8)) {
-      pos += 2;  // stand-alone marker
-      continue;
-    }
-    if (marker == 0xD9 || marker == 0xDA) break;  // EOI / SOS before a frame
-    const size_t length = ReadBigEndian16(p + pos + 2);
-    if (length < 2) break;
-    if (IsJpegStartOfFrame(marker)) {
-      if (length < 8 || pos + 2 + 8 > size) break;
-      FileHeader header;
-      header.bit_depth = p[pos + 4];
-      header.height = ReadBigEndian16(p + pos + 5);
-      header.width = ReadBigEndian16(p + pos + 7);
-      header.channels = p[pos + 9];
-      return header;
-    }
-    pos += 2 + length;
-  }
-  return absl::InvalidArgumentError(absl::StrCat(
-      field, ".compressed: not a decodable JPEG (no frame header in ",
-      file.size(), " bytes)"));
-}
-
 // Checks that width, height, step and encoding sent alongside a compressed
 // file agree with it. Compressed depth is always 16UC1.
-absl::Status CheckAgreesWithFile(const RawImage& image, const FileHeader& file,
+absl::Status CheckAgreesWithFile(const RawImage& image,
+                                 const ImageFileHeader& file,
                                  absl::string_view kind, Slot slot,
                                  absl::string_view field) {
   if (image.width != 0 && image.width != file.width) {
@@ -240,11 +162,14 @@ absl::StatusOr<Layout> InspectCompressed(const RawImage& image, Slot slot,
                                          const FrameLimits& limits) {
   const absl::string_view file = AbslView(image.compressed);
   Layout layout;
-  FileHeader header;
+  ImageFileHeader header;
   absl::string_view kind;
-  if (file.substr(0, kPngSignature.size()) == kPngSignature) {
+  if (IsPngFile(image.compressed)) {
     kind = "PNG";
-    FOVEA_ASSIGN_OR_RETURN(FileHeader png, ReadPngHeader(file, field));
+    FOVEA_ASSIGN_OR_RETURN(
+        ImageFileHeader png,
+        ReadPngFileHeader(image.compressed,
+                          absl::StrCat(field, ".compressed")));
     header = png;
     layout.format = Format::kPng;
     if (slot == Slot::kDepth &&
@@ -259,14 +184,16 @@ absl::StatusOr<Layout> InspectCompressed(const RawImage& image, Slot slot,
           field, ".compressed: a ", header.bit_depth,
           "-bit PNG; colour takes an 8-bit PNG (16-bit grey is for depth)"));
     }
-  } else if (file.size() >= 2 && static_cast<unsigned char>(file[0]) == 0xFF &&
-             static_cast<unsigned char>(file[1]) == 0xD8) {
+  } else if (IsJpegFile(image.compressed)) {
     kind = "JPEG";
     if (slot == Slot::kDepth) {
       return absl::InvalidArgumentError(absl::StrCat(
           field, ".compressed: a JPEG; depth takes a 16-bit grey PNG"));
     }
-    FOVEA_ASSIGN_OR_RETURN(FileHeader jpeg, ReadJpegHeader(file, field));
+    FOVEA_ASSIGN_OR_RETURN(
+        ImageFileHeader jpeg,
+        ReadJpegFileHeader(image.compressed,
+                           absl::StrCat(field, ".compressed")));
     header = jpeg;
     layout.format = Format::kJpeg;
   } else {

@@ -2,9 +2,10 @@
 #define FOVEA_CORE_FRAME_SUPPORT_GRID_H_
 
 // The pieces SearchSupport (support_plane.cc) is made of: a subsampled
-// grid of the cloud, planes' connected parts as candidate surfaces, their
-// scores and the chosen one's support region (support_score.cc). Internal
-// to core/frame; tests reach the behaviour through SearchSupport.
+// grid of the cloud and its geometry (support_grid.cc), planes' connected
+// parts as candidate surfaces and their scores (support_score.cc), and the
+// chosen one's support region (support_region.cc). Internal to
+// core/frame; tests reach the behaviour through SearchSupport.
 
 #include <Eigen/Core>
 #include <cmath>
@@ -17,6 +18,10 @@
 #include "core/frame/support_plane.h"
 
 namespace fovea::support_internal {
+
+inline constexpr float kDegToRad = static_cast<float>(M_PI / 180.0);
+// A refitted part keeps its plane only if within this of the plane found.
+inline constexpr float kMaxRefitAngleDeg = 10.0f;
 
 struct Plane {
   Eigen::Vector3f normal = Eigen::Vector3f::UnitZ();  // unit, to the camera
@@ -95,6 +100,14 @@ std::vector<Eigen::Vector2f> ConvexHull(
 std::vector<Eigen::Vector2f> HullOfMask(const OrganizedCloud& cloud,
                                         const cv::Mat& mask,
                                         const SupportPlane& plane);
+// The hull of the grid points `indices` in the frame's plane coordinates,
+// from each grid row's leftmost and rightmost point only: the image and
+// the plane are related by a homography, which keeps segments segments, so
+// a row's other points lie between its two ends (up to the noise across
+// the plane).
+std::vector<Eigen::Vector2f> HullOfIndices(const Grid& grid,
+                                           const SupportPlane& frame,
+                                           const std::vector<int>& indices);
 
 // The connected parts of `plane`'s near inliers (and of the grid points
 // `also`): 8-connected on the grid where neighbours lie within 2.5 grid
