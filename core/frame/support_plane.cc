@@ -1,6 +1,6 @@
 // SearchSupport: candidate planes by sequential RANSAC on a grid, their
 // connected parts as candidate surfaces, and the choice among them
-// (support_score.cc scores them and grows the chosen region).
+// (support_score.cc scores them, support_region.cc grows the chosen region).
 
 #include "core/frame/support_plane.h"
 
