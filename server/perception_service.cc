@@ -20,6 +20,7 @@
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/base/tsan.h"
+#include "server/call_support.h"
 #include "server/capabilities.h"
 #include "server/clock.h"
 #include "server/convert.h"
@@ -32,148 +33,6 @@
 
 namespace fovea::server {
 namespace {
-
-// Longest request_id written to the log; the id comes from the client.
-constexpr size_t kMaxLoggedRequestId = 128;
-
-// The metrics and the log line of one call: started when constructed,
-// handled at End*. Each call ends exactly once.
-class CallRecord {
- public:
-  CallRecord(std::string_view method, std::string_view request_id,
-             ServiceState& state)
-      : method_(method),
-        request_id_(request_id.substr(0, kMaxLoggedRequestId)),
-        start_(Clock::now()),
-        state_(state) {
-    state_.calls.fetch_add(1);
-    RecordCallStarted(method_);
-    RecordMessageReceived(method_);
-    IncrementInflight();
-  }
-
-  // A unary call: one message sent when OK.
-  grpc::Status EndUnary(const absl::Status& status) {
-    if (status.ok()) RecordMessageSent(method_);
-    return End(status);
-  }
-
-  // A server stream; its messages were counted as they were sent.
-  grpc::Status EndStream(const absl::Status& status) { return End(status); }
-
- private:
-  grpc::Status End(const absl::Status& status) {
-    const double seconds = SecondsSince(start_);
-    RecordCallHandled(method_, status.code(), seconds);
-    DecrementInflight();
-    state_.calls.fetch_sub(1);
-    std::string line = absl::StrFormat(
-        "call method=%s request_id=\"%s\" code=%s ms=%.1f", method_,
-        absl::CEscape(request_id_), GrpcCodeName(status.code()), seconds * 1e3);
-    if (!status.ok()) {
-      absl::StrAppend(&line, " message=\"", absl::CEscape(status.message()),
-                      "\"");
-    }
-    LogInfo(line);
-    return ToGrpcStatus(status);
-  }
-
-  const std::string_view method_;  // a string literal
-  const std::string request_id_;
-  const Clock::time_point start_;
-  ServiceState& state_;
-};
-
-// UNAVAILABLE once the server is shutting down (its drain delay is over).
-absl::Status CheckAccepting(const ServiceState& state) {
-  if (state.refusing.load()) {
-    return absl::UnavailableError("the server is shutting down; retry another");
-  }
-  return absl::OkStatus();
-}
-
-// What every frame-carrying call checks first: the server still accepts
-// calls, its body parsed (`parsed`, from ParseRequest), and the request
-// has a frame.
-template <typename Request>
-absl::Status AdmitFrameCall(const ServiceState& state,
-                            const absl::Status& parsed,
-                            const Request& request) {
-  FOVEA_RETURN_IF_ERROR(CheckAccepting(state));
-  if (!parsed.ok()) return parsed;
-  if (!request.has_frame()) {
-    return absl::InvalidArgumentError(
-        "frame: missing (colour, depth and intrinsics are required)");
-  }
-  return absl::OkStatus();
-}
-
-// DEADLINE_EXCEEDED once the client's deadline passed, CANCELLED once the
-// call was cancelled, else OK. Safe on any thread.
-absl::Status CheckInterrupt(const grpc::CallbackServerContext& context) {
-  if (DeadlinePassed(context.raw_deadline())) {
-    return absl::DeadlineExceededError("the client's deadline passed");
-  }
-  if (context.IsCancelled()) {
-    return absl::CancelledError(
-        "the call was cancelled (by the client, or by a server shutdown)");
-  }
-  return absl::OkStatus();
-}
-
-// Why a call that waits for a worker was cancelled: DEADLINE_EXCEEDED
-// when its deadline passed or is due within 100 ms (the client's own timer
-// may fire, and its cancellation arrive, before the server's), CANCELLED
-// otherwise.
-absl::Status AbandonStatus(const grpc::CallbackServerContext& context) {
-  const gpr_timespec soon = gpr_time_sub(
-      context.raw_deadline(), gpr_time_from_millis(100, GPR_TIMESPAN));
-  if (DeadlinePassed(soon)) {
-    return absl::DeadlineExceededError("the client's deadline passed");
-  }
-  return absl::CancelledError("the call was cancelled");
-}
-
-// Who finishes a call whose job waits for a worker: the worker, once it
-// starts the job, or the reaction to the client leaving (its deadline
-// passed, it cancelled), if that comes first. Whichever wins the exchange
-// finishes the call; an abandoned job never runs and frees its queue slot
-// (WorkQueue::TrySubmit). Shared by the reactor and its job, so the job
-// can look at it after the reactor is gone.
-class JobGate {
- public:
-  // Before submitting.
-  void Submitted() { state_.store(kWaiting); }
-  // The worker: true when it may run the job (and touch the reactor).
-  bool Start() { return Exchange(kStarted); }
-  // A reaction: true when it must finish the call itself.
-  bool Abandon() { return Exchange(kAbandoned); }
-  bool abandoned() const { return state_.load() == kAbandoned; }
-
- private:
-  static constexpr int kIdle = 0;  // not submitted (or refused)
-  static constexpr int kWaiting = 1;
-  static constexpr int kStarted = 2;
-  static constexpr int kAbandoned = 3;
-  bool Exchange(int to) {
-    int expected = kWaiting;
-    return state_.compare_exchange_strong(expected, to);
-  }
-  std::atomic<int> state_{kIdle};
-};
-
-// Submits `run` for the call that `gate` guards (see JobGate).
-bool SubmitGated(WorkQueue& work, const std::shared_ptr<JobGate>& gate,
-                 absl::AnyInvocable<void() &&> run) {
-  gate->Submitted();
-  const bool accepted = work.TrySubmit(
-      [gate, run = std::move(run)]() mutable {
-        if (gate->Start()) std::move(run)();
-      },
-      [gate] { return gate->abandoned(); });
-  if (!accepted) gate->Start();  // refused: nobody may abandon it now
-  return accepted;
-}
 
 // One Detect call. Converts the options at once, then runs on a worker;
 // finishes exactly once and deletes itself in OnDone.
@@ -564,18 +423,6 @@ class StreamReactor final
   std::optional<absl::Status> final_status_;  // guarded by mutex_
   const std::shared_ptr<JobGate> gate_ = std::make_shared<JobGate>();
 };
-
-// The request as parsed from its body, and how the parse went; the body's
-// slices are released once parsed. gRPC allocated the body (non-const) and
-// destroys it only when the call is done, so it may be cleared here.
-template <typename Request>
-std::pair<std::unique_ptr<const Request>, absl::Status> Parse(
-    const grpc::ByteBuffer* body) {
-  auto request = std::make_unique<Request>();
-  absl::Status parsed = ParseRequest(*body, request.get());
-  const_cast<grpc::ByteBuffer*>(body)->Clear();
-  return {std::move(request), std::move(parsed)};
-}
 
 }  // namespace
 
