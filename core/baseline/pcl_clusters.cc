@@ -16,6 +16,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
 #include "core/base/guarded.h"
+#include "core/base/status_macros.h"
 
 namespace fovea {
 namespace {
@@ -183,7 +184,7 @@ absl::Status Validate(const PclClustersOptions& options) {
 absl::StatusOr<PixelClusters> ClusterPixels(const OrganizedCloud& cloud,
                                             const cv::Mat& mask,
                                             const PclClustersOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   if (cloud.xyz.type() != CV_32FC3) {
     return absl::InvalidArgumentError("pcl_clusters: xyz must be CV_32FC3");
   }
@@ -199,10 +200,9 @@ absl::StatusOr<PixelClusters> ClusterPixels(const OrganizedCloud& cloud,
 absl::StatusOr<std::vector<AttentionPoint>> DetectPclClusters(
     const OrganizedCloud& cloud, const TableScene& scene, int max_points,
     const PclClustersOptions& options) {
-  absl::StatusOr<PixelClusters> clusters =
-      ClusterPixels(cloud, scene.candidate, options);
-  if (!clusters.ok()) return clusters.status();
-  return ClusterPoints(cloud, *clusters, max_points);
+  FOVEA_ASSIGN_OR_RETURN(PixelClusters clusters,
+                         ClusterPixels(cloud, scene.candidate, options));
+  return ClusterPoints(cloud, clusters, max_points);
 }
 
 }  // namespace fovea

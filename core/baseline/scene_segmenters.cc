@@ -21,6 +21,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
 #include "core/base/guarded.h"
+#include "core/base/status_macros.h"
 #include "core/frame/support_plane.h"
 
 namespace fovea {
@@ -176,9 +177,9 @@ absl::StatusOr<SupportPlane> FindPclSupportPlane(
 // The candidates (points standing on the support) of a checked cloud.
 absl::StatusOr<TableScene> StandingOnSupport(const OrganizedCloud& cloud,
                                              const PclSupportOptions& options) {
-  absl::StatusOr<SupportPlane> plane = FindPclSupportPlane(cloud, options);
-  if (!plane.ok()) return plane.status();
-  return PrepareTableScene(cloud, *plane, options.table);
+  FOVEA_ASSIGN_OR_RETURN(SupportPlane plane,
+                         FindPclSupportPlane(cloud, options));
+  return PrepareTableScene(cloud, plane, options.table);
 }
 
 // Segment ids ordered by size, largest first; segments smaller than
@@ -389,35 +390,33 @@ absl::Status Validate(const LccpSceneOptions& options) {
 
 absl::StatusOr<SceneSegmentation> SegmentSceneEuclidean(
     const OrganizedCloud& cloud, const EuclideanSceneOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   if (cloud.xyz.empty()) return SceneSegmentation{};
-  if (absl::Status s = CheckCloud(cloud); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(CheckCloud(cloud));
   if (!HasAnyPoint(cloud)) return NoSegments(cloud);
   return Guarded("pcl-euclidean", [&]() -> absl::StatusOr<SceneSegmentation> {
-    absl::StatusOr<TableScene> table =
-        StandingOnSupport(cloud, options.support);
-    if (!table.ok()) return table.status();
-    absl::StatusOr<PixelClusters> clusters =
-        ClusterPixels(cloud, table->candidate, options.clusters);
-    if (!clusters.ok()) return clusters.status();
+    FOVEA_ASSIGN_OR_RETURN(TableScene table,
+                           StandingOnSupport(cloud, options.support));
+    FOVEA_ASSIGN_OR_RETURN(
+        PixelClusters clusters,
+        ClusterPixels(cloud, table.candidate, options.clusters));
     SceneSegmentation result;
-    result.labels = std::move(clusters->labels);
-    result.segments = static_cast<int>(clusters->voxels.size());
+    result.labels = std::move(clusters.labels);
+    result.segments = static_cast<int>(clusters.voxels.size());
     return result;
   });
 }
 
 absl::StatusOr<SceneSegmentation> SegmentSceneLccp(
     const OrganizedCloud& cloud, const LccpSceneOptions& options) {
-  if (absl::Status s = Validate(options); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(Validate(options));
   if (cloud.xyz.empty()) return SceneSegmentation{};
-  if (absl::Status s = CheckCloud(cloud); !s.ok()) return s;
+  FOVEA_RETURN_IF_ERROR(CheckCloud(cloud));
   if (!HasAnyPoint(cloud)) return NoSegments(cloud);
   return Guarded("pcl-lccp", [&]() -> absl::StatusOr<SceneSegmentation> {
-    absl::StatusOr<TableScene> table =
-        StandingOnSupport(cloud, options.support);
-    if (!table.ok()) return table.status();
-    return Lccp(cloud, *table, options);
+    FOVEA_ASSIGN_OR_RETURN(TableScene table,
+                           StandingOnSupport(cloud, options.support));
+    return Lccp(cloud, table, options);
   });
 }
 
