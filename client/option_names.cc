@@ -22,6 +22,14 @@ namespace {
 template <typename Enum>
 using NameTable = std::vector<std::pair<absl::string_view, Enum>>;
 
+// A table and the spellings its views point into, allocated together so
+// that the one pointer kept (to `names`, the first member) reaches both.
+template <typename Enum>
+struct SpelledNames {
+  NameTable<Enum> names;
+  std::vector<std::string> spellings;
+};
+
 // The names of an enum's values, from its proto descriptor: each value's
 // name in lower case ("target_color" for TARGET_COLOR), the spelling of
 // core's registries (core/pipeline/saliency_registry.h, SegmentMethods in
@@ -30,16 +38,16 @@ using NameTable = std::vector<std::pair<absl::string_view, Enum>>;
 template <typename Enum>
 const NameTable<Enum>* DescriptorNames(
     const google::protobuf::EnumDescriptor* values) {
-  auto* spellings = new std::vector<std::string>();
-  spellings->reserve(values->value_count());  // the views below stay valid
-  auto* names = new NameTable<Enum>();
+  auto* table = new SpelledNames<Enum>();
+  table->spellings.reserve(values->value_count());  // the views stay valid
   for (int i = 0; i < values->value_count(); ++i) {
     const google::protobuf::EnumValueDescriptor* value = values->value(i);
     if (value->number() == 0) continue;
-    spellings->push_back(absl::AsciiStrToLower(value->name()));
-    names->emplace_back(spellings->back(), static_cast<Enum>(value->number()));
+    table->spellings.push_back(absl::AsciiStrToLower(value->name()));
+    table->names.emplace_back(table->spellings.back(),
+                              static_cast<Enum>(value->number()));
   }
-  return names;
+  return &table->names;
 }
 
 const NameTable<fovea::v1::SaliencyOperator>& SaliencyNames() {
