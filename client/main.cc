@@ -14,14 +14,11 @@
 // failure (unreadable file, cannot write --out), 2 the call failed (the gRPC
 // code name and message go to stderr), 64 usage error.
 
-#include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <iterator>
 #include <memory>
-#include <optional>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -32,18 +29,18 @@
 #include "absl/flags/usage_config.h"
 #include "absl/status/status.h"
 #include "absl/strings/match.h"
-#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "absl/strings/str_split.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
 #include "client/cli_frame.h"
 #include "client/cli_output.h"
+#include "client/cli_requests.h"
 #include "client/fovea_client.h"
-#include "client/option_names.h"
 #include "core/base/status_macros.h"
 
+// The connection and the output. The request flags (the frame, detect
+// options, scene, segmentation) are in cli_requests.cc.
 ABSL_FLAG(std::string, server, "127.0.0.1:50051",
           "gRPC server: HOST:PORT, replicas as IP:PORT,IP:PORT,... or one "
           "DNS name for all of them, dns:///NAME:PORT; calls go round robin "
@@ -68,87 +65,6 @@ ABSL_FLAG(std::string, out, "",
 ABSL_FLAG(std::string, service, "",
           "health: service to check (\"\" = the server, or "
           "fovea.v1.Perception)");
-
-// The frame.
-ABSL_FLAG(std::string, color, "", "colour image file, PNG or JPEG, sent as is");
-ABSL_FLAG(std::string, depth, "",
-          "depth image file, 16-bit grey PNG in --depth_scale units, sent as "
-          "is");
-ABSL_FLAG(std::string, pcd, "",
-          "OSD PCD file, sent raw as rgb8 + 32FC1 (OSD Kinect intrinsics "
-          "unless --fx/--fy/--cx/--cy)");
-ABSL_FLAG(std::optional<uint64_t>, synthetic, std::nullopt,
-          "seed of a built-in synthetic table scene, sent raw");
-ABSL_FLAG(std::optional<double>, fx, std::nullopt,
-          "focal length x, pixels (default 525, OSD Kinect v1)");
-ABSL_FLAG(std::optional<double>, fy, std::nullopt,
-          "focal length y, pixels (default 525)");
-ABSL_FLAG(std::optional<double>, cx, std::nullopt,
-          "principal point column, pixels (default 319.5)");
-ABSL_FLAG(std::optional<double>, cy, std::nullopt,
-          "principal point row, pixels (default 239.5)");
-ABSL_FLAG(double, depth_scale, 0.001, "metres per unit of a 16-bit depth PNG");
-ABSL_FLAG(std::string, frame_id, "", "camera frame id, echoed back");
-ABSL_FLAG(std::string, request_id, "",
-          "request id, echoed back (default: generated)");
-
-// Detect options (empty = the server's default).
-ABSL_FLAG(std::string, saliency, "",
-          "saliency channels: ph, sh, rso, sym3d, itti, harel, hou, "
-          "kootstra, target_color, location_prior; combine with '+' (equal "
-          "weights) or give weights as name:w, e.g. ph+sh+rso, ph:2+rso:1");
-ABSL_FLAG(std::string, extract, "", "attention points: msr | wta | tj");
-ABSL_FLAG(std::string, pyramid, "", "pyramid: none | simple | itti");
-ABSL_FLAG(std::string, norm, "", "map normalisation: lin | nms | nlm");
-ABSL_FLAG(std::string, combine, "", "pyramid level combination: sum | max");
-ABSL_FLAG(std::string, fusion, "", "channel fusion: sum | max");
-ABSL_FLAG(bool, maps, false, "ask for each channel's saliency map");
-ABSL_FLAG(std::string, target_color, "",
-          "target_color operator: the colour looked for, R,G,B (0-255), "
-          "e.g. 200,30,30");
-ABSL_FLAG(std::string, location_prior, "",
-          "location_prior operator: the pixel the prior is centred on, U,V "
-          "(column,row)");
-ABSL_FLAG(double, location_sigma, 0.0,
-          "location_prior operator: its standard deviation, pixels (0: the "
-          "server's default)");
-ABSL_FLAG(std::optional<bool>, split_edges, std::nullopt,
-          "split the master map at surface edges before extraction "
-          "(unset: the server's default; false: the thesis's map)");
-ABSL_FLAG(int32_t, points, 0,
-          "number of attention points at most, 0 = the server's default "
-          "(one per salient region, at most 100)");
-
-// Segmentation.
-// The scene.
-ABSL_FLAG(std::string, sensor, "",
-          "depth noise model: generic (chosen from the intrinsics, the "
-          "default) | kinect_v1 | active_stereo");
-ABSL_FLAG(int32_t, processing_width, 0,
-          "frames wider than this are processed reduced, pixels (0: the "
-          "server's 640)");
-ABSL_FLAG(std::string, gravity, "",
-          "X,Y,Z: unit vector pointing down in the camera frame");
-ABSL_FLAG(std::string, support_plane, "",
-          "NX,NY,NZ,D: the support plane n . p + d = 0 (camera frame, "
-          "metres), given instead of searched");
-ABSL_FLAG(std::string, workspace_box, "",
-          "MINX,MINY,MINZ,MAXX,MAXY,MAXZ: only points inside this camera-frame "
-          "box, metres");
-ABSL_FLAG(double, min_depth, 0.0,
-          "nearest depth considered, metres (0: the sensor's)");
-ABSL_FLAG(double, max_depth, 0.0,
-          "farthest depth considered, metres (0: the sensor's)");
-
-ABSL_FLAG(std::string, method, "", "segment: cos | ebs");
-ABSL_FLAG(int32_t, max_objects, 0, "segment: most objects, 0 = no limit");
-ABSL_FLAG(std::string, seeds, "",
-          "segment: seed pixels 'u,v;u,v;...' used in this order instead of "
-          "the server's attention points (e.g. where a person pointed); "
-          "segment-incremental: attention points, a Gaussian of saliency at "
-          "each, the first the most salient");
-ABSL_FLAG(double, time_budget_ms, 0.0,
-          "segment-incremental: time budget, milliseconds, 0 = none");
 
 namespace fovea::client {
 namespace {
@@ -236,166 +152,6 @@ absl::StatusOr<std::unique_ptr<FoveaClient>> MakeClient() {
   return FoveaClient::Connect(absl::GetFlag(FLAGS_server), options);
 }
 
-std::string RequestId() {
-  std::string id = absl::GetFlag(FLAGS_request_id);
-  if (id.empty()) id = absl::StrCat("cli-", absl::ToUnixMicros(absl::Now()));
-  return id;
-}
-
-absl::StatusOr<LoadedFrame> FrameFromFlags() {
-  FrameSource source;
-  source.color_path = absl::GetFlag(FLAGS_color);
-  source.depth_path = absl::GetFlag(FLAGS_depth);
-  source.pcd_path = absl::GetFlag(FLAGS_pcd);
-  source.synthetic_seed = absl::GetFlag(FLAGS_synthetic);
-  source.fx = absl::GetFlag(FLAGS_fx);
-  source.fy = absl::GetFlag(FLAGS_fy);
-  source.cx = absl::GetFlag(FLAGS_cx);
-  source.cy = absl::GetFlag(FLAGS_cy);
-  source.depth_scale = absl::GetFlag(FLAGS_depth_scale);
-  source.frame_id = absl::GetFlag(FLAGS_frame_id);
-  return LoadFrame(source);
-}
-
-// `count` comma-separated numbers of flag `name`; INVALID_ARGUMENT naming
-// it otherwise.
-absl::StatusOr<std::vector<double>> Numbers(const std::string& name,
-                                            const std::string& text,
-                                            size_t count) {
-  std::vector<double> values;
-  for (absl::string_view part : absl::StrSplit(text, ',')) {
-    double value = 0.0;
-    if (!absl::SimpleAtod(part, &value)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat(name, ": '", part, "' is not a number"));
-    }
-    values.push_back(value);
-  }
-  if (values.size() != count) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(name, ": expected ", count,
-                     " comma-separated numbers, got ", values.size()));
-  }
-  return values;
-}
-
-// The scene options of the flags (the server validates the values).
-absl::Status SceneFromFlags(fovea::v1::SceneOptions& scene) {
-  const std::string sensor = absl::GetFlag(FLAGS_sensor);
-  if (sensor == "generic") {
-    scene.set_sensor(fovea::v1::SENSOR_MODEL_GENERIC);
-  } else if (sensor == "kinect_v1") {
-    scene.set_sensor(fovea::v1::SENSOR_MODEL_KINECT_V1);
-  } else if (sensor == "active_stereo") {
-    scene.set_sensor(fovea::v1::SENSOR_MODEL_ACTIVE_STEREO);
-  } else if (!sensor.empty()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("sensor: unknown model '", sensor,
-                     "' (known: generic kinect_v1 active_stereo)"));
-  }
-  if (absl::GetFlag(FLAGS_processing_width) < 0) {
-    return absl::InvalidArgumentError("processing_width: must be >= 0");
-  }
-  scene.set_processing_width(
-      static_cast<uint32_t>(absl::GetFlag(FLAGS_processing_width)));
-  if (const std::string g = absl::GetFlag(FLAGS_gravity); !g.empty()) {
-    FOVEA_ASSIGN_OR_RETURN(std::vector<double> v, Numbers("gravity", g, 3));
-    scene.mutable_gravity()->set_x((v)[0]);
-    scene.mutable_gravity()->set_y((v)[1]);
-    scene.mutable_gravity()->set_z((v)[2]);
-  }
-  if (const std::string p = absl::GetFlag(FLAGS_support_plane); !p.empty()) {
-    FOVEA_ASSIGN_OR_RETURN(std::vector<double> v,
-                           Numbers("support_plane", p, 4));
-    fovea::v1::Plane* plane = scene.mutable_support_plane();
-    plane->mutable_normal()->set_x((v)[0]);
-    plane->mutable_normal()->set_y((v)[1]);
-    plane->mutable_normal()->set_z((v)[2]);
-    plane->set_d((v)[3]);
-  }
-  const std::string box = absl::GetFlag(FLAGS_workspace_box);
-  const double min_depth = absl::GetFlag(FLAGS_min_depth);
-  const double max_depth = absl::GetFlag(FLAGS_max_depth);
-  if (!box.empty() || min_depth != 0.0 || max_depth != 0.0) {
-    fovea::v1::Workspace* w = scene.mutable_workspace();
-    w->set_min_depth_m(min_depth);
-    w->set_max_depth_m(max_depth);
-    if (!box.empty()) {
-      FOVEA_ASSIGN_OR_RETURN(std::vector<double> v,
-                             Numbers("workspace_box", box, 6));
-      fovea::v1::Box* b = w->mutable_box();
-      b->mutable_min()->set_x((v)[0]);
-      b->mutable_min()->set_y((v)[1]);
-      b->mutable_min()->set_z((v)[2]);
-      b->mutable_max()->set_x((v)[3]);
-      b->mutable_max()->set_y((v)[4]);
-      b->mutable_max()->set_z((v)[5]);
-    }
-  }
-  return absl::OkStatus();
-}
-
-// Detect options from the flags; INVALID_ARGUMENT naming a bad one.
-absl::StatusOr<fovea::v1::DetectOptions> DetectOptionsFromFlags() {
-  fovea::v1::DetectOptions options;
-  FOVEA_ASSIGN_OR_RETURN(std::vector<fovea::v1::WeightedOperator> saliency,
-                         ParseSaliency(absl::GetFlag(FLAGS_saliency)));
-  for (fovea::v1::WeightedOperator& op : saliency) {
-    *options.add_saliency() = std::move(op);
-  }
-  // Each enum flag: parse when given, leave UNSPECIFIED otherwise.
-  auto set = [](const std::string& text, auto parse, auto setter) {
-    if (text.empty()) return absl::OkStatus();
-    FOVEA_ASSIGN_OR_RETURN(auto value, parse(text));
-    setter(value);
-    return absl::OkStatus();
-  };
-  for (absl::Status status : {
-           set(absl::GetFlag(FLAGS_extract), ParseExtraction,
-               [&](auto v) { options.set_extraction(v); }),
-           set(absl::GetFlag(FLAGS_pyramid), ParsePyramid,
-               [&](auto v) { options.set_pyramid(v); }),
-           set(absl::GetFlag(FLAGS_norm), ParseNormalization,
-               [&](auto v) { options.set_normalization(v); }),
-           set(absl::GetFlag(FLAGS_combine), ParseLevelCombination,
-               [&](auto v) { options.set_level_combination(v); }),
-           set(absl::GetFlag(FLAGS_fusion), ParseFusion,
-               [&](auto v) { options.set_fusion(v); }),
-       }) {
-    if (!status.ok()) return status;
-  }
-  const int32_t points = absl::GetFlag(FLAGS_points);
-  if (points < 0) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("points: must be >= 0, got ", points));
-  }
-  options.set_max_points(static_cast<uint32_t>(points));
-  options.set_return_channel_maps(absl::GetFlag(FLAGS_maps));
-  if (const std::string text = absl::GetFlag(FLAGS_target_color);
-      !text.empty()) {
-    FOVEA_ASSIGN_OR_RETURN(const auto rgb, ParseRgb("--target_color", text));
-    for (const uint32_t value : rgb) options.add_target_color_rgb(value);
-  }
-  if (const std::string text = absl::GetFlag(FLAGS_location_prior);
-      !text.empty()) {
-    FOVEA_ASSIGN_OR_RETURN(*options.mutable_location_prior(),
-                           ParsePixel("--location_prior", text));
-  }
-  if (const double sigma = absl::GetFlag(FLAGS_location_sigma); sigma != 0.0) {
-    if (!(sigma > 0.0) || !std::isfinite(sigma)) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "--location_sigma: ", sigma, " is not a number of pixels > 0"));
-    }
-    options.set_location_prior_sigma_px(sigma);
-  }
-  if (const std::optional<bool> split = absl::GetFlag(FLAGS_split_edges)) {
-    options.set_split_at_surface_edges(*split);
-  }
-  options.set_return_saliency_map(!absl::GetFlag(FLAGS_out).empty());
-  FOVEA_RETURN_IF_ERROR(SceneFromFlags(*options.mutable_scene()));
-  return options;
-}
-
 int RunHealth() {
   absl::StatusOr<std::unique_ptr<FoveaClient>> client = MakeClient();
   if (!client.ok()) return FailLocal(client.status());
@@ -431,7 +187,8 @@ int RunCapabilities() {
 }
 
 int RunDetect() {
-  absl::StatusOr<fovea::v1::DetectOptions> options = DetectOptionsFromFlags();
+  absl::StatusOr<fovea::v1::DetectOptions> options = DetectOptionsFromFlags(
+      /*return_saliency_map=*/!absl::GetFlag(FLAGS_out).empty());
   if (!options.ok()) return Fail(kExitUsage, options.status());
   absl::StatusOr<LoadedFrame> frame = FrameFromFlags();
   if (!frame.ok()) return FailLocal(frame.status());
@@ -471,44 +228,12 @@ int RunDetect() {
   return kExitOk;
 }
 
-// "u,v;u,v" into pixels; empty text is no seeds.
-absl::StatusOr<std::vector<std::pair<uint32_t, uint32_t>>> ParseSeeds(
-    const std::string& text) {
-  std::vector<std::pair<uint32_t, uint32_t>> seeds;
-  for (absl::string_view item : absl::StrSplit(text, ';', absl::SkipEmpty())) {
-    const std::vector<absl::string_view> uv = absl::StrSplit(item, ',');
-    uint32_t u = 0;
-    uint32_t v = 0;
-    if (uv.size() != 2 || !absl::SimpleAtoi(uv[0], &u) ||
-        !absl::SimpleAtoi(uv[1], &v)) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "seeds: '", item, "' is not a pixel 'u,v' (columns, rows)"));
-    }
-    seeds.emplace_back(u, v);
-  }
-  return seeds;
-}
-
 int RunSegment(bool incremental) {
-  absl::StatusOr<fovea::v1::DetectOptions> options = DetectOptionsFromFlags();
+  absl::StatusOr<fovea::v1::DetectOptions> options = DetectOptionsFromFlags(
+      /*return_saliency_map=*/!absl::GetFlag(FLAGS_out).empty());
   if (!options.ok()) return Fail(kExitUsage, options.status());
-  fovea::v1::SegmentationMethod method =
-      fovea::v1::SEGMENTATION_METHOD_UNSPECIFIED;
-  if (!absl::GetFlag(FLAGS_method).empty()) {
-    absl::StatusOr<fovea::v1::SegmentationMethod> parsed =
-        ParseSegmentationMethod(absl::GetFlag(FLAGS_method));
-    if (!parsed.ok()) return Fail(kExitUsage, parsed.status());
-    method = *parsed;
-  }
-  const int32_t max_objects = absl::GetFlag(FLAGS_max_objects);
-  const double time_budget_ms = absl::GetFlag(FLAGS_time_budget_ms);
-  if (max_objects < 0 || time_budget_ms < 0.0) {
-    return Fail(kExitUsage, absl::InvalidArgumentError(
-                                "max_objects, time_budget_ms: must be >= 0"));
-  }
-  absl::StatusOr<std::vector<std::pair<uint32_t, uint32_t>>> seeds =
-      ParseSeeds(absl::GetFlag(FLAGS_seeds));
-  if (!seeds.ok()) return Fail(kExitUsage, seeds.status());
+  absl::StatusOr<SegmentParameters> segment = SegmentParametersFromFlags();
+  if (!segment.ok()) return Fail(kExitUsage, segment.status());
   absl::StatusOr<LoadedFrame> frame = FrameFromFlags();
   if (!frame.ok()) return FailLocal(frame.status());
   absl::StatusOr<std::unique_ptr<FoveaClient>> client = MakeClient();
@@ -552,9 +277,9 @@ int RunSegment(bool incremental) {
     request.set_request_id(RequestId());
     *request.mutable_frame() = std::move(frame->frame);
     *request.mutable_detect_options() = *std::move(options);
-    request.set_max_objects(static_cast<uint32_t>(max_objects));
-    request.set_time_budget_seconds(time_budget_ms / 1e3);
-    for (const auto& [u, v] : *seeds) {
+    request.set_max_objects(static_cast<uint32_t>(segment->max_objects));
+    request.set_time_budget_seconds(segment->time_budget_ms / 1e3);
+    for (const auto& [u, v] : segment->seeds) {
       fovea::v1::AttentionPixel* point = request.add_attention_points();
       point->set_u(u);
       point->set_v(v);
@@ -566,9 +291,9 @@ int RunSegment(bool incremental) {
     request.set_request_id(RequestId());
     *request.mutable_frame() = std::move(frame->frame);
     *request.mutable_detect_options() = *std::move(options);
-    request.set_method(method);
-    request.set_max_objects(static_cast<uint32_t>(max_objects));
-    for (const auto& [u, v] : *seeds) {
+    request.set_method(segment->method);
+    request.set_max_objects(static_cast<uint32_t>(segment->max_objects));
+    for (const auto& [u, v] : segment->seeds) {
       fovea::v1::AttentionPixel* seed = request.add_seeds();
       seed->set_u(u);
       seed->set_v(v);

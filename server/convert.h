@@ -16,7 +16,11 @@
 namespace fovea::server {
 
 // Conversions between the wire contract (fovea.v1) and core/'s types. No
-// gRPC here: every function is tested on its own.
+// gRPC here: every function is tested on its own. One file per idea:
+// convert_frame.cc, convert_detect_options.cc, convert_detect_response.cc
+// and convert_segment.cc (what they share: convert_internal.h).
+
+// Frames (convert_frame.cc).
 
 // The wire frame as core's RawFrame. Non-owning: the views point into
 // `frame`'s strings, which must outlive the result. Nothing is checked
@@ -36,6 +40,8 @@ enum class DepthEncoding {
 // inverse of DecodeFrame for raw frames, used by the warm-up and tests.
 v1::Frame ToProtoFrame(const RgbdFrame& frame, DepthEncoding depth_encoding,
                        double depth_scale = 0.001);
+
+// Detect options (convert_detect_options.cc).
 
 // Request options to core options, starting from core's defaults:
 //   - empty `saliency` means the default channels; a weight of 0 means 1;
@@ -67,7 +73,8 @@ v1::LevelCombination ToProtoEnum(LevelCombination combination);
 v1::Normalization ToProtoEnum(NormalizationKind normalization);
 v1::Fusion ToProtoEnum(FusionKind fusion);
 v1::Extraction ToProtoEnum(ExtractionKind extraction);
-v1::SegmentationMethod ToProtoEnum(SegmentMethod method);
+
+// Detect responses (convert_detect_response.cc).
 
 // A saliency map (CV_32FC1, values in [0, 1]) as a 16-bit grey PNG file:
 // pixel = round(value * 65535), clamped to [0, 65535], NaN as 0. INTERNAL
@@ -82,6 +89,12 @@ absl::StatusOr<std::string> EncodeSaliencyPng(const cv::Mat& map);
 // cannot be encoded.
 absl::StatusOr<v1::DetectResponse> ToDetectResponse(
     const DetectResult& result, const v1::DetectRequest& request);
+
+// The support plane as the wire states it: plane, inlier count, how many
+// candidates there were and the chosen one's score.
+v1::SupportPlane ToProtoSupportPlane(const SupportPlane& plane);
+
+// Segmentation (convert_segment.cc).
 
 // Segment's options from the request: method (UNSPECIFIED = COS), seeds
 // as given (checked against the frame by core), detect_options as
@@ -98,6 +111,9 @@ absl::StatusOr<SegmentOptions> ToSegmentOptions(
 absl::StatusOr<IncrementalOptions> ToIncrementalOptions(
     const v1::SegmentIncrementalRequest& request);
 
+// The segmentation method on the wire. Every core value has one.
+v1::SegmentationMethod ToProtoEnum(SegmentMethod method);
+
 // COCO RLE (segment.proto RleMask) of a CV_8UC1 mask, non-zero = inside.
 v1::RleMask ToRleMask(const cv::Mat& mask);
 
@@ -106,10 +122,6 @@ v1::RleMask ToRleMask(const cv::Mat& mask);
 v1::SegmentResponse ToPointsMessage(const std::vector<AttentionPoint>& points,
                                     const std::string& request_id,
                                     const SupportPlane* plane = nullptr);
-
-// The support plane as the wire states it: plane, inlier count, how many
-// candidates there were and the chosen one's score.
-v1::SupportPlane ToProtoSupportPlane(const SupportPlane& plane);
 
 // One object's message.
 v1::SegmentResponse ToObjectMessage(const SegmentedObject& object,

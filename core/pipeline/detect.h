@@ -62,7 +62,7 @@ enum class ExtractionKind { kMsr, kWta, kTj };
 // registry (saliency_registry.h): the wire value is the Extraction value
 // whose name is the row's name in upper case. Adding one: its files in
 // core/attention/ and their test, an ExtractionKind value, one row in
-// detect.cc, one Extraction value in detect.proto.
+// option_names.cc, one Extraction value in detect.proto.
 struct DetectOptions;
 struct AttentionPoint;
 struct Extraction {
@@ -74,6 +74,8 @@ struct Extraction {
 };
 absl::Span<const Extraction> Extractions();
 
+// Each kind's one spelling and the parsers of the text forms (defined, with
+// Extractions() and ChannelsText, in option_names.cc).
 std::string_view SaliencyOpName(SaliencyOp op);        // "ph", "sym3d", ...
 std::string_view ExtractionName(ExtractionKind kind);  // "msr", "wta", "tj"
 std::string_view PyramidName(PyramidKind kind);  // "none", "simple", "itti"

@@ -2,8 +2,8 @@
 //
 // The first byte picks the mode:
 //   even: the rest is a serialized fovea.v1.Frame, parsed with
-//         ParseFromArray and mapped as server/convert.cc's ToRawFrame does
-//         (reimplemented here so the target needs only fovea_frame and
+//         ParseFromArray and mapped as server/convert_frame.cc's ToRawFrame
+//         does (reimplemented here so the target needs only fovea_frame and
 //         fovea_proto, not the whole server), so PNG/JPEG decoding and the
 //         wire validation run on whatever protobuf accepts;
 //   odd:  the rest drives a RawFrame directly (FuzzedDataProvider): sizes
@@ -79,7 +79,7 @@ void Decode(const fovea::RawFrame& raw) {
   }
 }
 
-// As server/convert.cc's ToRawImage.
+// As server/convert_frame.cc's ToRawImage.
 fovea::RawImage ToRawImage(const fovea::v1::Image& image) {
   fovea::RawImage raw;
   raw.width = image.width();

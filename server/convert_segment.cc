@@ -1,0 +1,202 @@
+// Segmentation: the wire's Segment and SegmentIncremental requests to
+// core's options, and core's results to the stream's messages (convert.h).
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
+#include "core/base/strings.h"
+#include "server/convert.h"
+#include "server/convert_internal.h"
+
+namespace fovea::server {
+namespace {
+
+using convert_internal::ToPoint3;
+
+// Pixels of a request as cv::Points; INVALID_ARGUMENT naming `field` for
+// too many or for coordinates beyond any frame (core checks the frame's
+// own size).
+absl::StatusOr<std::vector<cv::Point>> ToPixels(
+    const google::protobuf::RepeatedPtrField<v1::AttentionPixel>& pixels,
+    std::string_view field) {
+  if (pixels.size() > kMaxAttentionPoints) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(AbslView(field), ": ", pixels.size(), " given, at most ",
+                     kMaxAttentionPoints, " allowed"));
+  }
+  constexpr uint32_t kMaxCoordinate = 1 << 16;
+  std::vector<cv::Point> points;
+  for (int i = 0; i < pixels.size(); ++i) {
+    const v1::AttentionPixel& p = pixels.Get(i);
+    if (p.u() >= kMaxCoordinate || p.v() >= kMaxCoordinate) {
+      return absl::InvalidArgumentError(absl::StrCat(AbslView(field), "[", i,
+                                                     "]: (", p.u(), ", ", p.v(),
+                                                     ") is beyond any frame"));
+    }
+    points.emplace_back(static_cast<int>(p.u()), static_cast<int>(p.v()));
+  }
+  return points;
+}
+
+// A segmentation request's detect_options, errors prefixed with the field.
+absl::StatusOr<DetectOptions> ToNestedDetectOptions(
+    const v1::DetectOptions& options) {
+  absl::StatusOr<DetectOptions> detect = ToDetectOptions(options);
+  if (!detect.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("detect_options.", detect.status().message()));
+  }
+  return detect;
+}
+
+}  // namespace
+
+absl::StatusOr<SegmentOptions> ToSegmentOptions(
+    const v1::SegmentRequest& request) {
+  SegmentOptions options;
+  FOVEA_ASSIGN_OR_RETURN(DetectOptions detect,
+                         ToNestedDetectOptions(request.detect_options()));
+  options.detect = std::move(detect);
+  // By name: the value whose name is a segment method row's in upper case
+  // (core/pipeline/segment.h); UNSPECIFIED is the default method.
+  if (request.method() != v1::SEGMENTATION_METHOD_UNSPECIFIED) {
+    absl::StatusOr<SegmentMethod> method = absl::InvalidArgumentError("");
+    if (v1::SegmentationMethod_IsValid(request.method())) {
+      method = ParseSegmentMethod(
+          absl::AsciiStrToLower(v1::SegmentationMethod_Name(request.method())));
+    }
+    if (!method.ok()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "method: unknown value ", static_cast<int>(request.method())));
+    }
+    options.method = *method;
+  }
+  FOVEA_ASSIGN_OR_RETURN(std::vector<cv::Point> seeds,
+                         ToPixels(request.seeds(), "seeds"));
+  options.seeds = std::move(seeds);
+  options.max_objects =
+      static_cast<int>(std::min<uint32_t>(request.max_objects(), 1u << 20));
+  if (request.has_cover_scene()) options.cover_scene = request.cover_scene();
+  return options;
+}
+
+absl::StatusOr<IncrementalOptions> ToIncrementalOptions(
+    const v1::SegmentIncrementalRequest& request) {
+  IncrementalOptions options;
+  FOVEA_ASSIGN_OR_RETURN(DetectOptions detect,
+                         ToNestedDetectOptions(request.detect_options()));
+  options.detect = std::move(detect);
+  FOVEA_ASSIGN_OR_RETURN(
+      std::vector<cv::Point> points,
+      ToPixels(request.attention_points(), "attention_points"));
+  options.attention_points = std::move(points);
+  options.max_objects =
+      static_cast<int>(std::min<uint32_t>(request.max_objects(), 1u << 20));
+  const double budget = request.time_budget_seconds();
+  if (!std::isfinite(budget) || budget < 0.0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "time_budget_seconds: must be a finite number >= 0, got ", budget));
+  }
+  options.time_budget_seconds = budget;
+  return options;
+}
+
+v1::SegmentationMethod ToProtoEnum(SegmentMethod method) {
+  v1::SegmentationMethod value = v1::SEGMENTATION_METHOD_UNSPECIFIED;
+  v1::SegmentationMethod_Parse(
+      absl::AsciiStrToUpper(AbslView(SegmentMethodName(method))), &value);
+  return value;
+}
+
+v1::RleMask ToRleMask(const cv::Mat& mask) {
+  v1::RleMask rle;
+  rle.set_height(static_cast<uint32_t>(mask.rows));
+  rle.set_width(static_cast<uint32_t>(mask.cols));
+  // Column-major runs, starting with a (possibly empty) run of zeros.
+  bool inside = false;
+  uint32_t run = 0;
+  for (int u = 0; u < mask.cols; ++u) {
+    for (int v = 0; v < mask.rows; ++v) {
+      const bool here = mask.at<unsigned char>(v, u) != 0;
+      if (here != inside) {
+        rle.add_counts(run);
+        run = 0;
+        inside = here;
+      }
+      ++run;
+    }
+  }
+  if (mask.total() > 0) rle.add_counts(run);
+  return rle;
+}
+
+v1::SegmentResponse ToPointsMessage(const std::vector<AttentionPoint>& points,
+                                    const std::string& request_id,
+                                    const SupportPlane* plane) {
+  v1::SegmentResponse message;
+  message.set_request_id(request_id);
+  if (plane != nullptr)
+    *message.mutable_support_plane() = ToProtoSupportPlane(*plane);
+  for (size_t i = 0; i < points.size(); ++i) {
+    v1::AttentionPoint* out = message.add_attention_points();
+    out->set_u(static_cast<uint32_t>(points[i].u));
+    out->set_v(static_cast<uint32_t>(points[i].v));
+    *out->mutable_point() = ToPoint3(points[i].point);
+    out->set_saliency(points[i].saliency);
+    out->set_rank(static_cast<uint32_t>(i));
+  }
+  return message;
+}
+
+v1::SegmentResponse ToObjectMessage(const SegmentedObject& object,
+                                    const std::string& request_id) {
+  v1::SegmentResponse message;
+  message.set_request_id(request_id);
+  v1::ObjectResult* out = message.mutable_object();
+  out->set_index(static_cast<uint32_t>(object.index));
+  v1::AttentionPoint* seed = out->mutable_seed();
+  seed->set_u(static_cast<uint32_t>(object.seed.u));
+  seed->set_v(static_cast<uint32_t>(object.seed.v));
+  *seed->mutable_point() = ToPoint3(object.seed.point);
+  seed->set_saliency(object.seed.saliency);
+  *out->mutable_mask() = ToRleMask(object.mask);
+  v1::BoundingBox* box = out->mutable_box();
+  box->set_u(static_cast<uint32_t>(object.box.x));
+  box->set_v(static_cast<uint32_t>(object.box.y));
+  box->set_width(static_cast<uint32_t>(object.box.width));
+  box->set_height(static_cast<uint32_t>(object.box.height));
+  out->set_area(static_cast<uint32_t>(object.area));
+  out->set_score(object.score);
+  *out->mutable_centroid() = ToPoint3(object.centroid);
+  *out->mutable_extent() = ToPoint3(object.extent);
+  out->set_seconds_since_request(object.seconds_since_start);
+  return message;
+}
+
+v1::SegmentResponse ToSummaryMessage(const SegmentSummary& summary,
+                                     v1::StopReason stop_reason,
+                                     const std::string& request_id) {
+  v1::SegmentResponse message;
+  message.set_request_id(request_id);
+  message.set_last(true);
+  v1::SegmentSummary* out = message.mutable_summary();
+  out->set_stop_reason(stop_reason);
+  out->set_object_count(static_cast<uint32_t>(summary.objects));
+  out->set_scene_coverage(summary.scene_coverage);
+  for (const StageTiming& timing : summary.timings) {
+    v1::StageTiming* t = out->add_timings();
+    t->set_stage(timing.stage);
+    t->set_seconds(timing.seconds);
+  }
+  out->set_seconds_total(summary.total_seconds);
+  return message;
+}
+
+}  // namespace fovea::server
