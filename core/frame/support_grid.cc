@@ -184,40 +184,21 @@ std::vector<std::vector<int>> PlaneParts(const Grid& grid, const Plane& plane,
   // in 3D (the step at their depth, stretched by the plane's slant to the
   // ray); farther apart, something hid the plane between them (a bowl's
   // bottom and the table beyond its rim).
-  std::vector<int> labels(grid.size(), 0);
-  int n = 1;
-  std::vector<int> stack;
   const float step_per_z = static_cast<float>(grid.stride / grid.intrinsics.fx);
-  for (int seed = 0; seed < grid.size(); ++seed) {
-    if (!mask[seed] || labels[seed] != 0) continue;
-    labels[seed] = n;
-    stack.assign(1, seed);
-    while (!stack.empty()) {
-      const int i = stack.back();
-      stack.pop_back();
-      const Eigen::Vector3f& p = grid.p[i];
-      const float incidence =
-          std::max(kMinCosIncidence, std::abs(plane.normal.dot(p)) / p.norm());
-      const float reach = kPlaneStepFactor * step_per_z * p.z() / incidence;
-      const int r = i / grid.cols, c = i % grid.cols;
-      for (int dr = -1; dr <= 1; ++dr) {
-        for (int dc = -1; dc <= 1; ++dc) {
-          const int rr = r + dr, cc = c + dc;
-          if ((dr == 0 && dc == 0) || rr < 0 || cc < 0 || rr >= grid.rows ||
-              cc >= grid.cols) {
-            continue;
-          }
-          const int j = rr * grid.cols + cc;
-          if (!mask[j] || labels[j] != 0) continue;
-          const float limit = (dr != 0 && dc != 0) ? reach * 1.4142f : reach;
-          if (!((grid.p[j] - p).squaredNorm() <= limit * limit)) continue;
-          labels[j] = n;
-          stack.push_back(j);
-        }
-      }
-    }
-    ++n;
-  }
+  std::vector<int> labels;
+  const int n = LabelGridComponents(
+      grid, mask,
+      [&](int i) {
+        const Eigen::Vector3f& p = grid.p[i];
+        const float incidence = std::max(
+            kMinCosIncidence, std::abs(plane.normal.dot(p)) / p.norm());
+        const float reach = kPlaneStepFactor * step_per_z * p.z() / incidence;
+        return [&grid, p, reach](int j, bool diagonal) {
+          const float limit = diagonal ? reach * 1.4142f : reach;
+          return (grid.p[j] - p).squaredNorm() <= limit * limit;
+        };
+      },
+      labels);
   std::vector<std::vector<int>> parts(n);
   for (int i = 0; i < grid.size(); ++i) {
     if (labels[i] > 0) parts[labels[i]].push_back(i);

@@ -151,6 +151,46 @@ absl::StatusOr<SupportPlane> MakeSupportRegion(
     const OrganizedCloud& cloud, const Grid& grid, const Candidate& chosen,
     const SupportPlaneOptions& options, float min_cos);
 
+// Labels the 8-connected components of the cells in `mask`: `labels`
+// gets 1, 2, ... per component and 0 outside the mask; returns the next
+// label (components + 1). `from(i)` gives, for cell i, the predicate
+// `joins(j, diagonal)`: whether neighbour j (diagonal or not) lies on i's
+// surface. Depth-first from each unlabelled cell in index order.
+template <typename From>
+int LabelGridComponents(const Grid& grid, const std::vector<uint8_t>& mask,
+                        From from, std::vector<int>& labels) {
+  labels.assign(grid.size(), 0);
+  int next = 1;
+  std::vector<int> stack;
+  for (int seed = 0; seed < grid.size(); ++seed) {
+    if (!mask[seed] || labels[seed] != 0) continue;
+    labels[seed] = next;
+    stack.assign(1, seed);
+    while (!stack.empty()) {
+      const int i = stack.back();
+      stack.pop_back();
+      const auto joins = from(i);
+      const int r = i / grid.cols, c = i % grid.cols;
+      for (int dr = -1; dr <= 1; ++dr) {
+        for (int dc = -1; dc <= 1; ++dc) {
+          const int rr = r + dr, cc = c + dc;
+          if ((dr == 0 && dc == 0) || rr < 0 || cc < 0 || rr >= grid.rows ||
+              cc >= grid.cols) {
+            continue;
+          }
+          const int j = rr * grid.cols + cc;
+          if (!mask[j] || labels[j] != 0) continue;
+          if (!joins(j, dr != 0 && dc != 0)) continue;
+          labels[j] = next;
+          stack.push_back(j);
+        }
+      }
+    }
+    ++next;
+  }
+  return next;
+}
+
 }  // namespace fovea::support_internal
 
 #endif  // FOVEA_CORE_FRAME_SUPPORT_GRID_H_

@@ -54,40 +54,19 @@ constexpr float kStandingMinHeight = 0.025f;
 // the mask. Returns the number of labels + 1.
 int DepthConnectedClusters(const Grid& grid, const std::vector<uint8_t>& mask,
                            std::vector<int>& labels) {
-  labels.assign(grid.size(), 0);
-  int next = 1;
-  std::vector<int> stack;
   const float spacing_per_z =
       static_cast<float>(grid.stride / grid.intrinsics.fx);
-  for (int seed = 0; seed < grid.size(); ++seed) {
-    if (!mask[seed] || labels[seed] != 0) continue;
-    labels[seed] = next;
-    stack.assign(1, seed);
-    while (!stack.empty()) {
-      const int i = stack.back();
-      stack.pop_back();
-      const int r = i / grid.cols, c = i % grid.cols;
-      const float z = grid.p[i].z();
-      const float jump =
-          std::max(kJumpMin, kJumpPerSpacing * spacing_per_z * z);
-      for (int dr = -1; dr <= 1; ++dr) {
-        for (int dc = -1; dc <= 1; ++dc) {
-          const int rr = r + dr, cc = c + dc;
-          if ((dr == 0 && dc == 0) || rr < 0 || cc < 0 || rr >= grid.rows ||
-              cc >= grid.cols) {
-            continue;
-          }
-          const int j = rr * grid.cols + cc;
-          if (!mask[j] || labels[j] != 0) continue;
-          if (!(std::abs(grid.p[j].z() - z) <= jump)) continue;
-          labels[j] = next;
-          stack.push_back(j);
-        }
-      }
-    }
-    ++next;
-  }
-  return next;
+  return LabelGridComponents(
+      grid, mask,
+      [&](int i) {
+        const float z = grid.p[i].z();
+        const float jump =
+            std::max(kJumpMin, kJumpPerSpacing * spacing_per_z * z);
+        return [&grid, z, jump](int j, bool /*diagonal*/) {
+          return std::abs(grid.p[j].z() - z) <= jump;
+        };
+      },
+      labels);
 }
 
 // How many object-sized clusters stand on `c`: clusters (depth-connected)

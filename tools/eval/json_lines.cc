@@ -69,15 +69,21 @@ std::string DetectSummaryJson(const DetectEvalSummary& summary,
   return Line(json);
 }
 
-std::string IncSummaryJson(const IncEvalSummary& summary) {
-  Json json;
-  json["scenes"] = summary.scenes.size();
+// The object scores INC's and every method's summaries share, in order.
+template <typename Summary>
+void AddObjectScores(const Summary& summary, Json& json) {
   json["f_all"] = Score(summary.f_all);
   json["f_best"] = Score(summary.f_best);
   json["f_first"] = Score(summary.f_first);
   json["object_recall"] = Score(summary.object_recall);
   json["false_masks"] = Score(summary.false_masks);
   json["whole_scene_f"] = Score(summary.whole_scene_f);
+}
+
+std::string IncSummaryJson(const IncEvalSummary& summary) {
+  Json json;
+  json["scenes"] = summary.scenes.size();
+  AddObjectScores(summary, json);
   return Line(json);
 }
 
@@ -88,12 +94,7 @@ std::string MethodSummaryJson(const MethodSummary& summary,
   json["evaluation"] = cross_validated ? "cross-validated" : "held-out";
   json["folds"] = cross_validated ? folds : 0;
   json["scenes"] = summary.scenes;
-  json["f_all"] = Score(summary.f_all);
-  json["f_best"] = Score(summary.f_best);
-  json["f_first"] = Score(summary.f_first);
-  json["object_recall"] = Score(summary.object_recall);
-  json["false_masks"] = Score(summary.false_masks);
-  json["whole_scene_f"] = Score(summary.whole_scene_f);
+  AddObjectScores(summary, json);
   json["overlap_p"] = Score(summary.overlap_p);
   json["overlap_r"] = Score(summary.overlap_r);
   json["overlap_f"] = Score(summary.overlap_f);
