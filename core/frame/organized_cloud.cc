@@ -99,15 +99,17 @@ int WalkThinGaps(cv::Vec3f* line, int count, int step, float focal,
       const float z = std::min(a[2], p[2]);
       if (std::abs(a[2] - p[2]) <= slope * z * static_cast<float>(gap + 1)) {
         bridged += gap;
-        // Each pixel's ray (x/z, y/z) is linear along the line, and so is
-        // 1/z on a plane: the bridge is the plane through the two ends.
-        const cv::Vec3f ray_a = a * (1.0f / a[2]);
-        const cv::Vec3f ray_p = p * (1.0f / p[2]);
-        for (int k = 1; bridge && k <= gap; ++k) {
-          const float t = static_cast<float>(k) / static_cast<float>(gap + 1);
-          const float inverse_z = (1.0f - t) / a[2] + t / p[2];
-          line[(last_valid + k) * step] =
-              (ray_a + t * (ray_p - ray_a)) * (1.0f / inverse_z);
+        if (bridge) {
+          // Each pixel's ray (x/z, y/z) is linear along the line, and so is
+          // 1/z on a plane: the bridge is the plane through the two ends.
+          const cv::Vec3f ray_a = a * (1.0f / a[2]);
+          const cv::Vec3f ray_p = p * (1.0f / p[2]);
+          for (int k = 1; k <= gap; ++k) {
+            const float t = static_cast<float>(k) / static_cast<float>(gap + 1);
+            const float inverse_z = (1.0f - t) / a[2] + t / p[2];
+            line[(last_valid + k) * step] =
+                (ray_a + t * (ray_p - ray_a)) * (1.0f / inverse_z);
+          }
         }
       }
     }
