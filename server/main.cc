@@ -16,6 +16,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/time/time.h"
+#include "core/base/parallel.h"
 #include "server/capabilities.h"
 #include "server/descriptors.h"
 #include "server/env_flags.h"
@@ -42,6 +43,11 @@ ABSL_FLAG(std::string, metrics_listen, "127.0.0.1:9464",
 ABSL_FLAG(int, concurrency, Cores(),
           "Frames computed at once (worker threads); default: the number of "
           "cores.");
+ABSL_FLAG(int, threads_per_request, 0,
+          "Threads one frame may use (stages split by rows, filters or "
+          "surfaces); 0: cores / concurrency. The helper threads are shared "
+          "by all workers and at most cores - concurrency, so the threads "
+          "computing at once never outnumber the cores.");
 ABSL_FLAG(int, queue, 2 * Cores(),
           "Frames waiting for a worker; beyond it calls fail at once with "
           "RESOURCE_EXHAUSTED. Default: twice the number of cores.");
@@ -123,6 +129,7 @@ int main(int argc, char** argv) {
       {"listen",
        "metrics_listen",
        "concurrency",
+       "threads_per_request",
        "queue",
        "max_message_bytes",
        "max_width",
@@ -169,12 +176,16 @@ int main(int argc, char** argv) {
   sigaddset(&stop_signals, SIGINT);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
 
+  // OpenCV's loops run on the request's threads (ParallelScope), not on a
+  // pool of OpenCV's own with one thread per core beside ours.
+  fovea::UseParallelScopesInOpenCv();
   LogInfo(fovea::server::RaiseDescriptorLimit());
   fovea::server::ServerConfig config;
   config.listen = absl::GetFlag(FLAGS_listen);
   config.metrics_listen = absl::GetFlag(FLAGS_metrics_listen);
   config.concurrency = absl::GetFlag(FLAGS_concurrency);
   config.queue = absl::GetFlag(FLAGS_queue);
+  config.threads_per_request = absl::GetFlag(FLAGS_threads_per_request);
   config.max_message_bytes = absl::GetFlag(FLAGS_max_message_bytes);
   config.memory_quota_bytes = int64_t{absl::GetFlag(FLAGS_memory_quota_mb)}
                               << 20;

@@ -13,6 +13,7 @@
 #include <iterator>
 #include <memory>
 #include <optional>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -145,6 +146,22 @@ int DefaultMaxMessageBytes(const FrameLimits& limits) {
   return static_cast<int>(std::min<int64_t>(raw + (1 << 20), INT32_MAX));
 }
 
+ThreadBudget EffectiveThreads(const ServerConfig& config) {
+  const int cores =
+      config.cores > 0
+          ? config.cores
+          : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const int workers = std::max(1, config.concurrency);
+  const int wanted = config.threads_per_request > 0
+                         ? config.threads_per_request
+                         : std::max(1, cores / workers);
+  ThreadBudget budget;
+  budget.helpers =
+      std::min(workers * (wanted - 1), std::max(0, cores - workers));
+  budget.threads_per_request = 1 + std::min(wanted - 1, budget.helpers);
+  return budget;
+}
+
 absl::Status Validate(const ServerConfig& config) {
   if (config.listen.empty()) {
     return absl::InvalidArgumentError("--listen: empty, expected host:port");
@@ -152,6 +169,10 @@ absl::Status Validate(const ServerConfig& config) {
   if (config.concurrency < 1) {
     return absl::InvalidArgumentError(
         absl::StrCat("--concurrency: ", config.concurrency, " is below 1"));
+  }
+  if (config.threads_per_request < 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--threads_per_request: ", config.threads_per_request, " is negative"));
   }
   if (config.queue < 0) {
     return absl::InvalidArgumentError(
@@ -230,7 +251,11 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
                            MetricsEndpoint::Start(config.metrics_listen));
     server->metrics_ = std::move(metrics);
   }
-  server->work_ = std::make_unique<WorkQueue>(config.concurrency, config.queue);
+  const ThreadBudget threads = EffectiveThreads(config);
+  server->pool_ = std::make_unique<ThreadPool>(threads.helpers);
+  server->work_ = std::make_unique<WorkQueue>(config.concurrency, config.queue,
+                                              server->pool_.get(),
+                                              threads.threads_per_request);
   ServiceConfig service;
   server->service_state_ = service.state;
   server->drain_delay_s_ = config.drain_delay_s;
@@ -284,8 +309,8 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
 
   LogInfo(absl::StrFormat(
       "fovea-server %s listening on %s (port %d, %s), metrics %s, concurrency "
-      "%d, queue %d, max message %d bytes, memory quota %d MiB, max frame "
-      "%dx%d",
+      "%d, threads per request %d (%d shared helpers), queue %d, max message "
+      "%d bytes, memory quota %d MiB, max frame %dx%d",
       ServerVersion(), config.listen, server->port_,
       config.tls_cert.empty()        ? "plaintext"
       : config.tls_client_ca.empty() ? "TLS"
@@ -293,7 +318,8 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
       config.metrics_listen.empty()
           ? std::string("off")
           : absl::StrCat("on port ", server->metrics_port(), " /metrics"),
-      config.concurrency, config.queue, config.max_message_bytes,
+      config.concurrency, threads.threads_per_request, threads.helpers,
+      config.queue, config.max_message_bytes,
       static_cast<int>(config.memory_quota_bytes >> 20),
       config.limits.max_width, config.limits.max_height));
 

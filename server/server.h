@@ -36,6 +36,12 @@ struct ServerConfig {
   std::string metrics_listen;              // host:port of /metrics; empty: none
   int concurrency = 1;                     // frames computed at once, >= 1
   int queue = 2;                           // frames waiting for a worker, >= 0
+  // Threads one frame may use (ParallelScope), >= 0; 0: cores /
+  // concurrency. However many are asked for, the helpers shared by all
+  // workers are at most cores - concurrency, so that the threads computing
+  // at once never outnumber the cores (EffectiveThreadsPerRequest).
+  int threads_per_request = 0;
+  int cores = 0;  // 0: std::thread::hardware_concurrency()
   // Largest request, > 0; 0: DefaultMaxMessageBytes(limits).
   int max_message_bytes = 0;
   // gRPC's resource quota, bytes (>= 16 MiB).
@@ -87,6 +93,15 @@ struct ServerConfig {
   // warm-up Detect; tests block it to observe health before warm-up ends.
   std::function<void()> before_warm_up;
 };
+
+// The threads a frame gets with `config`, and the pool's helpers (shared
+// by all workers): threads_per_request (or cores / concurrency when 0),
+// cut so that concurrency + helpers <= max(cores, concurrency).
+struct ThreadBudget {
+  int threads_per_request = 1;
+  int helpers = 0;
+};
+ThreadBudget EffectiveThreads(const ServerConfig& config);
 
 // Names the flag of the first bad field (--concurrency, ...).
 absl::Status Validate(const ServerConfig& config);
@@ -158,6 +173,7 @@ class FoveaServer {
 
   int port_ = 0;
   std::unique_ptr<LoadedModels> models_;  // the service points into it
+  std::unique_ptr<ThreadPool> pool_;      // the workers' helpers
   std::unique_ptr<WorkQueue> work_;
   std::shared_ptr<ServiceState> service_state_;
   double drain_delay_s_ = 0.0;

@@ -26,13 +26,18 @@ void RunGuarded(absl::AnyInvocable<void() &&> job) {
 
 }  // namespace
 
-WorkQueue::WorkQueue(int workers, int queue_capacity)
+WorkQueue::WorkQueue(int workers, int queue_capacity, ThreadPool* pool,
+                     int threads_per_job)
     : queue_capacity_(queue_capacity) {
   FOVEA_CHECK(workers >= 1);
   FOVEA_CHECK(queue_capacity >= 0);
+  FOVEA_CHECK(threads_per_job >= 1);
   threads_.reserve(workers);
   for (int i = 0; i < workers; ++i) {
-    threads_.emplace_back([this] { WorkerLoop(); });
+    threads_.emplace_back([this, pool, threads_per_job] {
+      const ParallelScope scope(pool, threads_per_job);
+      WorkerLoop();
+    });
   }
 }
 

@@ -8,6 +8,7 @@
 #include "absl/base/thread_annotations.h"
 #include "absl/functional/any_invocable.h"
 #include "core/base/mutex.h"
+#include "core/base/parallel.h"
 
 namespace fovea::server {
 
@@ -27,8 +28,11 @@ namespace fovea::server {
 // answers INTERNAL); what still escapes is only logged.
 class WorkQueue {
  public:
-  // `workers` >= 1, `queue_capacity` >= 0 (checked: FOVEA_CHECK).
-  WorkQueue(int workers, int queue_capacity);
+  // `workers` >= 1, `queue_capacity` >= 0 (checked: FOVEA_CHECK). Each
+  // job runs in a ParallelScope of `pool` (not owned; may be null: one
+  // thread per job) and `threads_per_job` threads.
+  WorkQueue(int workers, int queue_capacity, ThreadPool* pool = nullptr,
+            int threads_per_job = 1);
   // Stop().
   ~WorkQueue();
 

@@ -10,6 +10,7 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "core/base/parallel.h"
 #include "core/base/status_macros.h"
 
 namespace fovea {
@@ -217,39 +218,44 @@ void EstimateNormals(const NormalOptions& options, OrganizedCloud& cloud) {
       cloud.xyz,
       static_cast<int>(std::lround(options.smoothing_half_window *
                                    cloud.intrinsics.fx / kReferenceFocalPx)));
-  for (int v = 0; v < h; ++v) {
-    const cv::Vec3f* row = cloud.xyz.ptr<cv::Vec3f>(v);
-    cv::Vec3f* out = cloud.normals.ptr<cv::Vec3f>(v);
-    for (int u = 0; u < w; ++u) {
-      out[u] = {kNaN, kNaN, kNaN};
-      const float z = row[u][2];
-      if (std::isnan(z)) continue;
-      const int r = HalfWindow(options, focal_px, z);
-      if (u - r < 0 || u + r >= w || v - r < 0 || v + r >= h) continue;
-      // The four samples must lie on the same surface as the centre.
-      const float max_change = options.max_depth_change_factor * z * r;
-      const float zl = row[u - r][2], zr = row[u + r][2];
-      const float zu = cloud.xyz.ptr<cv::Vec3f>(v - r)[u][2];
-      const float zd = cloud.xyz.ptr<cv::Vec3f>(v + r)[u][2];
-      if (!(std::abs(zl - z) <= max_change && std::abs(zr - z) <= max_change &&
-            std::abs(zu - z) <= max_change && std::abs(zd - z) <= max_change)) {
-        continue;
+  // Rows in parallel: each writes its own row of normals.
+  ParallelForRanges(h, [&](int begin, int end) {
+    for (int v = begin; v < end; ++v) {
+      const cv::Vec3f* row = cloud.xyz.ptr<cv::Vec3f>(v);
+      cv::Vec3f* out = cloud.normals.ptr<cv::Vec3f>(v);
+      for (int u = 0; u < w; ++u) {
+        out[u] = {kNaN, kNaN, kNaN};
+        const float z = row[u][2];
+        if (std::isnan(z)) continue;
+        const int r = HalfWindow(options, focal_px, z);
+        if (u - r < 0 || u + r >= w || v - r < 0 || v + r >= h) continue;
+        // The four samples must lie on the same surface as the centre.
+        const float max_change = options.max_depth_change_factor * z * r;
+        const float zl = row[u - r][2], zr = row[u + r][2];
+        const float zu = cloud.xyz.ptr<cv::Vec3f>(v - r)[u][2];
+        const float zd = cloud.xyz.ptr<cv::Vec3f>(v + r)[u][2];
+        if (!(std::abs(zl - z) <= max_change &&
+              std::abs(zr - z) <= max_change &&
+              std::abs(zu - z) <= max_change &&
+              std::abs(zd - z) <= max_change)) {
+          continue;
+        }
+        const cv::Vec3f& left = smooth.ptr<cv::Vec3f>(v)[u - r];
+        const cv::Vec3f& right = smooth.ptr<cv::Vec3f>(v)[u + r];
+        const cv::Vec3f& up = smooth.ptr<cv::Vec3f>(v - r)[u];
+        const cv::Vec3f& down = smooth.ptr<cv::Vec3f>(v + r)[u];
+        const cv::Vec3f gu = right - left;
+        const cv::Vec3f gv = down - up;
+        cv::Vec3f n = gv.cross(gu);
+        const float norm2 = n.dot(n);
+        if (!(norm2 > 0.0f)) continue;  // also false for NaN
+        n *= 1.0f / std::sqrt(norm2);
+        // Orient towards the camera (the origin): n . p < 0.
+        if (n[0] * row[u][0] + n[1] * row[u][1] + n[2] * z > 0.0f) n = -n;
+        out[u] = n;
       }
-      const cv::Vec3f& left = smooth.ptr<cv::Vec3f>(v)[u - r];
-      const cv::Vec3f& right = smooth.ptr<cv::Vec3f>(v)[u + r];
-      const cv::Vec3f& up = smooth.ptr<cv::Vec3f>(v - r)[u];
-      const cv::Vec3f& down = smooth.ptr<cv::Vec3f>(v + r)[u];
-      const cv::Vec3f gu = right - left;
-      const cv::Vec3f gv = down - up;
-      cv::Vec3f n = gv.cross(gu);
-      const float norm2 = n.dot(n);
-      if (!(norm2 > 0.0f)) continue;  // also false for NaN
-      n *= 1.0f / std::sqrt(norm2);
-      // Orient towards the camera (the origin): n . p < 0.
-      if (n[0] * row[u][0] + n[1] * row[u][1] + n[2] * z > 0.0f) n = -n;
-      out[u] = n;
     }
-  }
+  });
 }
 
 absl::StatusOr<OrganizedCloud> BuildOrganizedCloud(

@@ -25,24 +25,6 @@ constexpr double kReferenceFocalPx = 525.0;
 // 8 levels, 0..7).
 constexpr int kMaxSym3dLevel = 7;
 
-// Wall-clock stage timer that appends to the result's timings.
-class StageClock {
- public:
-  explicit StageClock(std::vector<StageTiming>& timings)
-      : timings_(timings), start_(Clock::now()) {}
-  void Lap(std::string stage) {
-    const Clock::time_point now = Clock::now();
-    timings_.push_back({std::move(stage),
-                        std::chrono::duration<double>(now - start_).count()});
-    start_ = now;
-  }
-
- private:
-  using Clock = std::chrono::steady_clock;
-  std::vector<StageTiming>& timings_;
-  Clock::time_point start_;
-};
-
 absl::Status Check(const InterruptCheck& interrupt) {
   return interrupt ? interrupt() : absl::OkStatus();
 }

@@ -14,6 +14,7 @@
 #include "core/attention/tj.h"
 #include "core/attention/wta.h"
 #include "core/base/interrupt.h"
+#include "core/base/stage_clock.h"
 #include "core/frame/frame_scale.h"
 #include "core/frame/hole_filling.h"
 #include "core/frame/organized_cloud.h"
@@ -205,12 +206,6 @@ struct DetectOptions {
 
 // Validates every field; errors are INVALID_ARGUMENT and name the field.
 absl::Status Validate(const DetectOptions& options);
-
-struct StageTiming {
-  std::string
-      stage;  // "cloud", "normals", "support_plane", "saliency.rso", ...
-  double seconds = 0.0;
-};
 
 struct NamedMap {
   std::string name;  // "master" or SaliencyOpName

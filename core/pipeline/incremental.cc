@@ -90,6 +90,9 @@ absl::StatusOr<SegmentSummary> RunUnguarded(const RgbdFrame& frame,
                                        inc_options, scene.table.region));
   IncSegmenter segmenter(inc, *svm, inc_options);
   summary.timings.push_back({"segment.prepare", SecondsSince(lap)});
+  for (const StageTiming& part : inc.timings) {
+    summary.timings.push_back({absl::StrCat("inc.", part.stage), part.seconds});
+  }
 
   while (true) {
     if (options.max_objects > 0 && summary.objects >= options.max_objects) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/parallel.h"
 #include "core/base/status_macros.h"
 #include "core/saliency/saliency_map.h"
 
@@ -148,33 +149,37 @@ absl::StatusOr<cv::Mat> ComputeSym3dSaliency(const OrganizedCloud& cloud,
   const int half = options.kernel_size / 2;
   const float inv_fx = static_cast<float>(1.0 / cloud.intrinsics.fx);
   const float curved_rad = options.curved_angle_deg * kDegToRad;
-  Patch patch;
-  patch.offsets.reserve(options.kernel_size * options.kernel_size);
-  patch.normals.reserve(options.kernel_size * options.kernel_size);
-  for (int v = 0; v < h; ++v) {
-    const uint8_t* cand = scene.candidate.ptr<uint8_t>(v);
-    const cv::Vec3f* row = cloud.xyz.ptr<cv::Vec3f>(v);
-    const cv::Vec3f* nrow = cloud.normals.ptr<cv::Vec3f>(v);
-    float* out = map.ptr<float>(v);
-    for (int u = 0; u < w; ++u) {
-      if (!cand[u] || std::isnan(nrow[u][2])) continue;
-      const float half_width = half * row[u][2] * inv_fx;  // metres
-      GatherPatch(cloud, u, v, half, options.max_distance_factor * half_width,
-                  patch);
-      if (patch.offsets.size() < 2u * options.min_side_points ||
-          !(patch.mean_radius > 0.0f)) {
-        continue;
+  // Rows in parallel, each range with its own patch buffers; each pixel
+  // writes only its own output.
+  ParallelForRanges(h, [&](int begin, int end) {
+    Patch patch;
+    patch.offsets.reserve(options.kernel_size * options.kernel_size);
+    patch.normals.reserve(options.kernel_size * options.kernel_size);
+    for (int v = begin; v < end; ++v) {
+      const uint8_t* cand = scene.candidate.ptr<uint8_t>(v);
+      const cv::Vec3f* row = cloud.xyz.ptr<cv::Vec3f>(v);
+      const cv::Vec3f* nrow = cloud.normals.ptr<cv::Vec3f>(v);
+      float* out = map.ptr<float>(v);
+      for (int u = 0; u < w; ++u) {
+        if (!cand[u] || std::isnan(nrow[u][2])) continue;
+        const float half_width = half * row[u][2] * inv_fx;  // metres
+        GatherPatch(cloud, u, v, half, options.max_distance_factor * half_width,
+                    patch);
+        if (patch.offsets.size() < 2u * options.min_side_points ||
+            !(patch.mean_radius > 0.0f)) {
+          continue;
+        }
+        const Eigen::Matrix3f axes = NormalAxes(patch);
+        const float band = options.plane_band_fraction * half_width;
+        float best = 0.0f;
+        for (int j = 0; j < 3; ++j) {
+          best = std::max(best, PlaneSymmetry(patch, axes.col(j), band, options,
+                                              curved_rad));
+        }
+        out[u] = best;
       }
-      const Eigen::Matrix3f axes = NormalAxes(patch);
-      const float band = options.plane_band_fraction * half_width;
-      float best = 0.0f;
-      for (int j = 0; j < 3; ++j) {
-        best = std::max(
-            best, PlaneSymmetry(patch, axes.col(j), band, options, curved_rad));
-      }
-      out[u] = best;
     }
-  }
+  });
   NormalizeLinear(map);
   return map;
 }

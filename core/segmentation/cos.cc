@@ -206,10 +206,12 @@ absl::StatusOr<CosScene> BuildCosScene(const OrganizedCloud& cloud,
                                        const CosOptions& options,
                                        const cv::Mat& region) {
   FOVEA_RETURN_IF_ERROR(Validate(options));
+  CosScene scene;
+  StageClock clock(scene.timings);
   FOVEA_ASSIGN_OR_RETURN(PlanarPatches patches,
                          FindPlanarPatches(cloud, region, options.patches));
-  CosScene scene;
   scene.patches = std::move(patches);
+  clock.Lap("patches");
   const int n = static_cast<int>(scene.patches.patches.size());
   scene.histograms =
       LabelColorHistograms(cloud.color, scene.patches.labels, n, options.color);
@@ -256,6 +258,7 @@ absl::StatusOr<CosScene> BuildCosScene(const OrganizedCloud& cloud,
         size[p] > 0 && (on_plane[p] > options.max_support_fraction * size[p] ||
                         (have_inliers && height < options.min_patch_height));
   }
+  clock.Lap("patch_features");
   return scene;
 }
 

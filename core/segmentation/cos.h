@@ -9,6 +9,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/base/interrupt.h"
+#include "core/base/stage_clock.h"
 #include "core/frame/organized_cloud.h"
 #include "core/frame/support_plane.h"
 #include "core/segmentation/linear_svm.h"
@@ -75,6 +76,8 @@ struct CosScene {
   std::vector<std::vector<Eigen::Vector3f>> samples;  // per patch
   std::vector<bool> support;                          // per patch
   std::vector<std::vector<int>> neighbours;           // per patch, sorted
+  // "patches", "patch_features": how long building it took.
+  std::vector<StageTiming> timings;
 };
 
 // Patches, their colour histograms, point samples, support flags and

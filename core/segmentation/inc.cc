@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/parallel.h"
 #include "core/base/status_macros.h"
 
 namespace fovea {
@@ -85,11 +86,23 @@ absl::StatusOr<IncScene> BuildIncScene(const OrganizedCloud& cloud,
   FOVEA_ASSIGN_OR_RETURN(CosScene surfaces,
                          BuildCosScene(cloud, plane, options.surfaces, region));
   IncScene scene;
+  scene.timings = surfaces.timings;
+  StageClock clock(scene.timings);
   scene.surfaces = std::move(surfaces);
   const cv::Mat& labels = scene.surfaces.patches.labels;
   const int n = static_cast<int>(scene.surfaces.patches.patches.size());
+  // Relations are only ever asked between object surfaces (the segmenter
+  // starts with the support removed, training skips it), so the support's
+  // pixels, and with them most of a frame, are left out of them.
+  cv::Mat object_labels = labels.clone();
+  for (int v = 0; v < object_labels.rows; ++v) {
+    int* label = object_labels.ptr<int>(v);
+    for (int u = 0; u < object_labels.cols; ++u) {
+      if (label[u] >= 0 && scene.surfaces.support[label[u]]) label[u] = -1;
+    }
+  }
   scene.relations = std::make_unique<RelationComputer>(
-      cloud, labels, n, plane.normal, options.relations);
+      cloud, object_labels, n, plane.normal, options.relations);
   // Eq. 3.6: a surface's saliency is the mean saliency of its points.
   std::vector<double> sum(n, 0.0);
   std::vector<int> count(n, 0);
@@ -103,10 +116,11 @@ absl::StatusOr<IncScene> BuildIncScene(const OrganizedCloud& cloud,
       ++count[l];
     }
   }
-  // Surface models and fusions of neighbours into one B-spline.
-  scene.kinds.assign(n, SurfaceKind::kPlane);
+  clock.Lap("relations");
+  // The points of every object surface, for the surface models the
+  // segmenter fits when it needs them.
+  scene.points.assign(n, {});
   if (options.fuse_surfaces) {
-    std::vector<std::vector<Eigen::Vector3f>> points(n);
     for (int v = 0; v < labels.rows; ++v) {
       const int* label = labels.ptr<int>(v);
       const cv::Vec3f* xyz = cloud.xyz.ptr<cv::Vec3f>(v);
@@ -115,25 +129,7 @@ absl::StatusOr<IncScene> BuildIncScene(const OrganizedCloud& cloud,
         if (l < 0 || scene.surfaces.support[l] || std::isnan(xyz[u][2])) {
           continue;
         }
-        points[l].emplace_back(xyz[u][0], xyz[u][1], xyz[u][2]);
-      }
-    }
-    std::vector<std::optional<SurfaceModel>> models(n);
-    for (int l = 0; l < n; ++l) {
-      if (scene.surfaces.support[l] || points[l].size() < 3) continue;
-      absl::StatusOr<SurfaceModel> model =
-          FitSurface(points[l], options.surface_models);
-      if (!model.ok()) continue;  // degenerate: no model, no fusion
-      scene.kinds[l] = model->kind;
-      models[l] = *std::move(model);
-    }
-    for (const auto& [a, b] : scene.relations->adjacent_pairs()) {
-      if (!models[a] || !models[b]) continue;
-      absl::StatusOr<FusionVerdict> verdict = ShouldFuse(
-          points[a], *models[a], points[b], *models[b], options.surface_models);
-      if (verdict.ok() && verdict->fuse &&
-          verdict->fused.kind == SurfaceKind::kBSpline) {
-        scene.fused.insert(PairKey(a, b));
+        scene.points[l].emplace_back(xyz[u][0], xyz[u][1], xyz[u][2]);
       }
     }
   }
@@ -143,6 +139,7 @@ absl::StatusOr<IncScene> BuildIncScene(const OrganizedCloud& cloud,
     if (count[l] > 0) scene.saliency[l] = sum[l] / count[l];
     if (!scene.surfaces.support[l]) scene.object_points += count[l];
   }
+  clock.Lap("surface_points");
   return scene;
 }
 
@@ -151,7 +148,9 @@ IncSegmenter::IncSegmenter(const IncScene& scene, const RbfSvm& svm,
     : scene_(scene),
       svm_(svm),
       options_(options),
-      removed_(scene.surfaces.patches.patches.size(), false) {
+      removed_(scene.surfaces.patches.patches.size(), false),
+      fitted_(removed_.size(), 0),
+      models_(removed_.size()) {
   for (size_t s = 0; s < removed_.size(); ++s) {
     if (scene_.surfaces.support[s]) removed_[s] = true;
   }
@@ -170,6 +169,48 @@ double IncSegmenter::SameProbability(int a, int b) {
   const double p = svm_.Probability(scene_.relations->Relate(a, b));
   probability_.emplace(key, p);
   return p;
+}
+
+void IncSegmenter::DecideFusions(const std::vector<int>& selection) {
+  if (!options_.fuse_surfaces) return;
+  // Pairs that share a border in the labels image (the relations').
+  const std::vector<std::pair<int, int>>& bordering =
+      scene_.relations->adjacent_pairs();
+  std::vector<int> to_fit;
+  std::vector<std::pair<int, int>> to_decide;
+  for (const int a : selection) {
+    if (!fitted_[a]) to_fit.push_back(a);
+    for (const int b : scene_.surfaces.neighbours[a]) {
+      if (a < b && std::binary_search(selection.begin(), selection.end(), b) &&
+          fused_.count(PairKey(a, b)) == 0 &&
+          std::binary_search(bordering.begin(), bordering.end(),
+                             std::make_pair(a, b))) {
+        to_decide.emplace_back(a, b);
+      }
+    }
+  }
+  // Every item writes only its own slot.
+  ParallelFor(static_cast<int>(to_fit.size()), [&](int i) {
+    const int l = to_fit[i];
+    if (scene_.surfaces.support[l] || scene_.points[l].size() < 3) return;
+    absl::StatusOr<SurfaceModel> model =
+        FitSurface(scene_.points[l], options_.surface_models);
+    if (model.ok()) models_[l] = *std::move(model);  // else: no fusion
+  });
+  for (const int l : to_fit) fitted_[l] = 1;
+  std::vector<char> fuse(to_decide.size(), 0);
+  ParallelFor(static_cast<int>(to_decide.size()), [&](int i) {
+    const auto [a, b] = to_decide[i];
+    if (!models_[a] || !models_[b]) return;
+    absl::StatusOr<FusionVerdict> verdict =
+        ShouldFuse(scene_.points[a], *models_[a], scene_.points[b], *models_[b],
+                   options_.surface_models);
+    fuse[i] = verdict.ok() && verdict->fuse &&
+              verdict->fused.kind == SurfaceKind::kBSpline;
+  });
+  for (size_t i = 0; i < to_decide.size(); ++i) {
+    fused_[PairKey(to_decide[i].first, to_decide[i].second)] = fuse[i] != 0;
+  }
 }
 
 std::vector<int> IncSegmenter::GroupOf(const std::vector<int>& selection,
@@ -195,11 +236,13 @@ std::vector<int> IncSegmenter::GroupOf(const std::vector<int>& selection,
     double Weight() const { return weighted / weights; }
   };
   std::vector<std::map<int, EdgeSums>> edges(n);
+  DecideFusions(selection);
   for (int i = 0; i < n; ++i) {
     for (const int neighbour : scene_.surfaces.neighbours[selection[i]]) {
       const auto j = index.find(neighbour);
       if (j == index.end() || j->second <= i) continue;
-      const double w = scene_.fused.count(PairKey(selection[i], neighbour)) > 0
+      const auto fused = fused_.find(PairKey(selection[i], neighbour));
+      const double w = fused != fused_.end() && fused->second
                            ? 0.0
                            : 1.0 - SameProbability(selection[i], neighbour);
       const double points =

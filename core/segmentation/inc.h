@@ -6,7 +6,6 @@
 #include <optional>
 #include <string>
 #include <unordered_map>
-#include <unordered_set>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -63,13 +62,15 @@ absl::Status Validate(const IncOptions& options);
 struct IncScene {
   CosScene surfaces;
   std::unique_ptr<RelationComputer> relations;
-  std::vector<double> saliency;    // per surface, eq. 3.6: mean of the map
-  std::vector<int> pixels;         // per surface, in the labels image
-  std::vector<SurfaceKind> kinds;  // per surface (support ones: kPlane)
-  // Neighbouring pairs (PairKey: smaller << 32 | larger) fused into one
-  // B-spline.
-  std::unordered_set<uint64_t> fused;
+  std::vector<double> saliency;  // per surface, eq. 3.6: mean of the map
+  std::vector<int> pixels;       // per surface, in the labels image
+  // Per surface, its points (none for support ones), for the surface models
+  // (options.fuse_surfaces), which the segmenter fits only for the
+  // surfaces an object's growth reaches, when it first reaches them.
+  std::vector<std::vector<Eigen::Vector3f>> points;
   int object_points = 0;  // pixels of non-support surfaces
+  // The surfaces' stages, then "relations" and "surface_points".
+  std::vector<StageTiming> timings;
 };
 
 // Surfaces (of the points in `region`, as BuildCosScene), their
@@ -109,6 +110,10 @@ class IncSegmenter {
 
  private:
   double SameProbability(int a, int b);
+  // Fits the surface models of `selection`'s surfaces and decides for each
+  // neighbouring pair of them whether one B-spline explains both (then
+  // their edge weighs 0), where not done before; in parallel.
+  void DecideFusions(const std::vector<int>& selection);
   // Groups of `selection` by the graph-based segmentation; the group of
   // `seed`.
   std::vector<int> GroupOf(const std::vector<int>& selection, int seed,
@@ -120,6 +125,11 @@ class IncSegmenter {
   std::vector<bool> removed_;
   int removed_points_ = 0;
   std::unordered_map<uint64_t, double> probability_;  // pair -> p(same)
+  // Per surface: fitted yet, and its model (none: support, too few points
+  // or degenerate).
+  std::vector<char> fitted_;
+  std::vector<std::optional<SurfaceModel>> models_;
+  std::unordered_map<uint64_t, bool> fused_;  // pair -> one B-spline
 };
 
 // Relation SVM training examples of one labelled frame: every pair of

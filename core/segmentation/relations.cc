@@ -6,6 +6,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/lab.h"
+#include "core/base/parallel.h"
 
 namespace fovea {
 namespace {
@@ -37,43 +38,63 @@ void Normalize(std::vector<double>& v) {
   for (double& x : v) x /= sum;
 }
 
+// The smallest rectangle holding every pixel of `labels` whose label is in
+// [0, count); empty when there is none.
+cv::Rect LabelledBox(const cv::Mat& labels, int count) {
+  int x0 = labels.cols, y0 = labels.rows, x1 = -1, y1 = -1;
+  for (int v = 0; v < labels.rows; ++v) {
+    const int* label = labels.ptr<int>(v);
+    for (int u = 0; u < labels.cols; ++u) {
+      if (label[u] < 0 || label[u] >= count) continue;
+      x0 = std::min(x0, u);
+      x1 = std::max(x1, u);
+      y0 = std::min(y0, v);
+      y1 = std::max(y1, v);
+    }
+  }
+  return x1 < 0 ? cv::Rect() : cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1);
+}
+
 // Per label, the mean absolute response of each filter of a Gabor bank on
-// the half-resolution grey image.
+// the half-resolution grey image. Only `box` (LabelledBox of labels_half)
+// is filtered: the filter reads the image around it as the whole image's
+// filter would.
 std::vector<std::vector<double>> GaborEnergies(const cv::Mat& grey_half,
                                                const cv::Mat& labels_half,
                                                int count,
-                                               const RelationOptions& options) {
+                                               const RelationOptions& options,
+                                               const cv::Rect& box) {
   const int filters =
       kOrientations * static_cast<int>(options.gabor_wavelengths_px.size());
   std::vector<std::vector<double>> energy(count,
                                           std::vector<double>(filters, 0.0));
   std::vector<int> n(count, 0);
-  for (int v = 0; v < labels_half.rows; ++v) {
-    for (int u = 0; u < labels_half.cols; ++u) {
-      const int l = labels_half.at<int>(v, u);
-      if (l >= 0 && l < count) ++n[l];
+  for (int v = box.y; v < box.br().y; ++v) {
+    const int* label = labels_half.ptr<int>(v);
+    for (int u = box.x; u < box.br().x; ++u) {
+      if (label[u] >= 0 && label[u] < count) ++n[label[u]];
     }
   }
-  int f = 0;
-  for (const float lambda : options.gabor_wavelengths_px) {
-    for (int o = 0; o < kOrientations; ++o, ++f) {
-      const int size = 2 * static_cast<int>(std::ceil(lambda)) + 1;
-      const cv::Mat kernel = cv::getGaborKernel(
-          cv::Size(size, size), 0.5 * lambda, o * M_PI / kOrientations, lambda,
-          1.0, 0.0, CV_32F);
-      cv::Mat response;
-      cv::filter2D(grey_half, response, CV_32F, kernel);
-      for (int v = 0; v < labels_half.rows; ++v) {
-        const int* label = labels_half.ptr<int>(v);
-        const float* r = response.ptr<float>(v);
-        for (int u = 0; u < labels_half.cols; ++u) {
-          if (label[u] >= 0 && label[u] < count) {
-            energy[label[u]][f] += std::abs(r[u]);
-          }
+  // Filters run in parallel; each sums its own column, in pixel order.
+  ParallelFor(box.empty() ? 0 : filters, [&](int f) {
+    const float lambda = options.gabor_wavelengths_px[f / kOrientations];
+    const int o = f % kOrientations;
+    const int size = 2 * static_cast<int>(std::ceil(lambda)) + 1;
+    const cv::Mat kernel =
+        cv::getGaborKernel(cv::Size(size, size), 0.5 * lambda,
+                           o * M_PI / kOrientations, lambda, 1.0, 0.0, CV_32F);
+    cv::Mat response;
+    cv::filter2D(grey_half(box), response, CV_32F, kernel);
+    for (int v = 0; v < box.height; ++v) {
+      const int* label = labels_half.ptr<int>(box.y + v) + box.x;
+      const float* r = response.ptr<float>(v);
+      for (int u = 0; u < box.width; ++u) {
+        if (label[u] >= 0 && label[u] < count) {
+          energy[label[u]][f] += std::abs(r[u]);
         }
       }
     }
-  }
+  });
   for (int l = 0; l < count; ++l) {
     if (n[l] > 0) {
       for (double& e : energy[l]) e /= n[l];
@@ -84,16 +105,28 @@ std::vector<std::vector<double>> GaborEnergies(const cv::Mat& grey_half,
 }
 
 // Per label, DFT magnitude energy in 4 radial bands (DC left out) of up to
-// options.fourier_windows 16x16 windows lying mostly on the label.
-std::vector<std::vector<double>> FourierEnergies(
-    const cv::Mat& grey_half, const cv::Mat& labels_half, int count,
-    const RelationOptions& options) {
+// options.fourier_windows 16x16 windows lying mostly on the label. The
+// windows sit on a grid of half a window from the image's corner; only
+// those centred in `box` (LabelledBox of labels_half) can count.
+std::vector<std::vector<double>> FourierEnergies(const cv::Mat& grey_half,
+                                                 const cv::Mat& labels_half,
+                                                 int count,
+                                                 const RelationOptions& options,
+                                                 const cv::Rect& box) {
   std::vector<std::vector<double>> bands(
       count, std::vector<double>(kFourierBands, 0.0));
   std::vector<int> windows(count, 0);
   const int step = kFourierWindow / 2;
-  for (int v = 0; v + kFourierWindow <= labels_half.rows; v += step) {
-    for (int u = 0; u + kFourierWindow <= labels_half.cols; u += step) {
+  // The first grid line whose window's centre (+ step) can be in the box.
+  auto first = [step](int box_start) {
+    return (std::max(0, box_start - step) + step - 1) / step * step;
+  };
+  for (int v = first(box.y);
+       v + kFourierWindow <= labels_half.rows && v + step < box.br().y;
+       v += step) {
+    for (int u = first(box.x);
+         u + kFourierWindow <= labels_half.cols && u + step < box.br().x;
+         u += step) {
       const int l = labels_half.at<int>(v + step, u + step);
       if (l < 0 || l >= count || windows[l] >= options.fourier_windows) {
         continue;
@@ -194,24 +227,34 @@ RelationComputer::RelationComputer(const OrganizedCloud& cloud,
       points_(count, 0),
       curvature_(count, 0.0),
       uprightness_(count, 0.0) {
-  histograms_ = LabelColorHistograms(cloud.color, labels, count, options.color);
+  // Everything below looks only at the surfaces' pixels: their bounding
+  // box, at full and at half resolution (a frame's support and background
+  // are often most of it, and callers leave them out).
+  const cv::Rect box = LabelledBox(labels, count);
+  const cv::Rect colour_box =
+      box.empty() ? cv::Rect(0, 0, labels.cols, labels.rows) : box;
+  histograms_ = LabelColorHistograms(cloud.color(colour_box),
+                                     labels(colour_box), count, options.color);
   cv::Mat grey, grey_half, labels_half;
   cv::cvtColor(cloud.color, grey, cv::COLOR_RGB2GRAY);
   cv::resize(grey, grey_half, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
   cv::resize(labels, labels_half, grey_half.size(), 0, 0, cv::INTER_NEAREST);
+  const cv::Rect half_box = LabelledBox(labels_half, count);
   cv::Mat grey_float;
   grey_half.convertTo(grey_float, CV_32F, 1.0 / 255.0);
-  gabor_ = GaborEnergies(grey_float, labels_half, count, options);
-  fourier_ = FourierEnergies(grey_half, labels_half, count, options);
+  gabor_ = GaborEnergies(grey_float, labels_half, count, options, half_box);
+  fourier_ = FourierEnergies(grey_half, labels_half, count, options, half_box);
 
-  cv::Mat lab;
-  cv::Mat color_float;
-  cloud.color.convertTo(color_float, CV_32FC3, 1.0 / 255.0);
-  RgbToLab(color_float, &lab);
+  cv::Mat lab;  // of the box
+  if (!box.empty()) {
+    cv::Mat color_float;
+    cloud.color(box).convertTo(color_float, CV_32FC3, 1.0 / 255.0);
+    RgbToLab(color_float, &lab);
+  }
   // Mean normals, then each surface's mean deviation from it.
   std::vector<Eigen::Vector3d> mean_normal(count, Eigen::Vector3d::Zero());
-  for (int v = 0; v < labels.rows; ++v) {
-    for (int u = 0; u < labels.cols; ++u) {
+  for (int v = box.y; v < box.br().y; ++v) {
+    for (int u = box.x; u < box.br().x; ++u) {
       const int l = labels.at<int>(v, u);
       if (l < 0 || l >= count) continue;
       ++points_[l];
@@ -221,8 +264,8 @@ RelationComputer::RelationComputer(const OrganizedCloud& cloud,
     }
   }
   std::vector<int> with_normal(count, 0);
-  for (int v = 0; v < labels.rows; ++v) {
-    for (int u = 0; u < labels.cols; ++u) {
+  for (int v = box.y; v < box.br().y; ++v) {
+    for (int u = box.x; u < box.br().x; ++u) {
       const int l = labels.at<int>(v, u);
       if (l < 0 || l >= count) continue;
       const cv::Vec3f& n = cloud.normals.at<cv::Vec3f>(v, u);
@@ -241,9 +284,9 @@ RelationComputer::RelationComputer(const OrganizedCloud& cloud,
   }
   const int offset = options.convexity_offset_px;
 
-  // Borders: every 4-adjacent pixel pair of two surfaces.
-  for (int v = 0; v < labels.rows; ++v) {
-    for (int u = 0; u < labels.cols; ++u) {
+  // Borders: every 4-adjacent pixel pair of two surfaces (both in the box).
+  for (int v = box.y; v < box.br().y; ++v) {
+    for (int u = box.x; u < box.br().x; ++u) {
       const int a = labels.at<int>(v, u);
       if (a < 0 || a >= count) continue;
       for (const cv::Point d : {cv::Point(1, 0), cv::Point(0, 1)}) {
@@ -265,8 +308,8 @@ RelationComputer::RelationComputer(const OrganizedCloud& cloud,
         const bool touching = !std::isnan(za) && !std::isnan(zb) &&
                               std::abs(za - zb) / std::max(za, zb) <=
                                   options.touch_depth_fraction;
-        const cv::Vec3f& la = lab.at<cv::Vec3f>(v, u);
-        const cv::Vec3f& lb = lab.at<cv::Vec3f>(y, x);
+        const cv::Vec3f& la = lab.at<cv::Vec3f>(v - box.y, u - box.x);
+        const cv::Vec3f& lb = lab.at<cv::Vec3f>(y - box.y, x - box.x);
         const double color = cv::norm(la - lb);
         border.color_sum += color;
         border.color_sq += color * color;

@@ -12,7 +12,9 @@
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
 #include "core/base/mutex.h"
+#include "core/base/parallel.h"
 #include "gtest/gtest.h"
+#include "server/server.h"
 
 namespace fovea::server {
 namespace {
@@ -179,6 +181,74 @@ TEST(WorkQueueTest, ConcurrentStopsJoinOnceAndReturnAfterTheJobs) {
   // No Stop returned before the accepted job had run.
   for (int i = 0; i < kStoppers; ++i) EXPECT_EQ(ran_when_stopped[i], 1) << i;
   EXPECT_FALSE(queue.TrySubmit([] {}));
+}
+
+TEST(WorkQueueTest, JobsRunInTheirWorkersParallelScope) {
+  ThreadPool pool(1);
+  WorkQueue queue(2, 2, &pool, 2);
+  std::atomic<int> threads{0};
+  std::atomic<int> items{0};
+  Notification done;
+  ASSERT_TRUE(queue.TrySubmit([&] {
+    threads.store(ParallelThreads());
+    ParallelFor(100, [&](int) { items.fetch_add(1); });
+    done.Notify();
+  }));
+  done.WaitForNotification();
+  EXPECT_EQ(threads.load(), 2);
+  EXPECT_EQ(items.load(), 100);
+}
+
+TEST(WorkQueueTest, WithoutAPoolJobsRunOnOneThread) {
+  WorkQueue queue(1, 1);
+  std::atomic<int> threads{0};
+  Notification done;
+  ASSERT_TRUE(queue.TrySubmit([&] {
+    threads.store(ParallelThreads());
+    done.Notify();
+  }));
+  done.WaitForNotification();
+  EXPECT_EQ(threads.load(), 1);
+}
+
+// The threads computing at once (workers + helpers) never outnumber the
+// cores, whatever threads_per_request asks for.
+TEST(EffectiveThreadsTest, DefaultSplitsTheCoresAndNothingOversubscribes) {
+  struct Case {
+    int cores, concurrency, asked, threads, helpers;
+  };
+  for (const Case& c : {
+           Case{2, 2, 0, 1, 0},  // the default deployment: a core per frame
+           Case{2, 1, 0, 2, 1},  // one worker gets both cores
+           Case{8, 2, 0, 4, 6},
+           Case{2, 1, 4, 2, 1},  // asked for more than the cores
+           Case{2, 2, 2, 1, 0},  // no core left for helpers
+           Case{4, 2, 3, 3,
+                2},  // 2 helpers shared: 3 threads when the other worker idles
+           Case{1, 4, 0, 1, 0},  // more workers than cores
+       }) {
+    ServerConfig config;
+    config.cores = c.cores;
+    config.concurrency = c.concurrency;
+    config.threads_per_request = c.asked;
+    const ThreadBudget budget = EffectiveThreads(config);
+    EXPECT_EQ(budget.threads_per_request, c.threads)
+        << c.cores << " cores, concurrency " << c.concurrency << ", asked "
+        << c.asked;
+    EXPECT_EQ(budget.helpers, c.helpers)
+        << c.cores << " cores, concurrency " << c.concurrency;
+    EXPECT_LE(c.concurrency + budget.helpers, std::max(c.cores, c.concurrency));
+  }
+}
+
+TEST(EffectiveThreadsTest, NegativeThreadsPerRequestIsRefusedNamingTheFlag) {
+  ServerConfig config;
+  config.threads_per_request = -1;
+  const absl::Status status = Validate(config);
+  EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(status.message().find("--threads_per_request"),
+            absl::string_view::npos)
+      << status;
 }
 
 }  // namespace

@@ -34,6 +34,11 @@ struct Loopback {
   std::unique_ptr<v1::Perception::Stub> stub;
 };
 
+int& LoopbackThreads() {
+  static int threads = 1;
+  return threads;
+}
+
 std::unique_ptr<Loopback>& LoopbackInstance() {
   static auto* loopback = new std::unique_ptr<Loopback>;
   return *loopback;
@@ -46,6 +51,7 @@ absl::StatusOr<Loopback*> StartLoopback() {
   server::ServerConfig config;
   config.listen = "127.0.0.1:0";
   config.concurrency = 1;
+  config.threads_per_request = LoopbackThreads();
   FOVEA_ASSIGN_OR_RETURN(std::unique_ptr<server::FoveaServer> started,
                          server::FoveaServer::Start(config));
   const auto deadline = std::chrono::steady_clock::now() + kWarmUpTimeout;
@@ -183,6 +189,8 @@ void BenchmarkGrpcIncremental(benchmark::State& state, const SceneList& scenes,
 }
 
 }  // namespace
+
+void SetGrpcThreadsPerRequest(int threads) { LoopbackThreads() = threads; }
 
 void RegisterGrpcBenchmarks(const SceneList* scenes,
                             const std::string& set_name,

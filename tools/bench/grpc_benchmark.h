@@ -20,6 +20,10 @@ namespace fovea::bench {
 // transport, the work queue and response conversion: the service's cost.
 // The server starts on first use, after its warm-up, and stops at
 // StopGrpcServer. `scenes` must outlive the run.
+// The loopback server's --threads_per_request (default 1, as the
+// in-process cases); call before the first gRPC case runs.
+void SetGrpcThreadsPerRequest(int threads);
+
 void RegisterGrpcBenchmarks(const SceneList* scenes,
                             const std::string& set_name,
                             const std::string& suffix,

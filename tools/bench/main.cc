@@ -1,7 +1,14 @@
 // fovea-bench: Google Benchmark cases for the stages of Detect on 640x480
 // frames, one core.
 //
-//   fovea-bench [--passes=N] [--osd_scenes=N] [--benchmark_* flags]
+//   fovea-bench [--passes=N] [--osd_scenes=N] [--threads=N]
+//               [--benchmark_* flags]
+//   fovea-bench stages [--set osd|pile-15|room-640x480|room-1920x1080]
+//                      [--scenes N] [--passes N] [--threads N]
+//                    (median time of every stage of Detect, Segment,
+//                    SegmentIncremental and pcl-lccp, as a Markdown table)
+//   fovea-bench anytime [same flags; default --set pile-15]
+//                    (median time to the k-th object of INC and COS)
 //   fovea-bench load --server 127.0.0.1:PORT --clients C --requests N
 //                    [--seconds S] [--rpc detect|segment|segment-incremental]
 //                    (closed-loop load on a running server, loopback only:
@@ -35,8 +42,10 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "core/base/parallel.h"
 #include "tools/bench/bench_inputs.h"
 #include "tools/bench/stage_benchmarks.h"
+#include "tools/bench/stages.h"
 #ifdef FOVEA_BENCH_GRPC
 #include "tools/bench/grpc_benchmark.h"
 #include "tools/bench/load.h"
@@ -60,6 +69,7 @@ constexpr const char* kDefaultFlags[] = {
 struct BenchFlags {
   SweepOptions sweep;
   int osd_scenes = 0;  // 0: all
+  int threads = 1;     // per case (and per loopback request)
 };
 
 // Takes "--name=N" when `arg` is that flag; false otherwise. Exits on a
@@ -89,7 +99,8 @@ BenchFlags ParseFlags(int argc, char** argv, std::vector<char*>& args) {
   for (int i = 1; i < argc; ++i) {
     const std::string_view arg = argv[i];
     if (TakeIntFlag(arg, "passes", flags.sweep.passes) ||
-        TakeIntFlag(arg, "osd_scenes", flags.osd_scenes)) {
+        TakeIntFlag(arg, "osd_scenes", flags.osd_scenes) ||
+        TakeIntFlag(arg, "threads", flags.threads)) {
       continue;
     }
     if (arg == "--help" || arg == "-h") {
@@ -98,6 +109,8 @@ BenchFlags ParseFlags(int argc, char** argv, std::vector<char*>& args) {
           "  --passes=N      passes over the scene set per repetition\n"
           "                  (default: enough for about 0.5 s)\n"
           "  --osd_scenes=N  first N OSD scenes only (default: all)\n"
+          "  --threads=N     threads per case and per loopback request\n"
+          "                  (default 1)\n"
           "  FOVEA_OSD_DIR   OSD data folder; adds the \"/osd\" cases\n"
           "Defaults before your flags: --benchmark_repetitions=5 "
           "--benchmark_report_aggregates_only=true\n\n");
@@ -175,6 +188,14 @@ int RunLoadCommand(int argc, char** argv) {
 #endif
 
 int main(int argc, char** argv) {
+  // OpenCV's loops follow the ParallelScope: one core without one.
+  fovea::UseParallelScopesInOpenCv();
+  if (argc > 1 && std::string_view(argv[1]) == "stages") {
+    return fovea::bench::RunStagesCommand(argc, argv);
+  }
+  if (argc > 1 && std::string_view(argv[1]) == "anytime") {
+    return fovea::bench::RunAnytimeCommand(argc, argv);
+  }
 #ifdef FOVEA_BENCH_GRPC
   if (argc > 1 && std::string_view(argv[1]) == "load") {
     return RunLoadCommand(argc, argv);
@@ -187,8 +208,6 @@ int main(int argc, char** argv) {
   if (benchmark::ReportUnrecognizedArguments(bench_argc, args.data())) {
     return 2;
   }
-  // One core: OpenCV runs its parallel loops on the calling thread alone.
-  cv::setNumThreads(1);
 
   // Registered cases keep pointers to these: they live until the end.
   static SceneList synthetic;
@@ -247,6 +266,17 @@ int main(int argc, char** argv) {
 #endif
   }
 
+  if (flags.threads < 1) {
+    std::fprintf(stderr, "fovea-bench: --threads: expected N >= 1\n");
+    return 2;
+  }
+  benchmark::AddCustomContext("threads_per_case",
+                              std::to_string(flags.threads));
+#ifdef FOVEA_BENCH_GRPC
+  fovea::bench::SetGrpcThreadsPerRequest(flags.threads);
+#endif
+  fovea::ThreadPool pool(flags.threads - 1);
+  const fovea::ParallelScope scope(&pool, flags.threads);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
 #ifdef FOVEA_BENCH_GRPC

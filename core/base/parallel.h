@@ -1,0 +1,89 @@
+#ifndef FOVEA_CORE_BASE_PARALLEL_H_
+#define FOVEA_CORE_BASE_PARALLEL_H_
+
+#include <deque>
+#include <functional>
+#include <memory>
+#include <thread>
+#include <vector>
+
+#include "absl/base/thread_annotations.h"
+#include "core/base/mutex.h"
+
+namespace fovea {
+
+// Helper threads shared by every request of a process, so that a request
+// may use more than one core without each one starting threads of its own:
+// the threads busy at once are at most the requests' own threads plus
+// helpers(). Stages split their work with ParallelFor (below); a request
+// says how many threads it may use with a ParallelScope.
+class ThreadPool {
+ public:
+  // Starts `helpers` threads (0: ParallelFor runs on the caller alone).
+  explicit ThreadPool(int helpers);
+  ~ThreadPool();  // waits for the running tasks, then joins
+  ThreadPool(const ThreadPool&) = delete;
+  ThreadPool& operator=(const ThreadPool&) = delete;
+
+  int helpers() const { return static_cast<int>(threads_.size()); }
+
+  // Runs fn(i) for every i in [0, n), each exactly once, on the calling
+  // thread and on at most `max_helpers` helpers (fewer when they are busy
+  // with other requests' work: the caller never waits for a helper to
+  // become free), and returns when every call has returned. The first
+  // exception a call throws is rethrown here once all have returned.
+  void ParallelFor(int n, int max_helpers, const std::function<void(int)>& fn);
+
+ private:
+  struct Job;
+  void Work();
+  static void RunShare(Job& job);
+
+  Mutex mutex_;
+  std::deque<std::shared_ptr<Job>> queue_ ABSL_GUARDED_BY(mutex_);
+  bool stopping_ ABSL_GUARDED_BY(mutex_) = false;
+  std::vector<std::thread> threads_;
+};
+
+// While it lives, ParallelFor on this thread splits its work over `threads`
+// threads in all (this one and threads - 1 of `pool`'s helpers). Scopes
+// nest: the innermost one counts. Without a scope, or in a call already
+// running on a helper, ParallelFor runs serially.
+class ParallelScope {
+ public:
+  ParallelScope(ThreadPool* pool, int threads);
+  ~ParallelScope();
+  ParallelScope(const ParallelScope&) = delete;
+  ParallelScope& operator=(const ParallelScope&) = delete;
+
+ private:
+  ThreadPool* previous_pool_;
+  int previous_threads_;
+};
+
+// The threads ParallelFor may use on this thread now (1 without a scope).
+int ParallelThreads();
+
+// 0 on any thread but a pool's helpers, which are numbered from 1.
+int ParallelThreadIndex();
+
+// fn(i) for every i in [0, n) through the current scope's pool (see
+// ParallelScope); serially, in order, without one. Work split this way
+// must give the same result in any order: each i writes only its own part
+// of the output.
+void ParallelFor(int n, const std::function<void(int)>& fn);
+
+// ParallelFor over [0, n) in about ParallelThreads() * 4 contiguous
+// ranges: fn(begin, end) for each, for loops over rows or items whose
+// bodies are too small to be a task each.
+void ParallelForRanges(int n, const std::function<void(int, int)>& fn);
+
+// Routes OpenCV's own parallel loops (filters, colour conversions,
+// resizing) through ParallelFor, so that they follow the calling thread's
+// ParallelScope too: serial without one, instead of OpenCV's pool of one
+// thread per core. Call once, from main, before any other thread starts.
+void UseParallelScopesInOpenCv();
+
+}  // namespace fovea
+
+#endif  // FOVEA_CORE_BASE_PARALLEL_H_

@@ -1,0 +1,386 @@
+#include "tools/bench/stages.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "core/base/parallel.h"
+#include "core/base/status_macros.h"
+#include "core/base/strings.h"
+#include "core/baseline/scene_segmenters.h"
+#include "core/frame/frame_decode.h"
+#include "core/frame/organized_cloud.h"
+#include "core/pipeline/detect.h"
+#include "core/pipeline/incremental.h"
+#include "core/pipeline/models.h"
+#include "core/pipeline/segment.h"
+#include "core/synth/room.h"
+#include "tools/bench/bench_inputs.h"
+
+namespace fovea::bench {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// One request's stage times, seconds, in the order they ran, same-named
+// stages summed (every "segment.object" of a run is one figure).
+class StageSeconds {
+ public:
+  double& operator[](const std::string& stage) {
+    for (auto& [name, seconds] : stages_) {
+      if (name == stage) return seconds;
+    }
+    return stages_.emplace_back(stage, 0.0).second;
+  }
+  const std::vector<std::pair<std::string, double>>& stages() const {
+    return stages_;
+  }
+
+ private:
+  std::vector<std::pair<std::string, double>> stages_;
+};
+
+void Add(const std::vector<StageTiming>& timings, StageSeconds& out) {
+  for (const StageTiming& t : timings) out[t.stage] += t.seconds;
+}
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+struct StagesFlags {
+  std::string set = "osd";
+  int scenes = 0;  // 0: the set's default
+  int passes = 3;
+  int threads = 1;  // per request: this one and threads - 1 helpers
+};
+
+int Usage(const char* command) {
+  std::fprintf(stderr,
+               "usage: fovea-bench %s [--set osd|pile-15|room-640x480|"
+               "room-1920x1080] [--scenes N] [--passes N] [--threads N]\n",
+               command);
+  return 2;
+}
+
+bool ParseStagesFlags(int argc, char** argv, StagesFlags& flags) {
+  for (int i = 2; i < argc; ++i) {
+    const std::string_view arg = argv[i];
+    const bool has_value = i + 1 < argc;
+    if (arg == "--set" && has_value) {
+      flags.set = argv[++i];
+    } else if ((arg == "--scenes" || arg == "--passes" || arg == "--threads") &&
+               has_value) {
+      int value = 0;
+      if (!absl::SimpleAtoi(argv[++i], &value) || value < 1) {
+        std::fprintf(stderr, "fovea-bench %s: %s: expected N >= 1\n", argv[1],
+                     std::string(arg).c_str());
+        return false;
+      }
+      (arg == "--scenes"   ? flags.scenes
+       : arg == "--passes" ? flags.passes
+                           : flags.threads) = value;
+    } else {
+      std::fprintf(stderr, "fovea-bench %s: unknown argument %s\n", argv[1],
+                   std::string(arg).c_str());
+      return false;
+    }
+  }
+  return true;
+}
+
+absl::Status LoadSet(const StagesFlags& flags, SceneList& scenes) {
+  const int count = flags.scenes;
+  if (flags.set == "osd") {
+    const char* dir = std::getenv("FOVEA_OSD_DIR");
+    if (dir == nullptr || *dir == '\0') {
+      return absl::FailedPreconditionError(
+          "--set osd needs FOVEA_OSD_DIR (the OSD data folder)");
+    }
+    return AddOsdScenes(dir, count, scenes);
+  }
+  if (flags.set == "pile-15") {
+    AddPileScenes(15, count > 0 ? count : 8, 1, scenes);
+    return absl::OkStatus();
+  }
+  if (flags.set == "room-640x480" || flags.set == "room-1920x1080") {
+    const bool hd = flags.set == "room-1920x1080";
+    std::vector<uint64_t> seeds;
+    for (int s = 1; s <= (count > 0 ? count : 8); ++s) seeds.push_back(s);
+    AddRoomScenes(seeds, synth::RoomSensor::kActiveStereo, hd ? 1920 : 640,
+                  hd ? 1080 : 480, scenes);
+    return absl::OkStatus();
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat("--set: unknown set ", flags.set));
+}
+
+// A column of the table: a request kind, run once per frame and pass.
+struct Column {
+  std::string name;
+  // Runs the request on the scene, appends its stage times (the whole
+  // request as "total", the first object as "first_object").
+  std::function<absl::Status(const BenchScene&, StageSeconds&)> run;
+};
+
+std::vector<Column> Columns(const LoadedModels& models) {
+  std::vector<Column> columns;
+  columns.push_back(
+      {"Detect", [](const BenchScene& scene, StageSeconds& out) {
+         const Clock::time_point start = Clock::now();
+         FOVEA_ASSIGN_OR_RETURN(
+             RgbdFrame frame, DecodeFrame(scene.raw_wire, BenchFrameLimits()));
+         out["decode"] += SecondsSince(start);
+         FOVEA_ASSIGN_OR_RETURN(DetectResult result,
+                                RunDetect(frame, DetectOptions{}));
+         Add(result.timings, out);
+         out["total"] += SecondsSince(start);
+         return absl::OkStatus();
+       }});
+  const auto segment_column = [&models](std::string name,
+                                        bool incremental) -> Column {
+    return {
+        std::move(name),
+        [&models, incremental](const BenchScene& scene, StageSeconds& out) {
+          const Clock::time_point start = Clock::now();
+          FOVEA_ASSIGN_OR_RETURN(
+              RgbdFrame frame, DecodeFrame(scene.raw_wire, BenchFrameLimits()));
+          out["decode"] += SecondsSince(start);
+          double first = -1.0;
+          SegmentSinks sinks;
+          sinks.object = [&](SegmentedObject) {
+            if (first < 0.0) first = SecondsSince(start);
+            return absl::OkStatus();
+          };
+          absl::StatusOr<SegmentSummary> summary =
+              incremental
+                  ? RunSegmentIncremental(frame, IncrementalOptions{},
+                                          &*models.inc, sinks)
+                  : RunSegment(frame, SegmentOptions{}, models.View(), sinks);
+          FOVEA_RETURN_IF_ERROR(summary.status());
+          Add(summary->timings, out);
+          const double total = SecondsSince(start);
+          out["total"] += total;
+          out["first_object"] += first < 0.0 ? total : first;
+          return absl::OkStatus();
+        }};
+  };
+  columns.push_back(segment_column("Segment (COS)", false));
+  columns.push_back(segment_column("SegmentIncremental (INC)", true));
+  columns.push_back(
+      {"pcl-lccp", [](const BenchScene& scene, StageSeconds& out) {
+         const Clock::time_point start = Clock::now();
+         FOVEA_ASSIGN_OR_RETURN(
+             RgbdFrame frame, DecodeFrame(scene.raw_wire, BenchFrameLimits()));
+         out["decode"] += SecondsSince(start);
+         Clock::time_point lap = Clock::now();
+         FOVEA_ASSIGN_OR_RETURN(
+             const OrganizedCloud cloud,
+             BuildOrganizedCloud(frame, DetectOptions{}.normals));
+         out["cloud + normals"] += SecondsSince(lap);
+         lap = Clock::now();
+         FOVEA_ASSIGN_OR_RETURN(SceneSegmentation segmentation,
+                                SegmentSceneLccp(cloud, LccpSceneOptions{}));
+         out["lccp"] += SecondsSince(lap);
+         out["total"] += SecondsSince(start);
+         return absl::OkStatus();
+       }});
+  return columns;
+}
+
+}  // namespace
+
+int RunStagesCommand(int argc, char** argv) {
+  StagesFlags flags;
+  if (!ParseStagesFlags(argc, argv, flags)) return Usage(argv[1]);
+  SceneList scenes;
+  if (absl::Status status = LoadSet(flags, scenes); !status.ok()) {
+    std::fprintf(stderr, "fovea-bench stages: %s\n", status.ToString().c_str());
+    return 2;
+  }
+  if (scenes.empty()) {
+    std::fprintf(stderr, "fovea-bench stages: no scenes in set %s\n",
+                 flags.set.c_str());
+    return 1;
+  }
+  const absl::StatusOr<LoadedModels> models =
+      LoadModels(FOVEA_BENCH_MODELS_DIR);
+  if (!models.ok()) {
+    std::fprintf(stderr, "fovea-bench stages: %s\n",
+                 models.status().ToString().c_str());
+    return 1;
+  }
+  const std::vector<Column> columns = Columns(*models);
+  ThreadPool pool(flags.threads - 1);
+  const ParallelScope scope(&pool, flags.threads);
+  // Per column and stage: one figure per request.
+  std::vector<std::map<std::string, std::vector<double>>> samples(
+      columns.size());
+  std::vector<std::string> order;  // stages in first-seen order
+  for (int pass = 0; pass < flags.passes; ++pass) {
+    for (size_t c = 0; c < columns.size(); ++c) {
+      for (const auto& scene : scenes) {
+        StageSeconds stages;
+        if (absl::Status s = columns[c].run(*scene, stages); !s.ok()) {
+          std::fprintf(stderr, "fovea-bench stages: %s on %s: %s\n",
+                       columns[c].name.c_str(), scene->name.c_str(),
+                       s.ToString().c_str());
+          return 1;
+        }
+        for (const auto& [stage, seconds] : stages.stages()) {
+          if (std::find(order.begin(), order.end(), stage) == order.end()) {
+            order.push_back(stage);
+          }
+          samples[c][stage].push_back(seconds);
+        }
+      }
+    }
+  }
+  // The totals last.
+  for (const char* last : {"first_object", "total"}) {
+    const auto at = std::find(order.begin(), order.end(), last);
+    if (at != order.end()) {
+      order.erase(at);
+      order.push_back(last);
+    }
+  }
+  std::printf(
+      "%zu %s frames x %d passes, %d thread(s) per request; medians, ms per "
+      "request\n\n",
+      scenes.size(), flags.set.c_str(), flags.passes, flags.threads);
+  std::printf("| stage |");
+  for (const Column& c : columns) std::printf(" %s |", c.name.c_str());
+  std::printf("\n|---|");
+  for (size_t c = 0; c < columns.size(); ++c) std::printf("---|");
+  std::printf("\n");
+  for (const std::string& stage : order) {
+    std::printf("| %s |", stage.c_str());
+    for (size_t c = 0; c < columns.size(); ++c) {
+      const auto found = samples[c].find(stage);
+      if (found == samples[c].end()) {
+        std::printf(" |");
+      } else {
+        std::printf(" %.1f |", 1e3 * Median(found->second));
+      }
+    }
+    std::printf("\n");
+  }
+  return 0;
+}
+
+int RunAnytimeCommand(int argc, char** argv) {
+  StagesFlags flags;
+  flags.set = "pile-15";
+  if (!ParseStagesFlags(argc, argv, flags)) return Usage(argv[1]);
+  SceneList scenes;
+  if (absl::Status status = LoadSet(flags, scenes); !status.ok()) {
+    std::fprintf(stderr, "fovea-bench anytime: %s\n",
+                 status.ToString().c_str());
+    return 2;
+  }
+  if (scenes.empty()) {
+    std::fprintf(stderr, "fovea-bench anytime: no scenes in set %s\n",
+                 flags.set.c_str());
+    return 1;
+  }
+  const absl::StatusOr<LoadedModels> models =
+      LoadModels(FOVEA_BENCH_MODELS_DIR);
+  if (!models.ok()) {
+    std::fprintf(stderr, "fovea-bench anytime: %s\n",
+                 models.status().ToString().c_str());
+    return 1;
+  }
+  ThreadPool pool(flags.threads - 1);
+  const ParallelScope scope(&pool, flags.threads);
+  // Per method: [k] the times from the frame to its k-th object (k from
+  // 0), one per request that got that far; and the whole requests' times.
+  struct Method {
+    std::string name;
+    bool incremental;
+    std::vector<std::vector<double>> to_object;
+    std::vector<double> total;
+  };
+  std::vector<Method> methods = {{"INC", true, {}, {}}, {"COS", false, {}, {}}};
+  for (int pass = 0; pass < flags.passes; ++pass) {
+    for (Method& method : methods) {
+      for (const auto& scene : scenes) {
+        const Clock::time_point start = Clock::now();
+        absl::StatusOr<RgbdFrame> frame =
+            DecodeFrame(scene->raw_wire, BenchFrameLimits());
+        int k = 0;
+        SegmentSinks sinks;
+        sinks.object = [&](SegmentedObject) {
+          if (static_cast<int>(method.to_object.size()) <= k) {
+            method.to_object.emplace_back();
+          }
+          method.to_object[k++].push_back(SecondsSince(start));
+          return absl::OkStatus();
+        };
+        absl::StatusOr<SegmentSummary> summary =
+            !frame.ok() ? absl::StatusOr<SegmentSummary>(frame.status())
+            : method.incremental
+                ? RunSegmentIncremental(*frame, IncrementalOptions{},
+                                        &*models->inc, sinks)
+                : RunSegment(*frame, SegmentOptions{}, models->View(), sinks);
+        if (!summary.ok()) {
+          std::fprintf(stderr, "fovea-bench anytime: %s on %s: %s\n",
+                       method.name.c_str(), scene->name.c_str(),
+                       summary.status().ToString().c_str());
+          return 1;
+        }
+        method.total.push_back(SecondsSince(start));
+      }
+    }
+  }
+  const size_t requests = scenes.size() * flags.passes;
+  std::printf(
+      "%zu %s frames x %d passes, %d thread(s) per request; median ms from "
+      "the frame to its k-th object, over the requests that reached k (how "
+      "many in brackets)\n\n",
+      scenes.size(), flags.set.c_str(), flags.passes, flags.threads);
+  std::printf("| objects k |");
+  for (const Method& m : methods) std::printf(" %s |", m.name.c_str());
+  std::printf("\n|---|");
+  for (size_t m = 0; m < methods.size(); ++m) std::printf("---|");
+  std::printf("\n");
+  size_t rows = 0;
+  for (const Method& m : methods) rows = std::max(rows, m.to_object.size());
+  for (size_t k = 0; k < rows; ++k) {
+    std::printf("| %zu |", k + 1);
+    for (const Method& m : methods) {
+      if (k >= m.to_object.size()) {
+        std::printf(" |");
+        continue;
+      }
+      const std::vector<double>& times = m.to_object[k];
+      if (times.size() == requests) {
+        std::printf(" %.1f |", 1e3 * Median(times));
+      } else {
+        std::printf(" %.1f (%zu) |", 1e3 * Median(times), times.size());
+      }
+    }
+    std::printf("\n");
+  }
+  std::printf("| whole scene |");
+  for (const Method& m : methods) std::printf(" %.1f |", 1e3 * Median(m.total));
+  std::printf("\n");
+  return 0;
+}
+
+}  // namespace fovea::bench
