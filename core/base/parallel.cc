@@ -128,6 +128,11 @@ void ParallelFor(int n, const std::function<void(int)>& fn) {
   pool->ParallelFor(n, threads - 1, fn);
 }
 
+void ParallelInvoke(const std::function<void()>& first,
+                    const std::function<void()>& second) {
+  ParallelFor(2, [&](int i) { i == 0 ? first() : second(); });
+}
+
 void ParallelForRanges(int n, const std::function<void(int, int)>& fn) {
   if (n <= 0) return;
   const int threads = ParallelThreads();

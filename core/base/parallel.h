@@ -78,6 +78,13 @@ void ParallelFor(int n, const std::function<void(int)>& fn);
 // bodies are too small to be a task each.
 void ParallelForRanges(int n, const std::function<void(int, int)>& fn);
 
+// Runs `first` and `second`, at once when the current scope allows (see
+// ParallelFor; the caller may run either), in order otherwise, and returns
+// when both have. For two independent stages of one request; each must
+// write only its own results.
+void ParallelInvoke(const std::function<void()>& first,
+                    const std::function<void()>& second);
+
 // Routes OpenCV's own parallel loops (filters, colour conversions,
 // resizing) through ParallelFor, so that they follow the calling thread's
 // ParallelScope too: serial without one, instead of OpenCV's pool of one

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/parallel.h"
 
 namespace fovea {
 
@@ -163,47 +165,52 @@ TableScene PrepareTableScene(const OrganizedCloud& cloud,
   scene.standing.setTo(cv::Scalar(0));
   const bool have_inliers = plane.inliers.rows == h && plane.inliers.cols == w;
   const Eigen::Vector3f& n = plane.normal;
-  for (int v = 0; v < h; ++v) {
-    const cv::Vec3f* p = cloud.xyz.ptr<cv::Vec3f>(v);
-    const cv::Vec3f* normals = cloud.normals.ptr<cv::Vec3f>(v);
-    float* height = scene.height.ptr<float>(v);
-    uint8_t* cand = scene.candidate.ptr<uint8_t>(v);
-    uint8_t* region = scene.region.ptr<uint8_t>(v);
-    uint8_t* standing = scene.standing.ptr<uint8_t>(v);
-    const uint8_t* inlier =
-        have_inliers ? plane.inliers.ptr<uint8_t>(v) : nullptr;
-    for (int u = 0; u < w; ++u) {
-      if (std::isnan(p[u][2])) {
-        height[u] = std::numeric_limits<float>::quiet_NaN();
-        continue;
-      }
-      const float hgt =
-          n.x() * p[u][0] + n.y() * p[u][1] + n.z() * p[u][2] + plane.d;
-      height[u] = hgt;
-      const float z = p[u][2];
-      const float min_height =
-          std::max(options.min_object_height,
-                   options.min_height_sigmas *
-                       (options.sigma0_m + options.sigma_per_z2 * z * z));
-      const bool on_plane = inlier != nullptr && inlier[u];
-      if (on_plane) region[u] = 255;
-      if (hgt > options.max_object_height) continue;
-      if (hgt <= min_height && (on_plane || hgt < -min_height)) continue;
-      const Eigen::Vector3f q(p[u][0], p[u][1], p[u][2]);
-      if (!plane.ProjectsInsideHull(q)) continue;
-      if (!scene.structures.empty() &&
-          OnStructure(scene.structures, q, normals[u], options)) {
-        continue;
-      }
-      region[u] = 255;
-      if (hgt <= min_height) continue;
-      standing[u] = 255;
-      if (plane.ProjectsInsideHull(q, options.hull_margin)) {
-        cand[u] = 255;
-        ++scene.candidate_count;
+  // Rows in parallel ranges; each range counts its own candidates.
+  std::vector<int> candidates(h, 0);
+  ParallelForRanges(h, [&](int begin, int end) {
+    for (int v = begin; v < end; ++v) {
+      const cv::Vec3f* p = cloud.xyz.ptr<cv::Vec3f>(v);
+      const cv::Vec3f* normals = cloud.normals.ptr<cv::Vec3f>(v);
+      float* height = scene.height.ptr<float>(v);
+      uint8_t* cand = scene.candidate.ptr<uint8_t>(v);
+      uint8_t* region = scene.region.ptr<uint8_t>(v);
+      uint8_t* standing = scene.standing.ptr<uint8_t>(v);
+      const uint8_t* inlier =
+          have_inliers ? plane.inliers.ptr<uint8_t>(v) : nullptr;
+      for (int u = 0; u < w; ++u) {
+        if (std::isnan(p[u][2])) {
+          height[u] = std::numeric_limits<float>::quiet_NaN();
+          continue;
+        }
+        const float hgt =
+            n.x() * p[u][0] + n.y() * p[u][1] + n.z() * p[u][2] + plane.d;
+        height[u] = hgt;
+        const float z = p[u][2];
+        const float min_height =
+            std::max(options.min_object_height,
+                     options.min_height_sigmas *
+                         (options.sigma0_m + options.sigma_per_z2 * z * z));
+        const bool on_plane = inlier != nullptr && inlier[u];
+        if (on_plane) region[u] = 255;
+        if (hgt > options.max_object_height) continue;
+        if (hgt <= min_height && (on_plane || hgt < -min_height)) continue;
+        const Eigen::Vector3f q(p[u][0], p[u][1], p[u][2]);
+        if (!plane.ProjectsInsideHull(q)) continue;
+        if (!scene.structures.empty() &&
+            OnStructure(scene.structures, q, normals[u], options)) {
+          continue;
+        }
+        region[u] = 255;
+        if (hgt <= min_height) continue;
+        standing[u] = 255;
+        if (plane.ProjectsInsideHull(q, options.hull_margin)) {
+          cand[u] = 255;
+          ++candidates[v];
+        }
       }
     }
-  }
+  });
+  for (const int c : candidates) scene.candidate_count += c;
   return scene;
 }
 

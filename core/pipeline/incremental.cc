@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/guarded.h"
+#include "core/base/parallel.h"
 #include "core/base/status_macros.h"
 
 namespace fovea {
@@ -51,6 +52,17 @@ absl::StatusOr<SegmentSummary> RunUnguarded(const RgbdFrame& frame,
 
   std::vector<AttentionPoint> points;
   cv::Mat saliency;
+  const IncOptions& inc_options = options.inc;
+  // The surfaces do not depend on the saliency map: with two threads they
+  // are built while Detect runs.
+  std::optional<absl::StatusOr<CosScene>> surfaces;
+  double surfaces_seconds = 0.0;
+  const auto build_surfaces = [&] {
+    const SteadyClock::time_point at = SteadyClock::now();
+    surfaces = BuildCosScene(scene.cloud, scene.plane, inc_options.surfaces,
+                             scene.table.region);
+    surfaces_seconds = SecondsSince(at);
+  };
   if (!options.attention_points.empty()) {
     const float sigma =
         static_cast<float>(options.attention_sigma_px *
@@ -71,25 +83,31 @@ absl::StatusOr<SegmentSummary> RunUnguarded(const RgbdFrame& frame,
       points.push_back(a);
     }
   } else {
-    FOVEA_ASSIGN_OR_RETURN(DetectResult detect,
-                           DetectOnScene(scene, options.detect, interrupt));
-    summary.timings.insert(summary.timings.end(), detect.timings.begin(),
-                           detect.timings.end());
-    saliency = std::move(detect.master);
-    points = std::move(detect.points);
+    absl::StatusOr<DetectResult> detect;
+    ParallelInvoke(
+        [&] { detect = DetectOnScene(scene, options.detect, interrupt); },
+        build_surfaces);
+    FOVEA_RETURN_IF_ERROR(detect.status());
+    summary.timings.insert(summary.timings.end(), detect->timings.begin(),
+                           detect->timings.end());
+    saliency = std::move(detect->master);
+    points = std::move(detect->points);
   }
   if (sinks.points) {
     FOVEA_RETURN_IF_ERROR(sinks.points(PointsToInput(scene.scale, points)));
   }
   FOVEA_RETURN_IF_ERROR(CheckInterrupt(interrupt));
 
+  if (!surfaces.has_value()) build_surfaces();
+  FOVEA_RETURN_IF_ERROR(surfaces->status());
   SteadyClock::time_point lap = SteadyClock::now();
-  const IncOptions& inc_options = options.inc;
   FOVEA_ASSIGN_OR_RETURN(IncScene inc,
-                         BuildIncScene(scene.cloud, scene.plane, saliency,
-                                       inc_options, scene.table.region));
+                         BuildIncScene(**std::move(surfaces), scene.cloud,
+                                       scene.plane, saliency, inc_options));
   IncSegmenter segmenter(inc, *svm, inc_options);
-  summary.timings.push_back({"segment.prepare", SecondsSince(lap)});
+  // With two threads, the surfaces' part overlapped Detect's stages.
+  summary.timings.push_back(
+      {"segment.prepare", surfaces_seconds + SecondsSince(lap)});
   for (const StageTiming& part : inc.timings) {
     summary.timings.push_back({absl::StrCat("inc.", part.stage), part.seconds});
   }

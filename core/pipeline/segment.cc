@@ -14,6 +14,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "core/base/guarded.h"
+#include "core/base/parallel.h"
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
 
@@ -351,17 +352,25 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
         sinks.support(PlaneToInput(scene.scale, scene.plane)));
   }
 
-  FOVEA_ASSIGN_OR_RETURN(std::vector<AttentionPoint> seeds,
-                         TakeSeeds(scene, options, interrupt, summary.timings));
+  // The cutter's scene does not depend on the seeds: with two threads it
+  // is built while Detect runs (its time overlaps Detect's stages).
+  absl::StatusOr<std::vector<AttentionPoint>> seeds;
+  absl::StatusOr<std::unique_ptr<ObjectCutter>> cutter;
+  double prepare_seconds = 0.0;
+  ParallelInvoke(
+      [&] { seeds = TakeSeeds(scene, options, interrupt, summary.timings); },
+      [&] {
+        const SteadyClock::time_point lap = SteadyClock::now();
+        cutter = method->create(&scene, options, models);
+        prepare_seconds = SecondsSince(lap);
+      });
+  FOVEA_RETURN_IF_ERROR(seeds.status());
   if (sinks.points) {
-    FOVEA_RETURN_IF_ERROR(sinks.points(PointsToInput(scene.scale, seeds)));
+    FOVEA_RETURN_IF_ERROR(sinks.points(PointsToInput(scene.scale, *seeds)));
   }
   FOVEA_RETURN_IF_ERROR(CheckInterrupt(interrupt));
-
-  SteadyClock::time_point lap = SteadyClock::now();
-  FOVEA_ASSIGN_OR_RETURN(std::unique_ptr<ObjectCutter> cutter,
-                         method->create(&scene, options, models));
-  summary.timings.push_back({"segment.prepare", SecondsSince(lap)});
+  FOVEA_RETURN_IF_ERROR(cutter.status());
+  summary.timings.push_back({"segment.prepare", prepare_seconds});
 
   const cv::Mat region =
       ObjectRegion(scene.table, options.detect.table_scene.min_object_height);
@@ -372,7 +381,7 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
                                 const char* stage) -> absl::StatusOr<bool> {
     const SteadyClock::time_point at = SteadyClock::now();
     FOVEA_ASSIGN_OR_RETURN(std::optional<CutObject> cut,
-                           cutter->Cut({seed.u, seed.v}, interrupt));
+                           (*cutter)->Cut({seed.u, seed.v}, interrupt));
     summary.timings.push_back({stage, SecondsSince(at)});
     if (!cut.has_value()) return false;
     if (cover) cut->mask.setTo(0, covered);
@@ -397,7 +406,7 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
   const auto full = [&] {
     return options.max_objects > 0 && summary.objects >= options.max_objects;
   };
-  for (const AttentionPoint& seed : seeds) {
+  for (const AttentionPoint& seed : *seeds) {
     if (full()) break;
     FOVEA_RETURN_IF_ERROR(CheckInterrupt(interrupt));
     if (absl::StatusOr<bool> sent = cut_and_send(seed, false, "segment.object");

@@ -85,6 +85,23 @@ absl::StatusOr<IncScene> BuildIncScene(const OrganizedCloud& cloud,
   }
   FOVEA_ASSIGN_OR_RETURN(CosScene surfaces,
                          BuildCosScene(cloud, plane, options.surfaces, region));
+  return BuildIncScene(std::move(surfaces), cloud, plane, saliency_map,
+                       options);
+}
+
+absl::StatusOr<IncScene> BuildIncScene(CosScene surfaces,
+                                       const OrganizedCloud& cloud,
+                                       const SupportPlane& plane,
+                                       const cv::Mat& saliency_map,
+                                       const IncOptions& options) {
+  FOVEA_RETURN_IF_ERROR(Validate(options));
+  if (saliency_map.type() != CV_32FC1 ||
+      saliency_map.size() != cloud.xyz.size() ||
+      surfaces.patches.labels.size() != cloud.xyz.size()) {
+    return absl::InvalidArgumentError(
+        "saliency map and surfaces' labels must be CV_32FC1 and CV_32SC1 of "
+        "the cloud's size");
+  }
   IncScene scene;
   scene.timings = surfaces.timings;
   StageClock clock(scene.timings);

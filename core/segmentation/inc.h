@@ -83,6 +83,15 @@ absl::StatusOr<IncScene> BuildIncScene(const OrganizedCloud& cloud,
                                        const IncOptions& options,
                                        const cv::Mat& region = cv::Mat());
 
+// The same from `surfaces`, which BuildCosScene made of the same cloud and
+// plane with options.surfaces (so that a caller can build them while it
+// computes the saliency map).
+absl::StatusOr<IncScene> BuildIncScene(CosScene surfaces,
+                                       const OrganizedCloud& cloud,
+                                       const SupportPlane& plane,
+                                       const cv::Mat& saliency_map,
+                                       const IncOptions& options);
+
 struct IncObject {
   cv::Mat mask;               // CV_8UC1, 255 on the object
   std::vector<int> surfaces;  // its surfaces

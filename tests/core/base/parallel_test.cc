@@ -98,6 +98,39 @@ TEST(ParallelForTest, ConcurrentRequestsShareOnePoolAndAllFinish) {
   EXPECT_EQ(sum.load(), 4L * 50 * (63 * 64 / 2));
 }
 
+TEST(ParallelInvokeTest, WithoutAScopeRunsBothInOrder) {
+  std::vector<int> order;
+  ParallelInvoke([&] { order.push_back(1); }, [&] { order.push_back(2); });
+  EXPECT_THAT(order, testing::ElementsAre(1, 2));
+}
+
+TEST(ParallelInvokeTest, WithAFreeHelperBothRunAtOnce) {
+  ThreadPool pool(1);
+  ParallelScope scope(&pool, 2);
+  // Whichever thread runs `first` waits for `second` to start: in order,
+  // it would wait its whole 10 s and see it had not.
+  std::atomic<bool> second_started{false};
+  std::atomic<int> runs{0};
+  bool overlapped = false;
+  ParallelInvoke(
+      [&] {
+        const auto until =
+            std::chrono::steady_clock::now() + std::chrono::seconds(10);
+        while (!second_started.load() &&
+               std::chrono::steady_clock::now() < until) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
+        overlapped = second_started.load();
+        runs.fetch_add(1);
+      },
+      [&] {
+        second_started.store(true);
+        runs.fetch_add(1);
+      });
+  EXPECT_TRUE(overlapped);
+  EXPECT_EQ(runs.load(), 2);
+}
+
 TEST(ParallelScopeTest, ScopesNestAndRestore) {
   ThreadPool pool(1);
   {
