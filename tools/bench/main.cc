@@ -9,6 +9,8 @@
 //                    SegmentIncremental and pcl-lccp, as a Markdown table)
 //   fovea-bench anytime [same flags; default --set pile-15]
 //                    (median time to the k-th object of INC and COS)
+//   fovea-bench memory [same flags; default --set room-640x480]
+//                    (each request kind's peak resident memory, MB)
 //   fovea-bench load --server 127.0.0.1:PORT --clients C --requests N
 //                    [--seconds S] [--rpc detect|segment|segment-incremental]
 //                    (closed-loop load on a running server, loopback only:
@@ -195,6 +197,9 @@ int main(int argc, char** argv) {
   }
   if (argc > 1 && std::string_view(argv[1]) == "anytime") {
     return fovea::bench::RunAnytimeCommand(argc, argv);
+  }
+  if (argc > 1 && std::string_view(argv[1]) == "memory") {
+    return fovea::bench::RunMemoryCommand(argc, argv);
   }
 #ifdef FOVEA_BENCH_GRPC
   if (argc > 1 && std::string_view(argv[1]) == "load") {

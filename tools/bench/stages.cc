@@ -1,7 +1,10 @@
 #include "tools/bench/stages.h"
 
+#include <malloc.h>
+
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
@@ -380,6 +383,106 @@ int RunAnytimeCommand(int argc, char** argv) {
   std::printf("| whole scene |");
   for (const Method& m : methods) std::printf(" %.1f |", 1e3 * Median(m.total));
   std::printf("\n");
+  return 0;
+}
+
+namespace {
+
+// The process's resident set now and its peak since the last reset, bytes
+// (/proc/self/status: VmRSS, VmHWM); -1 when unreadable.
+void ReadRss(int64_t& rss, int64_t& peak) {
+  rss = peak = -1;
+  std::FILE* status = std::fopen("/proc/self/status", "r");
+  if (status == nullptr) return;
+  char line[256];
+  while (std::fgets(line, sizeof line, status) != nullptr) {
+    long kb = 0;
+    if (std::sscanf(line, "VmRSS: %ld kB", &kb) == 1) rss = int64_t{kb} << 10;
+    if (std::sscanf(line, "VmHWM: %ld kB", &kb) == 1) peak = int64_t{kb} << 10;
+  }
+  std::fclose(status);
+}
+
+// Resets VmHWM to the current resident set (Linux: clear_refs 5).
+bool ResetPeakRss() {
+  std::FILE* refs = std::fopen("/proc/self/clear_refs", "w");
+  if (refs == nullptr) return false;
+  const bool ok = std::fputs("5", refs) >= 0;
+  return std::fclose(refs) == 0 && ok;
+}
+
+}  // namespace
+
+int RunMemoryCommand(int argc, char** argv) {
+  StagesFlags flags;
+  flags.set = "room-640x480";
+  flags.passes = 1;
+  if (!ParseStagesFlags(argc, argv, flags)) return Usage(argv[1]);
+  if (flags.scenes == 0) flags.scenes = 3;
+  SceneList scenes;
+  if (absl::Status status = LoadSet(flags, scenes); !status.ok()) {
+    std::fprintf(stderr, "fovea-bench memory: %s\n", status.ToString().c_str());
+    return 2;
+  }
+  const absl::StatusOr<LoadedModels> models =
+      LoadModels(FOVEA_BENCH_MODELS_DIR);
+  if (!models.ok() || scenes.empty()) {
+    std::fprintf(
+        stderr, "fovea-bench memory: %s\n",
+        models.ok() ? "no scenes" : models.status().ToString().c_str());
+    return 1;
+  }
+  // Blocks of 64 KiB and more are mapped and unmapped one by one, and the
+  // heap is trimmed before each request: what a request holds at its peak
+  // is then resident, instead of reusing what an earlier one freed.
+  mallopt(M_MMAP_THRESHOLD, 64 << 10);
+  mallopt(M_TRIM_THRESHOLD, 0);
+  ThreadPool pool(flags.threads - 1);
+  const ParallelScope scope(&pool, flags.threads);
+  const std::vector<Column> columns = Columns(*models);
+  std::printf(
+      "%zu %s frames, %d thread(s) per request; per request kind, the "
+      "largest rise of the peak resident set over the resident set just "
+      "before the request (models loaded, frames in memory), MB\n\n",
+      scenes.size(), flags.set.c_str(), flags.threads);
+  std::printf(
+      "| request | peak rise, MB | resident before, MB |\n|---|---|---|\n");
+  for (const Column& column : columns) {
+    int64_t worst = 0, before_worst = 0;
+    std::string failed;
+    // A first pass warms the allocator and the lazily built tables up.
+    for (int pass = 0; pass < 1 + flags.passes && failed.empty(); ++pass) {
+      for (const auto& scene : scenes) {
+        malloc_trim(0);
+        int64_t before = 0, peak = 0;
+        ReadRss(before, peak);
+        if (!ResetPeakRss()) {
+          std::fprintf(stderr,
+                       "fovea-bench memory: cannot reset the peak RSS "
+                       "(/proc/self/clear_refs)\n");
+          return 1;
+        }
+        StageSeconds stages;
+        if (absl::Status s = column.run(*scene, stages); !s.ok()) {
+          failed = s.ToString();  // a peer that cannot take the frame
+          break;
+        }
+        int64_t after = 0;
+        ReadRss(after, peak);
+        if (pass > 0 && peak - before > worst) {
+          worst = peak - before;
+          before_worst = before;
+        }
+      }
+    }
+    if (!failed.empty()) {
+      std::printf("| %s | failed: %s | |\n", column.name.c_str(),
+                  failed.c_str());
+      continue;
+    }
+    std::printf("| %s | %.1f | %.1f |\n", column.name.c_str(),
+                worst / 1048576.0, before_worst / 1048576.0);
+  }
   return 0;
 }
 

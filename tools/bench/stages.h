@@ -21,6 +21,13 @@ int RunStagesCommand(int argc, char** argv);
 // pile-15. `argv[1]` is "anytime". Returns the process's exit code.
 int RunAnytimeCommand(int argc, char** argv);
 
+// fovea-bench memory [--set ...] [--scenes N] [--passes N] [--threads N]
+// Per request kind of `stages`, the largest rise of the process's peak
+// resident set (VmHWM, reset before each request) over its resident set
+// just before the request; default set room-640x480, 3 frames, after one
+// warm-up pass. `argv[1]` is "memory". Returns the process's exit code.
+int RunMemoryCommand(int argc, char** argv);
+
 }  // namespace fovea::bench
 
 #endif  // FOVEA_TOOLS_BENCH_STAGES_H_
