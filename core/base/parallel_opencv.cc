@@ -10,9 +10,14 @@ namespace {
 
 class ScopedBackend : public cv::parallel::ParallelForAPI {
  public:
+  // OpenCV cuts a loop into `tasks` stripes; body(begin, end) runs stripes
+  // [begin, end). In a few contiguous ranges, so that a serial scope makes
+  // one call, as OpenCV's own serial path does (a filter sets up its row
+  // buffers once per call, not once per stripe).
   void parallel_for(int tasks, FN_parallel_for_body_cb_t body,
                     void* data) override {
-    ParallelFor(tasks, [&](int i) { body(i, i + 1, data); });
+    ParallelForRanges(tasks,
+                      [&](int begin, int end) { body(begin, end, data); });
   }
   int getThreadNum() const override { return ParallelThreadIndex(); }
   // OpenCV splits a loop into about this many stripes.
