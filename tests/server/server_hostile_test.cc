@@ -307,12 +307,17 @@ TEST_F(HostileRequestTest, MemoryQuotaRefusesWhatDoesNotFit) {
   big.set_request_id(std::string(12 << 20, 'x'));
   std::vector<std::future<grpc::Status>> calls;
   for (int i = 0; i < 6; ++i) calls.push_back(DetectAsync(big));
+  // gRPC's transport refuses what the quota cannot hold by resetting the
+  // stream (RESOURCE_EXHAUSTED) or, when the connection itself runs out,
+  // by closing it (UNAVAILABLE, which gRPC's own quota tests accept too,
+  // grpc/grpc#10820); which one depends on timing. Either is a refusal.
   int refused = 0;
   for (std::future<grpc::Status>& call : calls) {
     const grpc::StatusCode code = call.get().error_code();
     EXPECT_THAT(code, AnyOf(Eq(grpc::StatusCode::OK),
-                            Eq(grpc::StatusCode::RESOURCE_EXHAUSTED)));
-    refused += code == grpc::StatusCode::RESOURCE_EXHAUSTED ? 1 : 0;
+                            Eq(grpc::StatusCode::RESOURCE_EXHAUSTED),
+                            Eq(grpc::StatusCode::UNAVAILABLE)));
+    refused += code != grpc::StatusCode::OK ? 1 : 0;
   }
   EXPECT_GE(refused, 1);
   ExpectStillServing();

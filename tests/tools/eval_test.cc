@@ -17,6 +17,7 @@
 
 #include "core/pipeline/models.h"
 #include "core/synth/synth_scene.h"
+#include "tests/core/testing/files.h"
 #include "tests/core/testing/scenes.h"
 #include "tests/testing/run_command.h"
 #include "tools/eval/scene_kind.h"
@@ -81,7 +82,7 @@ void WritePcd(const std::filesystem::path& path,
 
 std::filesystem::path SyntheticDataDir() {
   const std::filesystem::path dir =
-      std::filesystem::path(::testing::TempDir()) / "fovea_eval_test_data";
+      testing::FreshTestDir("fovea_eval_test_data_");
   std::filesystem::create_directories(dir / "learn");
   for (int i = 0; i < 3; ++i) {
     WritePcd(dir / "learn" / ("learn" + std::to_string(i) + ".pcd"),
@@ -94,7 +95,7 @@ std::filesystem::path SyntheticDataDir() {
 // 5 cm apart in the third: every fold has patches to join and to reject.
 std::filesystem::path SegmentationDataDir() {
   const std::filesystem::path dir =
-      std::filesystem::path(::testing::TempDir()) / "fovea_segment_test_data";
+      testing::FreshTestDir("fovea_segment_test_data_");
   std::filesystem::create_directories(dir / "learn");
   const float gaps[3] = {0.0f, 0.0f, 0.05f};
   for (int i = 0; i < 3; ++i) {
@@ -129,7 +130,7 @@ TEST(FoveaEvalTest, DetectPrintsATableAndAJsonLastLine) {
 TEST(FoveaEvalTest, SweepWritesTheGridAsMarkdownAndCsv) {
   const std::filesystem::path dir = SyntheticDataDir();
   const std::filesystem::path out =
-      std::filesystem::path(::testing::TempDir()) / "fovea_eval_sweep";
+      testing::FreshTestDir("fovea_eval_sweep_");
   const ::fovea::testing::CommandRun run =
       RunEval("sweep --data " + dir.string() + " --out " + out.string() +
               " --filter rso/none/-/lin/wta/");
@@ -212,7 +213,7 @@ TEST(FoveaEvalTest, SegmentScoresTheShippedModelsAndPeersSideBySide) {
 TEST(FoveaTrainTest, WritesModelsTheServerLoads) {
   const std::filesystem::path dir = SegmentationDataDir();
   const std::filesystem::path models =
-      std::filesystem::path(::testing::TempDir()) / "fovea_train_models";
+      testing::FreshTestDir("fovea_train_models_");
   std::filesystem::create_directories(models);
   for (const auto& [command, file] :
        {std::pair<std::string, std::string>{"cos", kCosModelFile},
