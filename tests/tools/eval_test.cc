@@ -129,8 +129,7 @@ TEST(FoveaEvalTest, DetectPrintsATableAndAJsonLastLine) {
 
 TEST(FoveaEvalTest, SweepWritesTheGridAsMarkdownAndCsv) {
   const std::filesystem::path dir = SyntheticDataDir();
-  const std::filesystem::path out =
-      testing::FreshTestDir("fovea_eval_sweep_");
+  const std::filesystem::path out = testing::FreshTestDir("fovea_eval_sweep_");
   const ::fovea::testing::CommandRun run =
       RunEval("sweep --data " + dir.string() + " --out " + out.string() +
               " --filter rso/none/-/lin/wta/");
