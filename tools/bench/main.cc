@@ -11,6 +11,9 @@
 //                    (median time to the k-th object of INC and COS)
 //   fovea-bench memory [same flags; default --set room-640x480]
 //                    (each request kind's peak resident memory, MB)
+//   fovea-bench digest [same flags; default --set osd]
+//                    (a digest of each frame's Detect, COS and INC results:
+//                    equal digests, equal results)
 //   fovea-bench load --server 127.0.0.1:PORT --clients C --requests N
 //                    [--seconds S] [--rpc detect|segment|segment-incremental]
 //                    (closed-loop load on a running server, loopback only:
@@ -200,6 +203,9 @@ int main(int argc, char** argv) {
   }
   if (argc > 1 && std::string_view(argv[1]) == "memory") {
     return fovea::bench::RunMemoryCommand(argc, argv);
+  }
+  if (argc > 1 && std::string_view(argv[1]) == "digest") {
+    return fovea::bench::RunDigestCommand(argc, argv);
   }
 #ifdef FOVEA_BENCH_GRPC
   if (argc > 1 && std::string_view(argv[1]) == "load") {

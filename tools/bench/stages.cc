@@ -108,32 +108,6 @@ bool ParseStagesFlags(int argc, char** argv, StagesFlags& flags) {
   return true;
 }
 
-absl::Status LoadSet(const StagesFlags& flags, SceneList& scenes) {
-  const int count = flags.scenes;
-  if (flags.set == "osd") {
-    const char* dir = std::getenv("FOVEA_OSD_DIR");
-    if (dir == nullptr || *dir == '\0') {
-      return absl::FailedPreconditionError(
-          "--set osd needs FOVEA_OSD_DIR (the OSD data folder)");
-    }
-    return AddOsdScenes(dir, count, scenes);
-  }
-  if (flags.set == "pile-15") {
-    AddPileScenes(15, count > 0 ? count : 8, 1, scenes);
-    return absl::OkStatus();
-  }
-  if (flags.set == "room-640x480" || flags.set == "room-1920x1080") {
-    const bool hd = flags.set == "room-1920x1080";
-    std::vector<uint64_t> seeds;
-    for (int s = 1; s <= (count > 0 ? count : 8); ++s) seeds.push_back(s);
-    AddRoomScenes(seeds, synth::RoomSensor::kActiveStereo, hd ? 1920 : 640,
-                  hd ? 1080 : 480, scenes);
-    return absl::OkStatus();
-  }
-  return absl::InvalidArgumentError(
-      absl::StrCat("--set: unknown set ", flags.set));
-}
-
 // A column of the table: a request kind, run once per frame and pass.
 struct Column {
   std::string name;
@@ -209,11 +183,37 @@ std::vector<Column> Columns(const LoadedModels& models) {
 
 }  // namespace
 
+absl::Status LoadSceneSet(const std::string& set, int count,
+                          SceneList& scenes) {
+  if (set == "osd") {
+    const char* dir = std::getenv("FOVEA_OSD_DIR");
+    if (dir == nullptr || *dir == '\0') {
+      return absl::FailedPreconditionError(
+          "--set osd needs FOVEA_OSD_DIR (the OSD data folder)");
+    }
+    return AddOsdScenes(dir, count, scenes);
+  }
+  if (set == "pile-15") {
+    AddPileScenes(15, count > 0 ? count : 8, 1, scenes);
+    return absl::OkStatus();
+  }
+  if (set == "room-640x480" || set == "room-1920x1080") {
+    const bool hd = set == "room-1920x1080";
+    std::vector<uint64_t> seeds;
+    for (int s = 1; s <= (count > 0 ? count : 8); ++s) seeds.push_back(s);
+    AddRoomScenes(seeds, synth::RoomSensor::kActiveStereo, hd ? 1920 : 640,
+                  hd ? 1080 : 480, scenes);
+    return absl::OkStatus();
+  }
+  return absl::InvalidArgumentError(absl::StrCat("--set: unknown set ", set));
+}
+
 int RunStagesCommand(int argc, char** argv) {
   StagesFlags flags;
   if (!ParseStagesFlags(argc, argv, flags)) return Usage(argv[1]);
   SceneList scenes;
-  if (absl::Status status = LoadSet(flags, scenes); !status.ok()) {
+  if (absl::Status status = LoadSceneSet(flags.set, flags.scenes, scenes);
+      !status.ok()) {
     std::fprintf(stderr, "fovea-bench stages: %s\n", status.ToString().c_str());
     return 2;
   }
@@ -292,7 +292,8 @@ int RunAnytimeCommand(int argc, char** argv) {
   flags.set = "pile-15";
   if (!ParseStagesFlags(argc, argv, flags)) return Usage(argv[1]);
   SceneList scenes;
-  if (absl::Status status = LoadSet(flags, scenes); !status.ok()) {
+  if (absl::Status status = LoadSceneSet(flags.set, flags.scenes, scenes);
+      !status.ok()) {
     std::fprintf(stderr, "fovea-bench anytime: %s\n",
                  status.ToString().c_str());
     return 2;
@@ -420,7 +421,8 @@ int RunMemoryCommand(int argc, char** argv) {
   if (!ParseStagesFlags(argc, argv, flags)) return Usage(argv[1]);
   if (flags.scenes == 0) flags.scenes = 3;
   SceneList scenes;
-  if (absl::Status status = LoadSet(flags, scenes); !status.ok()) {
+  if (absl::Status status = LoadSceneSet(flags.set, flags.scenes, scenes);
+      !status.ok()) {
     std::fprintf(stderr, "fovea-bench memory: %s\n", status.ToString().c_str());
     return 2;
   }

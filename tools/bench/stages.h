@@ -1,7 +1,18 @@
 #ifndef FOVEA_TOOLS_BENCH_STAGES_H_
 #define FOVEA_TOOLS_BENCH_STAGES_H_
 
+#include <string>
+
+#include "absl/status/status.h"
+#include "tools/bench/bench_inputs.h"
+
 namespace fovea::bench {
+
+// Appends the frames of a named set to `scenes`: "osd" (FOVEA_OSD_DIR's
+// learn scenes; an error without it), "pile-15" (synthetic 15-object
+// piles, 8 by default), "room-640x480" or "room-1920x1080" (synthetic
+// active-stereo rooms, 8 by default). `count` > 0: that many frames.
+absl::Status LoadSceneSet(const std::string& set, int count, SceneList& scenes);
 
 // fovea-bench stages [--set osd|pile-15|room-640x480|room-1920x1080]
 //                    [--scenes N] [--passes N] [--threads N]
@@ -27,6 +38,14 @@ int RunAnytimeCommand(int argc, char** argv);
 // just before the request; default set room-640x480, 3 frames, after one
 // warm-up pass. `argv[1]` is "memory". Returns the process's exit code.
 int RunMemoryCommand(int argc, char** argv);
+
+// fovea-bench digest [--set ...] [--scenes N] [--threads N]
+// Per frame, a 64-bit digest of what Detect (points, master map, plane),
+// Segment (COS) and SegmentIncremental (INC) return with default options
+// (seeds, masks, scores), and one of the whole set: two builds, or one
+// and two threads, that print the same digests give the same results.
+// `argv[1]` is "digest". Returns the process's exit code.
+int RunDigestCommand(int argc, char** argv);
 
 }  // namespace fovea::bench
 
