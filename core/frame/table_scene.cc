@@ -7,6 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/parallel.h"
+#include "core/frame/hull_lookup.h"
 
 namespace fovea {
 
@@ -165,6 +166,8 @@ TableScene PrepareTableScene(const OrganizedCloud& cloud,
   scene.standing.setTo(cv::Scalar(0));
   const bool have_inliers = plane.inliers.rows == h && plane.inliers.cols == w;
   const Eigen::Vector3f& n = plane.normal;
+  const HullLookup in_hull(plane, 0.0f);
+  const HullLookup in_hull_by_margin(plane, options.hull_margin);
   // Rows in parallel ranges; each range counts its own candidates.
   std::vector<int> candidates(h, 0);
   ParallelForRanges(h, [&](int begin, int end) {
@@ -195,7 +198,7 @@ TableScene PrepareTableScene(const OrganizedCloud& cloud,
         if (hgt > options.max_object_height) continue;
         if (hgt <= min_height && (on_plane || hgt < -min_height)) continue;
         const Eigen::Vector3f q(p[u][0], p[u][1], p[u][2]);
-        if (!plane.ProjectsInsideHull(q)) continue;
+        if (!in_hull.Contains(q)) continue;
         if (!scene.structures.empty() &&
             OnStructure(scene.structures, q, normals[u], options)) {
           continue;
@@ -203,7 +206,7 @@ TableScene PrepareTableScene(const OrganizedCloud& cloud,
         region[u] = 255;
         if (hgt <= min_height) continue;
         standing[u] = 255;
-        if (plane.ProjectsInsideHull(q, options.hull_margin)) {
+        if (in_hull_by_margin.Contains(q)) {
           cand[u] = 255;
           ++candidates[v];
         }
