@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/frame/support_grid.h"
 
@@ -28,39 +29,56 @@ HullLookup::HullLookup(const SupportPlane& plane, float margin)
   y0_ = lo_y - cell_;
   cols_ = static_cast<int>(std::ceil((hi_x - lo_x) / cell_)) + 2;
   rows_ = static_cast<int>(std::ceil((hi_y - lo_y) / cell_)) + 2;
-  cells_.assign(static_cast<size_t>(cols_) * rows_, kInside);
+  cells_.assign(static_cast<size_t>(cols_) * rows_, kStraddles);
   // Each edge's cross product (|edge| times the signed distance from its
-  // line, positive inside) is linear in the point, so over a cell it is
-  // smallest and largest at two of its corners.
-  std::vector<uint8_t> outside(cells_.size(), 0);
+  // line, positive inside) is linear, A x + B y + C, so over a row of cells
+  // (a band of y) each edge bounds the x of the cells wholly inside it by
+  // one half-line, and of those wholly outside it by another: per row, the
+  // cells inside every edge form one interval, and those outside some edge
+  // lie left or right of two bounds.
+  struct Edge {
+    double A, B, C, inside_above, outside_below;
+  };
+  std::vector<Edge> edges;
   for (size_t e = 0; e < hull_.size(); ++e) {
     const Eigen::Vector2d a = hull_[e].cast<double>();
     const Eigen::Vector2d edge =
         hull_[(e + 1) % hull_.size()].cast<double>() - a;
     const double length = edge.norm();
-    // cross(x, y) = ex (y - ay) - ey (x - ax) = A x + B y + C.
-    const double A = -edge.y(), B = edge.x();
-    const double C = edge.y() * a.x() - edge.x() * a.y();
-    const double inside_above = (margin_ + kSlack) * length;
-    const double outside_below = -kSlack * length;
-    for (int j = 0; j < rows_; ++j) {
-      const double y_lo = y0_ + j * cell_, y_hi = y_lo + cell_;
-      const double by_min = std::min(B * y_lo, B * y_hi);
-      const double by_max = std::max(B * y_lo, B * y_hi);
-      for (int i = 0; i < cols_; ++i) {
-        const double x_lo = x0_ + i * cell_, x_hi = x_lo + cell_;
-        const double min = std::min(A * x_lo, A * x_hi) + by_min + C;
-        const double max = std::max(A * x_lo, A * x_hi) + by_max + C;
-        const size_t k = static_cast<size_t>(j) * cols_ + i;
-        if (max < outside_below) outside[k] = 1;
-        if (!(min >= inside_above) && cells_[k] == kInside) {
-          cells_[k] = kStraddles;
-        }
+    // cross(x, y) = ex (y - ay) - ey (x - ax).
+    edges.push_back({-edge.y(), edge.x(), edge.y() * a.x() - edge.x() * a.y(),
+                     (margin_ + kSlack) * length, -kSlack * length});
+  }
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  for (int j = 0; j < rows_; ++j) {
+    const double y_lo = y0_ + j * cell_, y_hi = y_lo + cell_;
+    // Inside: x_lo >= in_lo and x_hi <= in_hi. Outside: x_hi < out_left,
+    // or x_lo > out_right, or the whole row.
+    double in_lo = -kInf, in_hi = kInf, out_left = -kInf, out_right = kInf;
+    bool row_can_be_inside = true, row_outside = false;
+    for (const Edge& e : edges) {
+      const double by_min = std::min(e.B * y_lo, e.B * y_hi) + e.C;
+      const double by_max = std::max(e.B * y_lo, e.B * y_hi) + e.C;
+      if (e.A > 0.0) {
+        in_lo = std::max(in_lo, (e.inside_above - by_min) / e.A);
+        out_left = std::max(out_left, (e.outside_below - by_max) / e.A);
+      } else if (e.A < 0.0) {
+        in_hi = std::min(in_hi, (e.inside_above - by_min) / e.A);
+        out_right = std::min(out_right, (e.outside_below - by_max) / e.A);
+      } else {
+        row_can_be_inside = row_can_be_inside && by_min >= e.inside_above;
+        row_outside = row_outside || by_max < e.outside_below;
       }
     }
-  }
-  for (size_t k = 0; k < cells_.size(); ++k) {
-    if (outside[k]) cells_[k] = kOutside;
+    for (int i = 0; i < cols_; ++i) {
+      const double x_lo = x0_ + i * cell_, x_hi = x_lo + cell_;
+      Cell& cell = cells_[static_cast<size_t>(j) * cols_ + i];
+      if (row_outside || x_hi < out_left || x_lo > out_right) {
+        cell = kOutside;
+      } else if (row_can_be_inside && x_lo >= in_lo && x_hi <= in_hi) {
+        cell = kInside;
+      }
+    }
   }
 }
 

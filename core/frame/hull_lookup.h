@@ -20,7 +20,7 @@ namespace fovea {
 class HullLookup {
  public:
   // Cells along the longer side of the hull's bounding box.
-  static constexpr int kCells = 48;
+  static constexpr int kCells = 64;
   // Metres a whole cell must clear an edge by to skip the per-point test.
   static constexpr double kSlack = 1e-4;
 
