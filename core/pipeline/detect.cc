@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/guarded.h"
+#include "core/base/parallel.h"
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/pipeline/channels.h"
@@ -235,12 +236,24 @@ absl::StatusOr<PreparedScene> PrepareSceneUnguarded(
   clock.Lap("normals");
   FOVEA_RETURN_IF_ERROR(Check(interrupt));
 
+  // The support and the surface edges both need only the cloud: with two
+  // threads, at once.
   SupportPlaneOptions support_options = options.support_plane;
   AdaptToSensor(scene.sensor, support_options);
-  FOVEA_ASSIGN_OR_RETURN(
-      SupportPlane plane,
-      FindSupportPlane(scene.cloud, support_options, options.scene.support));
-  scene.plane = std::move(plane);
+  absl::StatusOr<SupportPlane> plane;
+  const auto find_support = [&] {
+    plane =
+        FindSupportPlane(scene.cloud, support_options, options.scene.support);
+  };
+  const auto find_edges = [&] {
+    if (options.split_at_surface_edges) {
+      scene.surface_edges =
+          FindSurfaceEdges(scene.cloud, options.surface_edges);
+    }
+  };
+  ParallelInvoke(find_support, find_edges);
+  FOVEA_RETURN_IF_ERROR(plane.status());
+  scene.plane = *std::move(plane);
   TableSceneOptions table_options = options.table_scene;
   AdaptToSensor(scene.sensor, table_options);
   scene.table = PrepareTableScene(scene.cloud, scene.plane, table_options);
@@ -280,7 +293,10 @@ absl::StatusOr<DetectResult> DetectOnSceneUnguarded(
                                                       : ChannelFusion::kSum));
   result.master = std::move(master);
   if (options.split_at_surface_edges) {
-    result.master.setTo(0.0f, FindSurfaceEdges(cloud, options.surface_edges));
+    result.master.setTo(0.0f,
+                        scene.surface_edges.empty()
+                            ? FindSurfaceEdges(cloud, options.surface_edges)
+                            : scene.surface_edges);
   }
   NormalizeLinear(result.master);
   clock.Lap("fusion");

@@ -238,6 +238,10 @@ struct PreparedScene {
   OrganizedCloud cloud;
   SupportPlane plane;
   TableScene table;
+  // CV_8UC1, 255 on surface edges (FindSurfaceEdges with
+  // options.surface_edges), when options.split_at_surface_edges; else
+  // empty. Built beside the support plane when the scope has two threads.
+  cv::Mat surface_edges;
   FrameScale scale;
   SensorModel sensor;  // the scene's, for the frame's intrinsics
   std::vector<StageTiming> timings;

@@ -417,7 +417,10 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
   if (options.cover_scene.value_or(options.seeds.empty())) {
     // Standing pixels off surface edges; each cover seed's piece is tried
     // once, so this ends after at most one seed per piece.
-    cv::Mat tried = FindSurfaceEdges(scene.cloud, options.detect.surface_edges);
+    cv::Mat tried =
+        scene.surface_edges.empty()
+            ? FindSurfaceEdges(scene.cloud, options.detect.surface_edges)
+            : scene.surface_edges.clone();
     tried.setTo(255, scene.table.standing == 0);
     int cover_seeds = 0;
     while (!full() && cover_seeds < kMaxAttentionPoints) {
