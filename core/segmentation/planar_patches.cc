@@ -36,12 +36,33 @@ bool FitPlane(const Eigen::Vector3d& sum, const Eigen::Matrix3d& sum_outer,
   return true;
 }
 
-// The 4-neighbours of pixel index i of a w x h image; -1 outside it.
-std::array<int, 4> Neighbours4(int i, int w, int h) {
-  const int u = i % w, v = i / w;
+// sum_outer += p p^T: the six distinct products once each (a product is
+// the same either way round, so the sum is what the full product gives).
+void AddOuterProduct(const Eigen::Vector3d& p, Eigen::Matrix3d& sum_outer) {
+  const double xy = p.x() * p.y(), xz = p.x() * p.z(), yz = p.y() * p.z();
+  sum_outer(0, 0) += p.x() * p.x();
+  sum_outer(1, 0) += xy;
+  sum_outer(2, 0) += xz;
+  sum_outer(0, 1) += xy;
+  sum_outer(1, 1) += p.y() * p.y();
+  sum_outer(2, 1) += yz;
+  sum_outer(0, 2) += xz;
+  sum_outer(1, 2) += yz;
+  sum_outer(2, 2) += p.z() * p.z();
+}
+
+// The 4-neighbours of pixel index i = v * w + u of a w x h image; -1
+// outside it.
+std::array<int, 4> Neighbours4(int i, int u, int v, int w, int h) {
   return {u > 0 ? i - 1 : -1, u + 1 < w ? i + 1 : -1, v > 0 ? i - w : -1,
           v + 1 < h ? i + w : -1};
 }
+
+// A pixel in a breadth-first queue, with its coordinates (no division to
+// find them again).
+struct Pixel {
+  int i, u, v;
+};
 
 // Point q continues the surface of its neighbour i (no depth step) and
 // lies on the plane n . p + d = 0 within the depth-dependent tolerance.
@@ -156,7 +177,7 @@ absl::StatusOr<PlanarPatches> FindPlanarPatches(
   }
 
   const float min_cos = std::cos(options.max_normal_angle_deg * kDegToRad);
-  std::vector<int> members;
+  std::vector<Pixel> members;
   members.reserve(n);
   for (const int seed : order) {
     if (label[seed] != kUnvisited) continue;
@@ -168,29 +189,35 @@ absl::StatusOr<PlanarPatches> FindPlanarPatches(
     Eigen::Matrix3d sum_outer = Eigen::Matrix3d::Zero();
     int next_fit = 3;
     members.clear();
-    members.push_back(seed);
+    members.push_back({seed, seed % w, seed / w});
     label[seed] = id;
     for (size_t head = 0; head < members.size(); ++head) {
-      const int i = members[head];
+      const Pixel m = members[head];
+      const int i = m.i;
       const Eigen::Vector3d p(xyz[i][0], xyz[i][1], xyz[i][2]);
       sum += p;
-      sum_outer += p * p.transpose();
+      AddOuterProduct(p, sum_outer);
       const int size = static_cast<int>(head) + 1;
       if (options.refit_growth > 0.0f && size >= next_fit) {
         FitPlane(sum, sum_outer, size, normal, d);
         next_fit = static_cast<int>(std::ceil(size * options.refit_growth));
       }
-      for (const int q : Neighbours4(i, w, h)) {
-        if (q < 0 || label[q] != kUnvisited) continue;
-        if (!ContinuesOntoPlane(xyz[q], xyz[i], normal, d, options)) continue;
-        const Eigen::Vector3f nq(nrm[q][0], nrm[q][1], nrm[q][2]);
+      const std::array<int, 4> next = Neighbours4(i, m.u, m.v, w, h);
+      const Pixel at[4] = {{next[0], m.u - 1, m.v},
+                           {next[1], m.u + 1, m.v},
+                           {next[2], m.u, m.v - 1},
+                           {next[3], m.u, m.v + 1}};
+      for (const Pixel& q : at) {
+        if (q.i < 0 || label[q.i] != kUnvisited) continue;
+        if (!ContinuesOntoPlane(xyz[q.i], xyz[i], normal, d, options)) continue;
+        const Eigen::Vector3f nq(nrm[q.i][0], nrm[q.i][1], nrm[q.i][2]);
         if (normal.dot(nq) < min_cos) continue;
-        label[q] = id;
+        label[q.i] = id;
         members.push_back(q);
       }
     }
     if (static_cast<int>(members.size()) < options.min_points) {
-      for (int i : members) label[i] = kNoise;
+      for (const Pixel& m : members) label[m.i] = kNoise;
       continue;
     }
     PlanarPatch patch;
@@ -203,19 +230,30 @@ absl::StatusOr<PlanarPatches> FindPlanarPatches(
   // Points near a fold have normals smoothed across it, which no patch
   // accepts; they join a neighbouring patch whose plane they lie on
   // (distance test only), growing out from the patches breadth first.
-  std::vector<int> frontier;
-  for (int i = 0; i < n; ++i) {
-    if (label[i] >= 0) frontier.push_back(i);
+  std::vector<Pixel> frontier;
+  for (int v = 0, i = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u, ++i) {
+      if (label[i] >= 0) frontier.push_back({i, u, v});
+    }
   }
   for (size_t head = 0; head < frontier.size(); ++head) {
-    const int i = frontier[head];
+    const Pixel m = frontier[head];
+    const int i = m.i;
     const PlanarPatch& patch = result.patches[label[i]];
-    for (const int q : Neighbours4(i, w, h)) {
-      if (q < 0 || (label[q] != kNoise && label[q] != kUnvisited)) continue;
-      if (!ContinuesOntoPlane(xyz[q], xyz[i], patch.normal, patch.d, options)) {
+    const std::array<int, 4> next = Neighbours4(i, m.u, m.v, w, h);
+    const Pixel at[4] = {{next[0], m.u - 1, m.v},
+                         {next[1], m.u + 1, m.v},
+                         {next[2], m.u, m.v - 1},
+                         {next[3], m.u, m.v + 1}};
+    for (const Pixel& q : at) {
+      if (q.i < 0 || (label[q.i] != kNoise && label[q.i] != kUnvisited)) {
         continue;
       }
-      label[q] = label[i];
+      if (!ContinuesOntoPlane(xyz[q.i], xyz[i], patch.normal, patch.d,
+                              options)) {
+        continue;
+      }
+      label[q.i] = label[i];
       frontier.push_back(q);
     }
   }
@@ -228,14 +266,16 @@ absl::StatusOr<PlanarPatches> FindPlanarPatches(
     patch.box = cv::Rect();
   }
   std::vector<cv::Vec4i> extent(result.patches.size(), cv::Vec4i(w, h, -1, -1));
-  for (int i = 0; i < n; ++i) {
-    if (label[i] < 0) continue;
-    ++result.patches[label[i]].points;
-    cv::Vec4i& e = extent[label[i]];
-    e[0] = std::min(e[0], i % w);
-    e[1] = std::min(e[1], i / w);
-    e[2] = std::max(e[2], i % w);
-    e[3] = std::max(e[3], i / w);
+  for (int v = 0, i = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u, ++i) {
+      if (label[i] < 0) continue;
+      ++result.patches[label[i]].points;
+      cv::Vec4i& e = extent[label[i]];
+      e[0] = std::min(e[0], u);
+      e[1] = std::min(e[1], v);
+      e[2] = std::max(e[2], u);
+      e[3] = std::max(e[3], v);
+    }
   }
   for (size_t k = 0; k < extent.size(); ++k) {
     const cv::Vec4i& e = extent[k];
