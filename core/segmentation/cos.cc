@@ -208,8 +208,13 @@ absl::StatusOr<CosScene> BuildCosScene(const OrganizedCloud& cloud,
   FOVEA_RETURN_IF_ERROR(Validate(options));
   CosScene scene;
   StageClock clock(scene.timings);
-  FOVEA_ASSIGN_OR_RETURN(PlanarPatches patches,
-                         FindPlanarPatches(cloud, region, options.patches));
+  const bool have_inliers = plane.inliers.size() == cloud.xyz.size();
+  FOVEA_ASSIGN_OR_RETURN(
+      PlanarPatches patches,
+      FindPlanarPatches(cloud, region, options.patches,
+                        options.support_from_inliers && have_inliers
+                            ? plane.inliers
+                            : cv::Mat()));
   scene.patches = std::move(patches);
   clock.Lap("patches");
   const int n = static_cast<int>(scene.patches.patches.size());
@@ -240,7 +245,6 @@ absl::StatusOr<CosScene> BuildCosScene(const OrganizedCloud& cloud,
   }
   std::vector<int> on_plane(n, 0);
   std::vector<int> size(n, 0);
-  const bool have_inliers = plane.inliers.size() == scene.patches.labels.size();
   for (int v = 0; v < scene.patches.labels.rows; ++v) {
     const int* label = scene.patches.labels.ptr<int>(v);
     for (int u = 0; u < scene.patches.labels.cols; ++u) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <opencv2/imgproc.hpp>
 
 #include "absl/strings/str_cat.h"
 #include "core/base/status_macros.h"
@@ -16,7 +17,8 @@ constexpr float kDegToRad = static_cast<float>(M_PI / 180.0);
 constexpr int kCurvatureBuckets = 1024;
 // Label states while growing.
 constexpr int kUnvisited = -2;
-constexpr int kUnused = -3;  // no normal, or outside the mask
+constexpr int kUnused = -3;   // no normal, or outside the mask
+constexpr int kSupport = -4;  // on the support, labelled by its parts
 constexpr int kNoise = -1;
 
 // Least-squares plane of the points summed in `sum` and `sum_outer`,
@@ -78,6 +80,43 @@ bool ContinuesOntoPlane(const cv::Vec3f& q, const cv::Vec3f& i,
   return std::abs(n.x() * q[0] + n.y() * q[1] + n.z() * q[2] + d) <= tolerance;
 }
 
+// Each 4-connected part of the kSupport pixels becomes one patch (noise
+// below options.min_points), its plane fitted to all its points.
+void AddSupportParts(const cv::Vec3f* xyz, int w, int h,
+                     const PlanarPatchOptions& options, int* label,
+                     PlanarPatches& result) {
+  cv::Mat on_support(h, w, CV_8UC1);
+  const int n = w * h;
+  for (int i = 0; i < n; ++i) on_support.data[i] = label[i] == kSupport;
+  cv::Mat parts;
+  const int count = cv::connectedComponents(on_support, parts, 4, CV_32S);
+  std::vector<Eigen::Vector3d> sum(count, Eigen::Vector3d::Zero());
+  std::vector<Eigen::Matrix3d> sum_outer(count, Eigen::Matrix3d::Zero());
+  std::vector<int> size(count, 0);
+  const int* part = parts.ptr<int>();
+  for (int i = 0; i < n; ++i) {
+    if (part[i] == 0) continue;
+    const Eigen::Vector3d p(xyz[i][0], xyz[i][1], xyz[i][2]);
+    sum[part[i]] += p;
+    AddOuterProduct(p, sum_outer[part[i]]);
+    ++size[part[i]];
+  }
+  std::vector<int> id(count, kNoise);
+  for (int k = 1; k < count; ++k) {
+    PlanarPatch patch;
+    if (size[k] < options.min_points ||
+        !FitPlane(sum[k], sum_outer[k], size[k], patch.normal, patch.d)) {
+      continue;
+    }
+    patch.centroid = (sum[k] / static_cast<double>(size[k])).cast<float>();
+    id[k] = static_cast<int>(result.patches.size());
+    result.patches.push_back(patch);
+  }
+  for (int i = 0; i < n; ++i) {
+    if (part[i] != 0) label[i] = id[part[i]];
+  }
+}
+
 }  // namespace
 
 absl::Status Validate(const PlanarPatchOptions& options) {
@@ -117,13 +156,19 @@ absl::Status Validate(const PlanarPatchOptions& options) {
 
 absl::StatusOr<PlanarPatches> FindPlanarPatches(
     const OrganizedCloud& cloud, const cv::Mat& mask,
-    const PlanarPatchOptions& options) {
+    const PlanarPatchOptions& options, const cv::Mat& support) {
   FOVEA_RETURN_IF_ERROR(Validate(options));
   const int w = cloud.width(), h = cloud.height();
   if (!mask.empty() &&
       (mask.type() != CV_8UC1 || mask.rows != h || mask.cols != w)) {
     return absl::InvalidArgumentError(
         "planar_patches: mask must be CV_8UC1 of the cloud's size");
+  }
+  if (!support.empty() && (support.type() != CV_8UC1 || support.rows != h ||
+                           support.cols != w || !support.isContinuous())) {
+    return absl::InvalidArgumentError(
+        "planar_patches: support must be a continuous CV_8UC1 of the cloud's "
+        "size");
   }
   if (!cloud.xyz.isContinuous() || !cloud.normals.isContinuous() ||
       (!mask.empty() && !mask.isContinuous())) {
@@ -139,7 +184,9 @@ absl::StatusOr<PlanarPatches> FindPlanarPatches(
   for (int i = 0; i < n; ++i) {
     const bool use = !std::isnan(nrm[i][2]) && !std::isnan(xyz[i][2]) &&
                      (mask.empty() || mask.data[i] != 0);
-    label[i] = use ? kUnvisited : kUnused;
+    label[i] = !use                                       ? kUnused
+               : !support.empty() && support.data[i] != 0 ? kSupport
+                                                          : kUnvisited;
   }
 
   // Curvature, counting-sorted into seed order.
@@ -148,7 +195,7 @@ absl::StatusOr<PlanarPatches> FindPlanarPatches(
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
       const int i = v * w + u;
-      if (label[i] == kUnused) continue;
+      if (label[i] != kUnvisited) continue;
       cv::Vec3f m(0, 0, 0);
       for (int dv = -1; dv <= 1; ++dv) {
         const int y = v + dv;
@@ -173,7 +220,7 @@ absl::StatusOr<PlanarPatches> FindPlanarPatches(
   for (int b = 0; b < kCurvatureBuckets; ++b) count[b + 1] += count[b];
   std::vector<int> order(count[kCurvatureBuckets]);
   for (int i = 0; i < n; ++i) {
-    if (label[i] != kUnused) order[count[bucket[i]]++] = i;
+    if (label[i] == kUnvisited) order[count[bucket[i]]++] = i;
   }
 
   const float min_cos = std::cos(options.max_normal_angle_deg * kDegToRad);
@@ -227,6 +274,7 @@ absl::StatusOr<PlanarPatches> FindPlanarPatches(
     patch.centroid = (sum / static_cast<double>(members.size())).cast<float>();
     result.patches.push_back(patch);
   }
+  if (!support.empty()) AddSupportParts(xyz, w, h, options, label, result);
   // Points near a fold have normals smoothed across it, which no patch
   // accepts; they join a neighbouring patch whose plane they lie on
   // (distance test only), growing out from the patches breadth first.

@@ -60,10 +60,19 @@ struct PlanarPatches {
 // plane they lie on, breadth first from the patches. Curvature is 1 - |n . m|,
 // m the mean normal of the 3 x 3 neighbourhood. `mask` (CV_8UC1, non-zero =
 // use; empty = all points with a normal) limits the points. Work is linear in
-// the pixels. Errors: invalid options, a mask of another size or type.
+// the pixels.
+//
+// `support` (CV_8UC1, non-zero on the support plane's inliers; empty =
+// none): its points are not grown but taken as they are, each 4-connected
+// part of them one patch (its plane fitted to its points), before the
+// leftovers join. On a table scene that is most of the points (85 % of the
+// labelled ones in the OSD scenes), the support's patches being what the
+// growth would make of them anyway, up to their rims.
+//
+// Errors: invalid options, a mask or support of another size or type.
 absl::StatusOr<PlanarPatches> FindPlanarPatches(
     const OrganizedCloud& cloud, const cv::Mat& mask,
-    const PlanarPatchOptions& options);
+    const PlanarPatchOptions& options, const cv::Mat& support = cv::Mat());
 
 }  // namespace fovea
 
