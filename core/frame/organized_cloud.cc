@@ -20,37 +20,54 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 // The cloud box-smoothed over valid points only: the mean of the valid
 // points in the (2 * half + 1)^2 window around each pixel, NaN where the
-// window holds none. Two separable box filters (sum of points, count of
-// valid points), so the cost does not depend on the window.
+// window holds none. Separable sums in double (as OpenCV's box filter of a
+// float image sums), rows in parallel ranges: each range sums the rows it
+// needs along u, then those down v.
 cv::Mat SmoothValidPoints(const cv::Mat& xyz, int half) {
   const int h = xyz.rows, w = xyz.cols;
-  cv::Mat points(h, w, CV_32FC3), valid(h, w, CV_32FC1);
-  for (int v = 0; v < h; ++v) {
-    const cv::Vec3f* in = xyz.ptr<cv::Vec3f>(v);
-    cv::Vec3f* p = points.ptr<cv::Vec3f>(v);
-    float* c = valid.ptr<float>(v);
-    for (int u = 0; u < w; ++u) {
-      const bool ok = !std::isnan(in[u][2]);
-      p[u] = ok ? in[u] : cv::Vec3f(0.0f, 0.0f, 0.0f);
-      c[u] = ok ? 1.0f : 0.0f;
-    }
-  }
-  const cv::Size window(2 * half + 1, 2 * half + 1);
-  cv::boxFilter(points, points, -1, window, cv::Point(-1, -1), false,
-                cv::BORDER_CONSTANT);
-  cv::boxFilter(valid, valid, -1, window, cv::Point(-1, -1), false,
-                cv::BORDER_CONSTANT);
-  for (int v = 0; v < h; ++v) {
-    cv::Vec3f* p = points.ptr<cv::Vec3f>(v);
-    const float* c = valid.ptr<float>(v);
-    for (int u = 0; u < w; ++u) {
-      if (c[u] > 0.5f) {
-        p[u] *= 1.0f / c[u];
-      } else {
-        p[u] = {kNaN, kNaN, kNaN};
+  cv::Mat points(h, w, CV_32FC3);
+  ParallelForRanges(h, [&](int begin, int end) {
+    const int top = std::max(0, begin - half);
+    const int bottom = std::min(h, end + half);
+    // (x, y, z, count) summed along each row of [top, bottom).
+    std::vector<cv::Vec4d> along(static_cast<size_t>(bottom - top) * w);
+    std::vector<cv::Vec4d> valid(w);
+    for (int y = top; y < bottom; ++y) {
+      const cv::Vec3f* in = xyz.ptr<cv::Vec3f>(y);
+      for (int u = 0; u < w; ++u) {
+        valid[u] = std::isnan(in[u][2])
+                       ? cv::Vec4d(0.0, 0.0, 0.0, 0.0)
+                       : cv::Vec4d(in[u][0], in[u][1], in[u][2], 1.0);
+      }
+      cv::Vec4d* out = &along[static_cast<size_t>(y - top) * w];
+      for (int u = 0; u < w; ++u) {
+        cv::Vec4d sum(0.0, 0.0, 0.0, 0.0);
+        const int last = std::min(w - 1, u + half);
+        for (int k = std::max(0, u - half); k <= last; ++k) sum += valid[k];
+        out[u] = sum;
       }
     }
-  }
+    for (int v = begin; v < end; ++v) {
+      cv::Vec3f* out = points.ptr<cv::Vec3f>(v);
+      const int first = std::max(0, v - half) - top;
+      const int last = std::min(h - 1, v + half) - top;
+      for (int u = 0; u < w; ++u) {
+        cv::Vec4d sum(0.0, 0.0, 0.0, 0.0);
+        for (int y = first; y <= last; ++y) {
+          sum += along[static_cast<size_t>(y) * w + u];
+        }
+        const float count = static_cast<float>(sum[3]);
+        if (count > 0.5f) {
+          const float inverse = 1.0f / count;
+          out[u] = {static_cast<float>(sum[0]) * inverse,
+                    static_cast<float>(sum[1]) * inverse,
+                    static_cast<float>(sum[2]) * inverse};
+        } else {
+          out[u] = {kNaN, kNaN, kNaN};
+        }
+      }
+    }
+  });
   return points;
 }
 
