@@ -163,11 +163,12 @@ void RegisterSaliencyCases(const SceneList* scenes, const std::string& set,
              return map.status();
            });
   // Planar patches (thesis section 3.2.2), the first step of every
-  // segmentation, on the whole cloud.
+  // segmentation, as COS and INC call it: on the table scene's region, the
+  // support's inliers taken as they are.
   Register("BM_PlanarPatches" + suffix, scenes, set, sweep, kPlanarPatchesMs,
            [](const BenchScene& scene) {
-             absl::StatusOr<PlanarPatches> patches =
-                 FindPlanarPatches(scene.cloud, {}, {});
+             absl::StatusOr<PlanarPatches> patches = FindPlanarPatches(
+                 scene.cloud, scene.table.region, {}, scene.plane.inliers);
              benchmark::DoNotOptimize(patches);
              return patches.status();
            });
