@@ -20,9 +20,9 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 // The cloud box-smoothed over valid points only: the mean of the valid
 // points in the (2 * half + 1)^2 window around each pixel, NaN where the
-// window holds none. Separable sums in double (as OpenCV's box filter of a
-// float image sums), rows in parallel ranges: each range sums the rows it
-// needs along u, then those down v.
+// window holds none. Separable running sums in double (as OpenCV's box
+// filter of a float image sums), rows in parallel ranges: each range sums
+// the rows it needs along u, then those down v.
 cv::Mat SmoothValidPoints(const cv::Mat& xyz, int half) {
   const int h = xyz.rows, w = xyz.cols;
   cv::Mat points(h, w, CV_32FC3);
@@ -39,23 +39,37 @@ cv::Mat SmoothValidPoints(const cv::Mat& xyz, int half) {
                        ? cv::Vec4d(0.0, 0.0, 0.0, 0.0)
                        : cv::Vec4d(in[u][0], in[u][1], in[u][2], 1.0);
       }
+      // Running sums along the row: add the pixel entering the window,
+      // take away the one leaving it.
       cv::Vec4d* out = &along[static_cast<size_t>(y - top) * w];
+      cv::Vec4d sum(0.0, 0.0, 0.0, 0.0);
+      for (int k = 0; k < std::min(w, half); ++k) sum += valid[k];
       for (int u = 0; u < w; ++u) {
-        cv::Vec4d sum(0.0, 0.0, 0.0, 0.0);
-        const int last = std::min(w - 1, u + half);
-        for (int k = std::max(0, u - half); k <= last; ++k) sum += valid[k];
+        if (u + half < w) sum += valid[u + half];
+        if (u - half - 1 >= 0) sum -= valid[u - half - 1];
         out[u] = sum;
       }
     }
+    // The same down the columns.
+    std::vector<cv::Vec4d> column(w, cv::Vec4d(0.0, 0.0, 0.0, 0.0));
+    for (int y = std::max(0, begin - half); y < std::min(h, begin + half);
+         ++y) {
+      const cv::Vec4d* row = &along[static_cast<size_t>(y - top) * w];
+      for (int u = 0; u < w; ++u) column[u] += row[u];
+    }
     for (int v = begin; v < end; ++v) {
+      const cv::Vec4d* enter =
+          v + half < h ? &along[static_cast<size_t>(v + half - top) * w]
+                       : nullptr;
+      const cv::Vec4d* leave =
+          v - half - 1 >= top
+              ? &along[static_cast<size_t>(v - half - 1 - top) * w]
+              : nullptr;
       cv::Vec3f* out = points.ptr<cv::Vec3f>(v);
-      const int first = std::max(0, v - half) - top;
-      const int last = std::min(h - 1, v + half) - top;
       for (int u = 0; u < w; ++u) {
-        cv::Vec4d sum(0.0, 0.0, 0.0, 0.0);
-        for (int y = first; y <= last; ++y) {
-          sum += along[static_cast<size_t>(y) * w + u];
-        }
+        if (enter != nullptr) column[u] += enter[u];
+        if (leave != nullptr) column[u] -= leave[u];
+        const cv::Vec4d& sum = column[u];
         const float count = static_cast<float>(sum[3]);
         if (count > 0.5f) {
           const float inverse = 1.0f / count;

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/check.h"
 #include "core/base/status_macros.h"
 #include "core/frame/osd_pcd.h"
 
@@ -77,32 +79,58 @@ std::vector<int> Frontier(const CosScene& scene, const std::vector<int>& object,
 // times; the ground truth counts those pixels as the object's.
 void ExtendIntoUnlabelled(const OrganizedCloud& cloud, int passes,
                           float max_depth_step_fraction, cv::Mat& labels) {
-  for (int pass = 0; pass < passes; ++pass) {
-    cv::Mat next = labels.clone();
-    int changed = 0;
-    for (int v = 0; v < labels.rows; ++v) {
-      for (int u = 0; u < labels.cols; ++u) {
-        if (labels.at<int>(v, u) >= 0) continue;
-        const float z = cloud.xyz.at<cv::Vec3f>(v, u)[2];
-        if (std::isnan(z)) continue;
-        constexpr int kDu[4] = {1, -1, 0, 0};
-        constexpr int kDv[4] = {0, 0, 1, -1};
-        for (int k = 0; k < 4; ++k) {
-          const int x = u + kDu[k];
-          const int y = v + kDv[k];
-          if (x < 0 || y < 0 || x >= labels.cols || y >= labels.rows) continue;
-          const int l = labels.at<int>(y, x);
-          const float zn = cloud.xyz.at<cv::Vec3f>(y, x)[2];
-          if (l >= 0 && std::abs(zn - z) <= max_depth_step_fraction * z) {
-            next.at<int>(v, u) = l;
-            ++changed;
-            break;
-          }
-        }
+  const int w = labels.cols, h = labels.rows;
+  FOVEA_CHECK(labels.isContinuous() && labels.type() == CV_32SC1);
+  int* label = labels.ptr<int>();
+  // The pixel's new label from the labels as they were before this pass
+  // (the first 4-neighbour, right, left, down, up, with a patch and nearly
+  // the same depth), or -1.
+  const auto joins = [&](int u, int v) {
+    const float z = cloud.xyz.ptr<cv::Vec3f>(v)[u][2];
+    if (std::isnan(z)) return -1;
+    constexpr int kDu[4] = {1, -1, 0, 0};
+    constexpr int kDv[4] = {0, 0, 1, -1};
+    for (int k = 0; k < 4; ++k) {
+      const int x = u + kDu[k];
+      const int y = v + kDv[k];
+      if (x < 0 || y < 0 || x >= w || y >= h) continue;
+      const int l = label[y * w + x];
+      const float zn = cloud.xyz.ptr<cv::Vec3f>(y)[x][2];
+      if (l >= 0 && std::abs(zn - z) <= max_depth_step_fraction * z) return l;
+    }
+    return -1;
+  };
+  // A pixel can join in a pass only if a neighbour joined in the one
+  // before (else its neighbours are as they were when it did not): after
+  // the first pass, which looks at every pixel, only the neighbours of
+  // the pixels that joined are looked at.
+  std::vector<std::pair<int, int>> joined;  // (pixel, its new label)
+  std::vector<int> candidates;
+  for (int i = 0; i < w * h; ++i) {
+    if (label[i] < 0) candidates.push_back(i);
+  }
+  std::vector<int> seen_in_pass(static_cast<size_t>(w) * h, -1);
+  for (int pass = 0; pass < passes && !candidates.empty(); ++pass) {
+    joined.clear();
+    for (const int i : candidates) {
+      const int l = joins(i % w, i / w);
+      if (l >= 0) joined.emplace_back(i, l);
+    }
+    if (joined.empty()) break;
+    for (const auto& [i, l] : joined) label[i] = l;
+    candidates.clear();
+    for (const auto& [i, l] : joined) {
+      const int u = i % w, v = i / w;
+      for (const int q : {u + 1 < w ? i + 1 : -1, u > 0 ? i - 1 : -1,
+                          v + 1 < h ? i + w : -1, v > 0 ? i - w : -1}) {
+        if (q < 0 || label[q] >= 0 || seen_in_pass[q] == pass) continue;
+        seen_in_pass[q] = pass;
+        candidates.push_back(q);
       }
     }
-    labels = next;
-    if (changed == 0) break;
+    // Candidates in raster order (the order does not change the labels,
+    // only how the pass walks memory).
+    std::sort(candidates.begin(), candidates.end());
   }
 }
 
@@ -218,23 +246,11 @@ absl::StatusOr<CosScene> BuildCosScene(const OrganizedCloud& cloud,
   scene.patches = std::move(patches);
   clock.Lap("patches");
   const int n = static_cast<int>(scene.patches.patches.size());
-  scene.histograms =
-      LabelColorHistograms(cloud.color, scene.patches.labels, n, options.color);
-  scene.samples = SampleLabelPoints(cloud, scene.patches.labels, n,
-                                    options.hull_points_per_patch);
-  // After the features: the extended pixels have no trustworthy normal.
+  // The patches as grown, before the rims join them, for the features.
+  const cv::Mat grown = scene.patches.labels.clone();
   ExtendIntoUnlabelled(cloud, options.rim_passes,
                        options.patches.max_depth_step_fraction,
                        scene.patches.labels);
-  // Each sample onto its patch's plane: the sensor's noise (1-2 mm at a
-  // metre) would otherwise push the hull's faces out by its peaks, as far
-  // as the concavities compactness is to measure.
-  for (int p = 0; p < n; ++p) {
-    const PlanarPatch& patch = scene.patches.patches[p];
-    for (Eigen::Vector3f& q : scene.samples[p]) {
-      q -= (patch.normal.dot(q) + patch.d) * patch.normal;
-    }
-  }
   scene.neighbours.assign(n, {});
   for (const auto& [a, b] : scene.patches.adjacency) {
     scene.neighbours[a].push_back(b);
@@ -247,12 +263,12 @@ absl::StatusOr<CosScene> BuildCosScene(const OrganizedCloud& cloud,
   std::vector<int> size(n, 0);
   for (int v = 0; v < scene.patches.labels.rows; ++v) {
     const int* label = scene.patches.labels.ptr<int>(v);
+    const uint8_t* inlier =
+        have_inliers ? plane.inliers.ptr<uint8_t>(v) : nullptr;
     for (int u = 0; u < scene.patches.labels.cols; ++u) {
       if (label[u] < 0) continue;
       ++size[label[u]];
-      if (have_inliers && plane.inliers.at<unsigned char>(v, u) != 0) {
-        ++on_plane[label[u]];
-      }
+      if (inlier != nullptr && inlier[u] != 0) ++on_plane[label[u]];
     }
   }
   scene.support.assign(n, false);
@@ -261,6 +277,42 @@ absl::StatusOr<CosScene> BuildCosScene(const OrganizedCloud& cloud,
     scene.support[p] =
         size[p] > 0 && (on_plane[p] > options.max_support_fraction * size[p] ||
                         (have_inliers && height < options.min_patch_height));
+  }
+  // Colour histograms and hull samples of the patches that can be part of
+  // an object (the support's are never read), on their bounding box.
+  cv::Rect box;
+  for (int p = 0; p < n; ++p) {
+    if (!scene.support[p]) box |= scene.patches.patches[p].box;
+  }
+  cv::Mat feature_labels(box.size(), CV_32SC1);
+  for (int v = 0; v < box.height; ++v) {
+    const int* from = grown.ptr<int>(box.y + v) + box.x;
+    int* to = feature_labels.ptr<int>(v);
+    for (int u = 0; u < box.width; ++u) {
+      to[u] = from[u] >= 0 && !scene.support[from[u]] ? from[u] : -1;
+    }
+  }
+  OrganizedCloud box_cloud;
+  box_cloud.intrinsics = cloud.intrinsics;
+  box_cloud.xyz = box.empty() ? cv::Mat() : cloud.xyz(box);
+  scene.histograms =
+      box.empty()
+          ? std::vector<std::vector<float>>(
+                n, std::vector<float>(HistogramBins(options.color), 0.0f))
+          : LabelColorHistograms(cloud.color(box), feature_labels, n,
+                                 options.color);
+  scene.samples = box.empty()
+                      ? std::vector<std::vector<Eigen::Vector3f>>(n)
+                      : SampleLabelPoints(box_cloud, feature_labels, n,
+                                          options.hull_points_per_patch);
+  // Each sample onto its patch's plane: the sensor's noise (1-2 mm at a
+  // metre) would otherwise push the hull's faces out by its peaks, as far
+  // as the concavities compactness is to measure.
+  for (int p = 0; p < n; ++p) {
+    const PlanarPatch& patch = scene.patches.patches[p];
+    for (Eigen::Vector3f& q : scene.samples[p]) {
+      q -= (patch.normal.dot(q) + patch.d) * patch.normal;
+    }
   }
   clock.Lap("patch_features");
   return scene;

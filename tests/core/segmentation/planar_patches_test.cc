@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <map>
 #include <opencv2/imgproc.hpp>
+#include <set>
 
 #include "core/frame/organized_cloud.h"
 #include "core/synth/synth_scene.h"
@@ -125,6 +126,77 @@ TEST(PlanarPatchesTest, TheMaskLimitsThePoints) {
   EXPECT_EQ(cv::countNonZero((p->labels >= 0) & ~box), 0);
   EXPECT_GT(cv::countNonZero(p->labels >= 0), 0.8 * cv::countNonZero(box));
   EXPECT_FALSE(FindPlanarPatches(cloud, cv::Mat(3, 3, CV_8UC1), {}).ok());
+}
+
+// The support's pixels are taken as they are: every support pixel with a
+// normal lies in one patch (its one connected part), fitted to the table's
+// plane; the box's faces are grown as without the support, and the leftover
+// rims still join them.
+TEST(PlanarPatchesTest, SupportPixelsAreOnePatchAndTheBoxIsGrownAsBefore) {
+  const synth::SynthScene scene =
+      testing::BoxOnTable(Eigen::Vector3f(0.08f, 0.06f, 0.05f));
+  const OrganizedCloud cloud = CloudOf(scene);
+  cv::Mat support = scene.frame.labels == 1;
+  for (int v = 0; v < support.rows; ++v) {
+    for (int u = 0; u < support.cols; ++u) {
+      if (!cloud.HasNormal(u, v)) support.at<uint8_t>(v, u) = 0;
+    }
+  }
+  absl::StatusOr<PlanarPatches> with =
+      FindPlanarPatches(cloud, {}, {}, support);
+  absl::StatusOr<PlanarPatches> without = FindPlanarPatches(cloud, {}, {});
+  ASSERT_TRUE(with.ok()) << with.status();
+  ASSERT_TRUE(without.ok());
+  // One label over all the support pixels.
+  std::set<int> support_ids;
+  for (int v = 0; v < support.rows; ++v) {
+    for (int u = 0; u < support.cols; ++u) {
+      if (support.at<uint8_t>(v, u)) {
+        support_ids.insert(with->labels.at<int>(v, u));
+      }
+    }
+  }
+  ASSERT_EQ(support_ids.size(), 1u);
+  const int table = *support_ids.begin();
+  ASSERT_GE(table, 0);
+  // Its plane is the table's: y = 0 in the scene's world, a plane facing
+  // the camera with normal . p + d = 0 at every support pixel.
+  const PlanarPatch& t = with->patches[table];
+  double worst = 0.0;
+  for (int v = 0; v < support.rows; v += 7) {
+    for (int u = 0; u < support.cols; u += 7) {
+      if (!support.at<uint8_t>(v, u)) continue;
+      const cv::Vec3f q = cloud.xyz.at<cv::Vec3f>(v, u);
+      worst = std::max<double>(
+          worst,
+          std::abs(t.normal.dot(Eigen::Vector3f(q[0], q[1], q[2])) + t.d));
+    }
+  }
+  EXPECT_LT(worst, 0.01);
+  // The box's pixels get the same patches either way (up to the ids).
+  const cv::Mat box = scene.frame.labels >= 20;
+  std::map<int, int> same;  // id without -> id with
+  int box_pixels = 0, agreeing = 0;
+  for (int v = 0; v < box.rows; ++v) {
+    for (int u = 0; u < box.cols; ++u) {
+      if (!box.at<uint8_t>(v, u)) continue;
+      const int a = without->labels.at<int>(v, u);
+      const int b = with->labels.at<int>(v, u);
+      if (a < 0 && b < 0) continue;
+      ++box_pixels;
+      const auto [it, fresh] = same.emplace(a, b);
+      agreeing += it->second == b;
+    }
+  }
+  ASSERT_GT(box_pixels, 1000);
+  EXPECT_GT(agreeing, 0.98 * box_pixels);
+  // Bookkeeping matches the label image.
+  for (size_t id = 0; id < with->patches.size(); ++id) {
+    const cv::Mat mine = with->labels == static_cast<int>(id);
+    EXPECT_EQ(cv::countNonZero(mine), with->patches[id].points);
+    EXPECT_EQ(cv::boundingRect(mine), with->patches[id].box);
+  }
+  EXPECT_FALSE(FindPlanarPatches(cloud, {}, {}, cv::Mat(3, 3, CV_8UC1)).ok());
 }
 
 TEST(PlanarPatchesTest, RejectsBadOptionsNamingTheField) {
