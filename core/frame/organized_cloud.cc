@@ -25,23 +25,20 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 // the rows it needs along u, then those down v.
 cv::Mat SmoothValidPoints(const cv::Mat& xyz, int half) {
   const int h = xyz.rows, w = xyz.cols;
+  const int window = 2 * half + 1;
   cv::Mat points(h, w, CV_32FC3);
   ParallelForRanges(h, [&](int begin, int end) {
-    const int top = std::max(0, begin - half);
-    const int bottom = std::min(h, end + half);
-    // (x, y, z, count) summed along each row of [top, bottom).
-    std::vector<cv::Vec4d> along(static_cast<size_t>(bottom - top) * w);
     std::vector<cv::Vec4d> valid(w);
-    for (int y = top; y < bottom; ++y) {
+    // (x, y, z, count) of row y's valid points summed along the row, by
+    // running sums: add the pixel entering the window, take away the one
+    // leaving it.
+    const auto sum_along = [&](int y, cv::Vec4d* out) {
       const cv::Vec3f* in = xyz.ptr<cv::Vec3f>(y);
       for (int u = 0; u < w; ++u) {
         valid[u] = std::isnan(in[u][2])
                        ? cv::Vec4d(0.0, 0.0, 0.0, 0.0)
                        : cv::Vec4d(in[u][0], in[u][1], in[u][2], 1.0);
       }
-      // Running sums along the row: add the pixel entering the window,
-      // take away the one leaving it.
-      cv::Vec4d* out = &along[static_cast<size_t>(y - top) * w];
       cv::Vec4d sum(0.0, 0.0, 0.0, 0.0);
       for (int k = 0; k < std::min(w, half); ++k) sum += valid[k];
       for (int u = 0; u < w; ++u) {
@@ -49,26 +46,29 @@ cv::Mat SmoothValidPoints(const cv::Mat& xyz, int half) {
         if (u - half - 1 >= 0) sum -= valid[u - half - 1];
         out[u] = sum;
       }
-    }
-    // The same down the columns.
+    };
+    // The same down the columns, keeping the last `window` rows' sums in a
+    // ring (row y in slot y % window).
+    std::vector<cv::Vec4d> ring(static_cast<size_t>(window) * w);
+    std::vector<cv::Vec4d> entering(w);
     std::vector<cv::Vec4d> column(w, cv::Vec4d(0.0, 0.0, 0.0, 0.0));
-    for (int y = std::max(0, begin - half); y < std::min(h, begin + half);
-         ++y) {
-      const cv::Vec4d* row = &along[static_cast<size_t>(y - top) * w];
-      for (int u = 0; u < w; ++u) column[u] += row[u];
+    const auto slot = [&](int y) {
+      return &ring[static_cast<size_t>(y % window) * w];
+    };
+    const int top = std::max(0, begin - half);
+    for (int y = top; y < std::min(h, begin + half); ++y) {
+      sum_along(y, slot(y));
+      for (int u = 0; u < w; ++u) column[u] += slot(y)[u];
     }
     for (int v = begin; v < end; ++v) {
-      const cv::Vec4d* enter =
-          v + half < h ? &along[static_cast<size_t>(v + half - top) * w]
-                       : nullptr;
-      const cv::Vec4d* leave =
-          v - half - 1 >= top
-              ? &along[static_cast<size_t>(v - half - 1 - top) * w]
-              : nullptr;
+      const bool enter = v + half < h;
+      const bool leave = v - half - 1 >= top;
+      if (enter) sum_along(v + half, entering.data());
+      const cv::Vec4d* leaving = leave ? slot(v - half - 1) : nullptr;
       cv::Vec3f* out = points.ptr<cv::Vec3f>(v);
       for (int u = 0; u < w; ++u) {
-        if (enter != nullptr) column[u] += enter[u];
-        if (leave != nullptr) column[u] -= leave[u];
+        if (enter) column[u] += entering[u];
+        if (leave) column[u] -= leaving[u];
         const cv::Vec4d& sum = column[u];
         const float count = static_cast<float>(sum[3]);
         if (count > 0.5f) {
@@ -80,6 +80,8 @@ cv::Mat SmoothValidPoints(const cv::Mat& xyz, int half) {
           out[u] = {kNaN, kNaN, kNaN};
         }
       }
+      // Row v + half takes the slot of row v - half - 1, which has left.
+      if (enter) std::copy(entering.begin(), entering.end(), slot(v + half));
     }
   });
   return points;
