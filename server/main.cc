@@ -16,6 +16,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/time/time.h"
+#include "core/base/memory_reuse.h"
 #include "core/base/parallel.h"
 #include "server/capabilities.h"
 #include "server/descriptors.h"
@@ -179,6 +180,8 @@ int main(int argc, char** argv) {
   // OpenCV's loops run on the request's threads (ParallelScope), not on a
   // pool of OpenCV's own with one thread per core beside ours.
   fovea::UseParallelScopesInOpenCv();
+  // A frame's large blocks stay mapped for the next one.
+  fovea::ReuseFreedMemory();
   LogInfo(fovea::server::RaiseDescriptorLimit());
   fovea::server::ServerConfig config;
   config.listen = absl::GetFlag(FLAGS_listen);

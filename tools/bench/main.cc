@@ -47,6 +47,7 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "core/base/memory_reuse.h"
 #include "core/base/parallel.h"
 #include "tools/bench/bench_inputs.h"
 #include "tools/bench/stage_benchmarks.h"
@@ -195,6 +196,8 @@ int RunLoadCommand(int argc, char** argv) {
 int main(int argc, char** argv) {
   // OpenCV's loops follow the ParallelScope: one core without one.
   fovea::UseParallelScopesInOpenCv();
+  // As fovea-server does (`memory` sets its own allocation rules).
+  fovea::ReuseFreedMemory();
   if (argc > 1 && std::string_view(argv[1]) == "stages") {
     return fovea::bench::RunStagesCommand(argc, argv);
   }
