@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdint>
 #include <exception>
 #include <utility>
 
@@ -13,18 +14,48 @@ thread_local ThreadPool* current_pool = nullptr;
 thread_local int current_threads = 1;
 // 0 on a request's thread, 1.. on a pool's helpers.
 thread_local int thread_index = 0;
+// The request the work on this thread is for (0: none yet): the outermost
+// ParallelScope with a pool starts one; a helper takes its job's.
+thread_local uint64_t current_family = 0;
+std::atomic<uint64_t> next_family{1};
+
+// Sets this thread's scope and family for the life of the object.
+class ScopeAs {
+ public:
+  ScopeAs(ThreadPool* pool, int threads, uint64_t family)
+      : pool_(current_pool),
+        threads_(current_threads),
+        family_(current_family) {
+    current_pool = pool;
+    current_threads = threads;
+    current_family = family;
+  }
+  ~ScopeAs() {
+    current_pool = pool_;
+    current_threads = threads_;
+    current_family = family_;
+  }
+
+ private:
+  ThreadPool* pool_;
+  int threads_;
+  uint64_t family_;
+};
 
 }  // namespace
 
 // One ParallelFor call: its items are taken by index by whoever runs it
-// (the caller and the helpers that picked up one of its tickets).
+// (the caller and the threads that picked up one of its tickets).
 struct ThreadPool::Job {
   const std::function<void(int)>* fn = nullptr;
   int n = 0;
+  int threads = 1;      // the scope its items run in
+  uint64_t family = 0;  // the request it is for
   std::atomic<int> next{0};
-  Mutex mutex;
-  int finished ABSL_GUARDED_BY(mutex) = 0;
-  std::exception_ptr error ABSL_GUARDED_BY(mutex);
+  // Guarded by the pool's mutex_ (one lock for every job: what a waiting
+  // thread waits for is "my job is done, or there is work of my request").
+  int finished = 0;
+  std::exception_ptr error;
 };
 
 ThreadPool::ThreadPool(int helpers) {
@@ -56,7 +87,7 @@ void ThreadPool::RunShare(Job& job) {
     ++done;
   }
   if (done == 0) return;
-  MutexLock lock(&job.mutex);
+  MutexLock lock(&mutex_);
   job.finished += done;
   if (error && !job.error) job.error = error;
 }
@@ -73,9 +104,21 @@ void ThreadPool::Work() {
       job = std::move(queue_.front());
       queue_.pop_front();
     }
-    // A helper runs what it takes serially: no nested fan-out.
+    // In the job's scope: a ParallelFor inside an item fans out too.
+    const ScopeAs scope(this, job->threads, job->family);
     RunShare(*job);
   }
+}
+
+std::shared_ptr<ThreadPool::Job> ThreadPool::TakeTicketOf(uint64_t family) {
+  for (auto it = queue_.begin(); it != queue_.end(); ++it) {
+    if ((*it)->family == family) {
+      std::shared_ptr<Job> job = std::move(*it);
+      queue_.erase(it);
+      return job;
+    }
+  }
+  return nullptr;
 }
 
 void ThreadPool::ParallelFor(int n, int max_helpers,
@@ -89,29 +132,55 @@ void ThreadPool::ParallelFor(int n, int max_helpers,
   auto job = std::make_shared<Job>();
   job->fn = &fn;
   job->n = n;
+  job->threads = current_threads;
+  job->family = current_family;
   {
     MutexLock lock(&mutex_);
     for (int t = 0; t < tickets; ++t) queue_.push_back(job);
   }
   RunShare(*job);
-  MutexLock lock(&job->mutex);
-  // A ticket a helper takes after this returns finds no item left
+  // Until every item has returned, help with this request's other work
+  // (the tickets of the jobs its other threads started) rather than wait
+  // idle; a ticket taken after the job is done finds no item left
   // (next >= n) and never touches `fn`.
-  job->mutex.Await([&job]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(job->mutex) {
-    return job->finished == job->n;
-  });
-  if (job->error) std::rethrow_exception(job->error);
+  const uint64_t family = job->family;
+  mutex_.Lock();
+  while (job->finished < job->n) {
+    std::shared_ptr<Job> other = TakeTicketOf(family);
+    if (other != nullptr) {
+      mutex_.Unlock();
+      RunShare(*other);
+      mutex_.Lock();
+      continue;
+    }
+    mutex_.Await([&]() ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_) {
+      if (job->finished == job->n) return true;
+      for (const std::shared_ptr<Job>& queued : queue_) {
+        if (queued->family == family) return true;
+      }
+      return false;
+    });
+  }
+  const std::exception_ptr error = job->error;
+  mutex_.Unlock();
+  if (error) std::rethrow_exception(error);
 }
 
 ParallelScope::ParallelScope(ThreadPool* pool, int threads)
-    : previous_pool_(current_pool), previous_threads_(current_threads) {
+    : previous_pool_(current_pool),
+      previous_threads_(current_threads),
+      previous_family_(current_family) {
   current_pool = pool;
   current_threads = pool == nullptr ? 1 : std::max(1, threads);
+  if (pool != nullptr && current_family == 0) {
+    current_family = next_family.fetch_add(1);
+  }
 }
 
 ParallelScope::~ParallelScope() {
   current_pool = previous_pool_;
   current_threads = previous_threads_;
+  current_family = previous_family_;
 }
 
 int ParallelThreads() { return current_threads; }

@@ -1,6 +1,7 @@
 #ifndef FOVEA_CORE_BASE_PARALLEL_H_
 #define FOVEA_CORE_BASE_PARALLEL_H_
 
+#include <cstdint>
 #include <deque>
 #include <functional>
 #include <memory>
@@ -28,16 +29,25 @@ class ThreadPool {
   int helpers() const { return static_cast<int>(threads_.size()); }
 
   // Runs fn(i) for every i in [0, n), each exactly once, on the calling
-  // thread and on at most `max_helpers` helpers (fewer when they are busy
+  // thread and on at most `max_helpers` others (fewer when they are busy
   // with other requests' work: the caller never waits for a helper to
   // become free), and returns when every call has returned. The first
   // exception a call throws is rethrown here once all have returned.
+  //
+  // Items may call ParallelFor again, on any thread: the inner call fans
+  // out in the same scope. A thread whose items are done while others'
+  // are still running helps with the same request's queued work (its own
+  // inner calls, or the other branch's), never with another request's.
   void ParallelFor(int n, int max_helpers, const std::function<void(int)>& fn);
 
  private:
   struct Job;
   void Work();
-  static void RunShare(Job& job);
+  void RunShare(Job& job);
+  // A queued ticket of the request `family`, removed from the queue; null
+  // when there is none.
+  std::shared_ptr<Job> TakeTicketOf(uint64_t family)
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mutex_);
 
   Mutex mutex_;
   std::deque<std::shared_ptr<Job>> queue_ ABSL_GUARDED_BY(mutex_);
@@ -47,8 +57,9 @@ class ThreadPool {
 
 // While it lives, ParallelFor on this thread splits its work over `threads`
 // threads in all (this one and threads - 1 of `pool`'s helpers). Scopes
-// nest: the innermost one counts. Without a scope, or in a call already
-// running on a helper, ParallelFor runs serially.
+// nest: the innermost one counts. Without a scope, ParallelFor runs
+// serially. The outermost scope with a pool starts a request: the work
+// that ParallelFor hands out on its behalf, however nested, is its own.
 class ParallelScope {
  public:
   ParallelScope(ThreadPool* pool, int threads);
@@ -59,6 +70,7 @@ class ParallelScope {
  private:
   ThreadPool* previous_pool_;
   int previous_threads_;
+  uint64_t previous_family_;
 };
 
 // The threads ParallelFor may use on this thread now (1 without a scope).

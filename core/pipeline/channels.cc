@@ -40,25 +40,50 @@ FeaturePyramidOptions ToFeaturePyramidOptions(const DetectOptions& options) {
 
 }  // namespace
 
+bool UsesCloudPyramid(const DetectOptions& options) {
+  for (const WeightedChannel& c : options.channels) {
+    const SaliencyOperator* row = FindSaliencyOperator(c.op);
+    if (row == nullptr || row->domain == OperatorDomain::kImage) continue;
+    if (options.pyramid != PyramidKind::kNone ||
+        row->level_without_pyramid != nullptr) {
+      return true;
+    }
+  }
+  return false;
+}
+
+CloudPyramidOptions CloudPyramidLevels(const DetectOptions& options) {
+  // Without a feature pyramid only SYM3D's level is needed.
+  CloudPyramidOptions levels = options.cloud_pyramid;
+  if (options.pyramid == PyramidKind::kNone) {
+    levels.max_levels = std::min(levels.max_levels, options.sym3d_level + 1);
+  }
+  return levels;
+}
+
 ChannelComputer::ChannelComputer(const OrganizedCloud& cloud,
                                  const SupportPlane& plane,
                                  const TableScene& table,
-                                 const DetectOptions& options)
-    : cloud_(cloud), plane_(plane), table_(table), options_(options) {}
+                                 const DetectOptions& options,
+                                 const CloudPyramid* pyramid)
+    : cloud_(cloud),
+      plane_(plane),
+      table_(table),
+      options_(options),
+      prebuilt_(pyramid) {}
 
 absl::StatusOr<const CloudPyramid*> ChannelComputer::Pyramid() {
-  if (!pyramid_.has_value()) {
-    // Without a feature pyramid only SYM3D's level is needed.
-    CloudPyramidOptions levels = options_.cloud_pyramid;
-    if (options_.pyramid == PyramidKind::kNone) {
-      levels.max_levels = std::min(levels.max_levels, options_.sym3d_level + 1);
-    }
-    FOVEA_ASSIGN_OR_RETURN(CloudPyramid built,
-                           BuildCloudPyramid(cloud_, levels));
+  if (prebuilt_ == nullptr && !pyramid_.has_value()) {
+    FOVEA_ASSIGN_OR_RETURN(
+        CloudPyramid built,
+        BuildCloudPyramid(cloud_, CloudPyramidLevels(options_)));
     pyramid_ = std::move(built);
-    tables_.assign(pyramid_->size(), std::nullopt);
   }
-  return &*pyramid_;
+  const CloudPyramid* pyramid = prebuilt_ != nullptr ? prebuilt_ : &*pyramid_;
+  if (tables_.size() != static_cast<size_t>(pyramid->size())) {
+    tables_.assign(pyramid->size(), std::nullopt);
+  }
+  return pyramid;
 }
 
 absl::StatusOr<const TableScene*> ChannelComputer::TableAt(int level) {

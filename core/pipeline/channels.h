@@ -15,14 +15,26 @@
 
 namespace fovea {
 
+// Whether the channels of `options` read the cloud pyramid (a geometric
+// operator with a feature pyramid, or on a coarser level without one).
+bool UsesCloudPyramid(const DetectOptions& options);
+
+// The levels the channels of `options` read: options.cloud_pyramid, but
+// without a feature pyramid only down to the operators' level.
+CloudPyramidOptions CloudPyramidLevels(const DetectOptions& options);
+
 // Computes saliency channels for one frame. Keeps the state the channels
 // share: the Gaussian cloud pyramid and each level's table scene, built on
 // first use (a frame with only level-0 channels never builds them).
 class ChannelComputer {
  public:
-  // `cloud`, `plane` and `table` are level 0 and must outlive this object.
+  // `cloud`, `plane` and `table` are level 0 and must outlive this object;
+  // so must `pyramid` when given: BuildCloudPyramid(cloud,
+  // CloudPyramidLevels(options)), built beforehand (else built on first
+  // use).
   ChannelComputer(const OrganizedCloud& cloud, const SupportPlane& plane,
-                  const TableScene& table, const DetectOptions& options);
+                  const TableScene& table, const DetectOptions& options,
+                  const CloudPyramid* pyramid = nullptr);
 
   // The channel's map, CV_32FC1 of level 0's size, in [0, 1]:
   //  - pyramid NONE: the operator on one level (level 0; SYM3D on
@@ -52,6 +64,7 @@ class ChannelComputer {
   const SupportPlane& plane_;
   const TableScene& table_;
   const DetectOptions& options_;
+  const CloudPyramid* prebuilt_;  // not owned; null: none
   std::optional<CloudPyramid> pyramid_;
   std::vector<std::optional<TableScene>> tables_;  // per level, level 0 unused
 };

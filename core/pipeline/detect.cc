@@ -236,8 +236,8 @@ absl::StatusOr<PreparedScene> PrepareSceneUnguarded(
   clock.Lap("normals");
   FOVEA_RETURN_IF_ERROR(Check(interrupt));
 
-  // The support and the surface edges both need only the cloud: with two
-  // threads, at once.
+  // The support, the surface edges and the cloud pyramid need only the
+  // cloud: with two threads, the support beside the other two.
   SupportPlaneOptions support_options = options.support_plane;
   AdaptToSensor(scene.sensor, support_options);
   absl::StatusOr<SupportPlane> plane;
@@ -245,14 +245,25 @@ absl::StatusOr<PreparedScene> PrepareSceneUnguarded(
     plane =
         FindSupportPlane(scene.cloud, support_options, options.scene.support);
   };
-  const auto find_edges = [&] {
+  absl::Status pyramid = absl::OkStatus();
+  const auto edges_and_pyramid = [&] {
     if (options.split_at_surface_edges) {
       scene.surface_edges =
           FindSurfaceEdges(scene.cloud, options.surface_edges);
     }
+    if (UsesCloudPyramid(options)) {
+      absl::StatusOr<CloudPyramid> built =
+          BuildCloudPyramid(scene.cloud, CloudPyramidLevels(options));
+      if (built.ok()) {
+        scene.pyramid = *std::move(built);
+      } else {
+        pyramid = built.status();
+      }
+    }
   };
-  ParallelInvoke(find_support, find_edges);
+  ParallelInvoke(find_support, edges_and_pyramid);
   FOVEA_RETURN_IF_ERROR(plane.status());
+  FOVEA_RETURN_IF_ERROR(pyramid);
   scene.plane = *std::move(plane);
   TableSceneOptions table_options = options.table_scene;
   AdaptToSensor(scene.sensor, table_options);
@@ -272,7 +283,9 @@ absl::StatusOr<DetectResult> DetectOnSceneUnguarded(
   StageClock clock(result.timings);
   const OrganizedCloud& cloud = scene.cloud;
 
-  ChannelComputer channels(cloud, scene.plane, scene.table, options);
+  ChannelComputer channels(
+      cloud, scene.plane, scene.table, options,
+      scene.pyramid.has_value() ? &*scene.pyramid : nullptr);
   std::vector<NamedMap> maps;
   for (const WeightedChannel& c : options.channels) {
     FOVEA_ASSIGN_OR_RETURN(cv::Mat map, channels.Compute(c.op));

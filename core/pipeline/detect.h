@@ -3,6 +3,7 @@
 
 #include <functional>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -242,6 +243,10 @@ struct PreparedScene {
   // options.surface_edges), when options.split_at_surface_edges; else
   // empty. Built beside the support plane when the scope has two threads.
   cv::Mat surface_edges;
+  // The cloud pyramid the saliency channels read (BuildCloudPyramid with
+  // CloudPyramidLevels(options)), when they read one (UsesCloudPyramid);
+  // built beside the support plane when the scope has two threads.
+  std::optional<CloudPyramid> pyramid;
   FrameScale scale;
   SensorModel sensor;  // the scene's, for the frame's intrinsics
   std::vector<StageTiming> timings;

@@ -73,13 +73,80 @@ TEST(ParallelForTest, AnExceptionReachesTheCallerAfterEveryItemReturned) {
   EXPECT_EQ(ran.load(), 100);
 }
 
-TEST(ParallelForTest, NestedCallsOnHelpersRunSeriallyAndFinish) {
+TEST(ParallelForTest, NestedCallsFanOutOnAnyThreadAndFinish) {
   ThreadPool pool(1);
   ParallelScope scope(&pool, 2);
   std::atomic<int> inner{0};
   ParallelFor(8,
               [&](int) { ParallelFor(8, [&](int) { inner.fetch_add(1); }); });
   EXPECT_EQ(inner.load(), 64);
+}
+
+// Two branches of one request: the short one's thread, once done, helps
+// the long one's inner loop, which would otherwise run on one thread.
+TEST(ParallelForTest, AThreadThatIsDoneHelpsItsRequestsOtherBranch) {
+  ThreadPool pool(1);
+  ParallelScope scope(&pool, 2);
+  std::mutex mutex;
+  std::set<std::thread::id> inner_threads;
+  ParallelInvoke([] {},
+                 [&] {
+                   ParallelFor(64, [&](int) {
+                     std::this_thread::sleep_for(std::chrono::milliseconds(2));
+                     std::lock_guard<std::mutex> lock(mutex);
+                     inner_threads.insert(std::this_thread::get_id());
+                   });
+                 });
+  EXPECT_EQ(inner_threads.size(), 2u);
+}
+
+// A request's waiting thread helps only its own request: with one helper
+// busy elsewhere, request B's items all run on B's own thread, never on
+// request A's, which is waiting for its slow item.
+TEST(ParallelForTest, AWaitingThreadNeverRunsAnotherRequestsWork) {
+  ThreadPool pool(1);
+  std::atomic<bool> a_waiting{false};
+  std::atomic<bool> b_done{false};
+  std::thread::id a_thread;
+  std::mutex mutex;
+  std::set<std::thread::id> b_threads;
+  std::thread a([&] {
+    a_thread = std::this_thread::get_id();
+    ParallelScope scope(&pool, 2);
+    std::atomic<bool> second_started{false};
+    ParallelFor(2, [&](int i) {
+      const auto until =
+          std::chrono::steady_clock::now() + std::chrono::seconds(10);
+      if (i == 0) {
+        // Until the other item runs on the other thread; then A's thread
+        // has nothing of its own to do and waits.
+        while (!second_started.load() &&
+               std::chrono::steady_clock::now() < until) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
+        a_waiting.store(true);
+        return;
+      }
+      // The helper, busy until B has finished.
+      second_started.store(true);
+      while (!b_done.load() && std::chrono::steady_clock::now() < until) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      }
+    });
+  });
+  while (!a_waiting.load()) std::this_thread::yield();
+  {
+    ParallelScope scope(&pool, 2);
+    ParallelFor(32, [&](int) {
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+      std::lock_guard<std::mutex> lock(mutex);
+      b_threads.insert(std::this_thread::get_id());
+    });
+  }
+  b_done.store(true);
+  a.join();
+  EXPECT_EQ(b_threads.count(a_thread), 0u);
+  EXPECT_EQ(b_threads.size(), 1u);
 }
 
 TEST(ParallelForTest, ConcurrentRequestsShareOnePoolAndAllFinish) {
