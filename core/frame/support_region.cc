@@ -13,6 +13,7 @@
 
 #include "absl/status/status.h"
 #include "core/base/lab.h"
+#include "core/base/parallel.h"
 #include "core/frame/support_grid.h"
 
 namespace fovea::support_internal {
@@ -221,30 +222,35 @@ absl::StatusOr<SupportPlane> MakeSupportRegion(
   const int v_begin = std::max(0, cells.y * grid.stride - grid.stride);
   const int v_end = std::min(
       cloud.height(), (cells.y + cells.height) * grid.stride + grid.stride);
-  for (int v = v_begin; v < v_end; ++v) {
-    const cv::Vec3f* p = cloud.xyz.ptr<cv::Vec3f>(v);
-    const cv::Vec3f* nrm = cloud.normals.ptr<cv::Vec3f>(v);
-    const uint8_t* m = member.ptr<uint8_t>(
-        std::min(grid.rows - 1, (v + grid.stride / 2) / grid.stride));
-    uint8_t* out = plane.inliers.ptr<uint8_t>(v);
-    for (int u = u_begin; u < u_end; ++u) {
-      if (std::isnan(p[u][2])) continue;
-      if (!m[std::min(grid.cols - 1, (u + grid.stride / 2) / grid.stride)]) {
-        continue;
+  // Rows in parallel ranges, each counting its own inliers.
+  std::vector<int> row_count(std::max(0, v_end - v_begin), 0);
+  ParallelForRanges(v_end - v_begin, [&](int first, int last) {
+    for (int v = v_begin + first; v < v_begin + last; ++v) {
+      const cv::Vec3f* p = cloud.xyz.ptr<cv::Vec3f>(v);
+      const cv::Vec3f* nrm = cloud.normals.ptr<cv::Vec3f>(v);
+      const uint8_t* m = member.ptr<uint8_t>(
+          std::min(grid.rows - 1, (v + grid.stride / 2) / grid.stride));
+      uint8_t* out = plane.inliers.ptr<uint8_t>(v);
+      for (int u = u_begin; u < u_end; ++u) {
+        if (std::isnan(p[u][2])) continue;
+        if (!m[std::min(grid.cols - 1, (u + grid.stride / 2) / grid.stride)]) {
+          continue;
+        }
+        const Eigen::Vector3f q(p[u][0], p[u][1], p[u][2]);
+        if (!(std::abs(best.Height(q)) <= InlierDistance(q.z(), options))) {
+          continue;
+        }
+        if (!std::isnan(nrm[u][2]) &&
+            std::abs(best.normal.dot(Eigen::Vector3f(
+                nrm[u][0], nrm[u][1], nrm[u][2]))) < min_cos_full) {
+          continue;
+        }
+        out[u] = 255;
+        ++row_count[v - v_begin];
       }
-      const Eigen::Vector3f q(p[u][0], p[u][1], p[u][2]);
-      if (!(std::abs(best.Height(q)) <= InlierDistance(q.z(), options))) {
-        continue;
-      }
-      if (!std::isnan(nrm[u][2]) &&
-          std::abs(best.normal.dot(Eigen::Vector3f(
-              nrm[u][0], nrm[u][1], nrm[u][2]))) < min_cos_full) {
-        continue;
-      }
-      out[u] = 255;
-      ++count;
     }
-  }
+  });
+  for (const int c : row_count) count += c;
   plane.inlier_count = count;
   plane.hull = HullOfMask(cloud, plane.inliers, plane);
   if (plane.hull.size() < 3) {
