@@ -12,6 +12,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
 #include "core/base/guarded.h"
+#include "core/base/parallel.h"
 #include "core/base/status_macros.h"
 
 namespace fovea {
@@ -84,70 +85,73 @@ void FilterColumns(const float* const rows[2 * kRadius + 1], size_t n,
 // row and column (eq. 2.19-2.26): separable masked sums, then the
 // renormalisation by the valid weight, NaN where no valid pixel
 // contributed. With `unit_length`, the result is rescaled to length 1 (NaN
-// if shorter than kMinNormalLength). `scratch` is reused between calls.
-cv::Mat FilterAndDecimate(const cv::Mat& src, bool unit_length,
-                          std::vector<float>& scratch) {
+// if shorter than kMinNormalLength). Output rows in parallel ranges, each
+// with its own buffers.
+cv::Mat FilterAndDecimate(const cv::Mat& src, bool unit_length) {
   constexpr int kTaps = 2 * kRadius + 1;
   const int h = src.rows, w = src.cols;
   const int w_out = HalfUp(w), h_out = HalfUp(h);
   const size_t row_floats = static_cast<size_t>(kChannels) * w_out;
   const size_t padded_floats =
       static_cast<size_t>(kChannels) * (w + 2 * kRadius);
-  // A ring of the row sums of the kTaps input rows the current output row
-  // needs (cache-resident), one masked padded input row and the
-  // accumulator of one output row.
-  scratch.resize(kTaps * row_floats + padded_floats + row_floats);
-  float* ring = scratch.data();
-  float* padded = ring + kTaps * row_floats;
-  float* acc = padded + padded_floats;
-  std::fill(padded, padded + kChannels * kRadius, 0.0f);
-  std::fill(padded + padded_floats - kChannels * kRadius,
-            padded + padded_floats, 0.0f);
-  // Row sums of input row v - kRadius (0 outside the image) into the ring.
-  const auto compute_row = [&](int padded_row) {
-    float* out = ring + row_floats * (padded_row % kTaps);
-    const int v = padded_row - kRadius;
-    if (v < 0 || v >= h) {
-      std::fill(out, out + row_floats, 0.0f);
-      return;
-    }
-    MaskRow(src.ptr<float>(v), w, padded);
-    FilterRowAtKeptColumns(padded, w_out, out);
-  };
-  int computed = -1;  // last padded row in the ring
   cv::Mat out(h_out, w_out, CV_32FC3);
-  for (int r = 0; r < h_out; ++r) {
-    // Input rows 2r - 2 .. 2r + 2 are padded rows 2r .. 2r + 4.
-    while (computed < 2 * r + 2 * kRadius) compute_row(++computed);
-    const float* rows[kTaps];
-    for (int t = 0; t < kTaps; ++t) {
-      rows[t] = ring + row_floats * ((2 * r + t) % kTaps);
-    }
-    FilterColumns(rows, row_floats, acc);
-    float* dst = out.ptr<float>(r);
-    for (int c = 0; c < w_out; ++c) {
-      const float* s = acc + kChannels * c;
-      float* p = dst + 3 * c;
-      if (s[3] <= 0.0f) {
-        p[0] = p[1] = p[2] = kNaN;
-        continue;
+  ParallelForRanges(h_out, [&](int first, int last) {
+    // A ring of the row sums of the kTaps input rows the current output
+    // row needs (cache-resident), one masked padded input row and the
+    // accumulator of one output row.
+    std::vector<float> scratch(kTaps * row_floats + padded_floats + row_floats);
+    float* ring = scratch.data();
+    float* padded = ring + kTaps * row_floats;
+    float* acc = padded + padded_floats;
+    std::fill(padded, padded + kChannels * kRadius, 0.0f);
+    std::fill(padded + padded_floats - kChannels * kRadius,
+              padded + padded_floats, 0.0f);
+    // Row sums of input row v - kRadius (0 outside the image) into the
+    // ring.
+    const auto compute_row = [&](int padded_row) {
+      float* row = ring + row_floats * (padded_row % kTaps);
+      const int v = padded_row - kRadius;
+      if (v < 0 || v >= h) {
+        std::fill(row, row + row_floats, 0.0f);
+        return;
       }
-      float scale = 1.0f / s[3];
-      if (unit_length) {
-        // The common factor 1 / weight cancels in the unit vector.
-        const float length =
-            std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]) * scale;
-        if (!(length >= kMinNormalLength)) {
+      MaskRow(src.ptr<float>(v), w, padded);
+      FilterRowAtKeptColumns(padded, w_out, row);
+    };
+    int computed = 2 * first - 1;  // last padded row in the ring
+    for (int r = first; r < last; ++r) {
+      // Input rows 2r - 2 .. 2r + 2 are padded rows 2r .. 2r + 4.
+      while (computed < 2 * r + 2 * kRadius) compute_row(++computed);
+      const float* rows[kTaps];
+      for (int t = 0; t < kTaps; ++t) {
+        rows[t] = ring + row_floats * ((2 * r + t) % kTaps);
+      }
+      FilterColumns(rows, row_floats, acc);
+      float* dst = out.ptr<float>(r);
+      for (int c = 0; c < w_out; ++c) {
+        const float* s = acc + kChannels * c;
+        float* p = dst + 3 * c;
+        if (s[3] <= 0.0f) {
           p[0] = p[1] = p[2] = kNaN;
           continue;
         }
-        scale /= length;
+        float scale = 1.0f / s[3];
+        if (unit_length) {
+          // The common factor 1 / weight cancels in the unit vector.
+          const float length =
+              std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]) * scale;
+          if (!(length >= kMinNormalLength)) {
+            p[0] = p[1] = p[2] = kNaN;
+            continue;
+          }
+          scale /= length;
+        }
+        p[0] = s[0] * scale;
+        p[1] = s[1] * scale;
+        p[2] = s[2] * scale;
       }
-      p[0] = s[0] * scale;
-      p[1] = s[1] * scale;
-      p[2] = s[2] * scale;
     }
-  }
+  });
   return out;
 }
 
@@ -170,13 +174,11 @@ absl::Status ValidateCloud(const OrganizedCloud& cloud) {
   return absl::OkStatus();
 }
 
-OrganizedCloud Downsample(const OrganizedCloud& cloud,
-                          std::vector<float>& scratch) {
+OrganizedCloud Downsample(const OrganizedCloud& cloud) {
   OrganizedCloud out;
-  out.xyz = FilterAndDecimate(cloud.xyz, /*unit_length=*/false, scratch);
+  out.xyz = FilterAndDecimate(cloud.xyz, /*unit_length=*/false);
   if (!cloud.normals.empty()) {
-    out.normals =
-        FilterAndDecimate(cloud.normals, /*unit_length=*/true, scratch);
+    out.normals = FilterAndDecimate(cloud.normals, /*unit_length=*/true);
   }
   if (!cloud.color.empty()) {
     // cv::pyrDown: the same kernel centred on the kept pixel 2u, and the
@@ -210,8 +212,7 @@ Intrinsics DownsampleIntrinsics(const Intrinsics& intrinsics) {
 absl::StatusOr<OrganizedCloud> DownsampleCloud(const OrganizedCloud& cloud) {
   FOVEA_RETURN_IF_ERROR(ValidateCloud(cloud));
   return Guarded("DownsampleCloud", [&]() -> absl::StatusOr<OrganizedCloud> {
-    std::vector<float> scratch;
-    return Downsample(cloud, scratch);
+    return Downsample(cloud);
   });
 }
 
@@ -223,14 +224,13 @@ absl::StatusOr<CloudPyramid> BuildCloudPyramid(
   pyramid.levels.reserve(options.max_levels);
   pyramid.levels.push_back(cloud);  // cv::Mat headers: shares the pixels
   return Guarded("BuildCloudPyramid", [&]() -> absl::StatusOr<CloudPyramid> {
-    std::vector<float> scratch;
     while (pyramid.size() < options.max_levels) {
       const OrganizedCloud& last = pyramid.levels.back();
       if (HalfUp(last.width()) < options.min_size ||
           HalfUp(last.height()) < options.min_size) {
         break;
       }
-      OrganizedCloud next = Downsample(last, scratch);
+      OrganizedCloud next = Downsample(last);
       pyramid.levels.push_back(std::move(next));
     }
     return std::move(pyramid);
