@@ -128,8 +128,9 @@ absl::StatusOr<SegmentSummary> RunUnguarded(const RgbdFrame& frame,
                            segmenter.Next(interrupt));
     summary.timings.push_back({"segment.object", SecondsSince(lap)});
     if (!next.has_value()) break;  // the scene is exhausted
-    if (VisibleArea(scene.cloud, next->mask) < options.min_object_area_m2 ||
-        StandingShare(scene.table, next->mask) < kMinStandingShare) {
+    if (VisibleArea(scene.cloud, next->mask, next->box) <
+            options.min_object_area_m2 ||
+        StandingShare(scene.table, next->mask, next->box) < kMinStandingShare) {
       continue;  // a fragment, or not on the table: it left the scene, but
                  // is not reported
     }
@@ -141,7 +142,7 @@ absl::StatusOr<SegmentSummary> RunUnguarded(const RgbdFrame& frame,
     object.seed.point = {q[0], q[1], q[2]};
     object.mask = std::move(next->mask);
     object.score = next->score;
-    DescribeObject(scene.cloud, object);
+    DescribeObject(scene.cloud, object, next->box);
     ObjectToInput(scene.scale, object);
     object.index = summary.objects++;
     object.seconds_since_start = SecondsSince(start);

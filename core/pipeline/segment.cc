@@ -29,13 +29,25 @@ double SecondsSince(SteadyClock::time_point start) {
 
 }  // namespace
 
-double StandingShare(const TableScene& table, const cv::Mat& mask) {
+namespace {
+
+// `within`, or the whole mask when it is empty.
+cv::Rect Within(const cv::Mat& mask, const cv::Rect& within) {
+  return within.empty() ? cv::Rect(0, 0, mask.cols, mask.rows)
+                        : within & cv::Rect(0, 0, mask.cols, mask.rows);
+}
+
+}  // namespace
+
+double StandingShare(const TableScene& table, const cv::Mat& mask,
+                     const cv::Rect& within) {
+  const cv::Rect box = Within(mask, within);
   int with_depth = 0, standing = 0;
-  for (int v = 0; v < mask.rows; ++v) {
+  for (int v = box.y; v < box.br().y; ++v) {
     const unsigned char* in = mask.ptr<unsigned char>(v);
     const float* h = table.height.ptr<float>(v);
     const unsigned char* c = table.standing.ptr<unsigned char>(v);
-    for (int u = 0; u < mask.cols; ++u) {
+    for (int u = box.x; u < box.br().x; ++u) {
       if (in[u] == 0 || std::isnan(h[u])) continue;
       ++with_depth;
       standing += c[u] != 0;
@@ -44,13 +56,15 @@ double StandingShare(const TableScene& table, const cv::Mat& mask) {
   return with_depth > 0 ? static_cast<double>(standing) / with_depth : 1.0;
 }
 
-double VisibleArea(const OrganizedCloud& cloud, const cv::Mat& mask) {
+double VisibleArea(const OrganizedCloud& cloud, const cv::Mat& mask,
+                   const cv::Rect& within) {
+  const cv::Rect box = Within(mask, within);
   const double per_z2 = 1.0 / (cloud.intrinsics.fx * cloud.intrinsics.fy);
   double area = 0.0;
-  for (int v = 0; v < mask.rows; ++v) {
+  for (int v = box.y; v < box.br().y; ++v) {
     const unsigned char* in = mask.ptr<unsigned char>(v);
     const cv::Vec3f* xyz = cloud.xyz.ptr<cv::Vec3f>(v);
-    for (int u = 0; u < mask.cols; ++u) {
+    for (int u = box.x; u < box.br().x; ++u) {
       if (in[u] == 0 || std::isnan(xyz[u][2])) continue;
       area += per_z2 * xyz[u][2] * xyz[u][2];
     }
@@ -86,9 +100,13 @@ void ObjectToInput(const FrameScale& scale, SegmentedObject& object) {
   object.box = object.area > 0 ? cv::boundingRect(object.mask) : cv::Rect();
 }
 
-void DescribeObject(const OrganizedCloud& cloud, SegmentedObject& object) {
-  object.area = cv::countNonZero(object.mask);
-  object.box = object.area > 0 ? cv::boundingRect(object.mask) : cv::Rect();
+void DescribeObject(const OrganizedCloud& cloud, SegmentedObject& object,
+                    const cv::Rect& within) {
+  const cv::Rect search = Within(object.mask, within);
+  const cv::Mat part = object.mask(search);
+  object.area = search.empty() ? 0 : cv::countNonZero(part);
+  object.box =
+      object.area > 0 ? cv::boundingRect(part) + search.tl() : cv::Rect();
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   Eigen::Vector3f lo =
       Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity());

@@ -119,12 +119,16 @@ struct SegmentedObject {
 };
 
 // Fills the object's box, area, centroid and extent from its mask and the
-// cloud's points under it.
-void DescribeObject(const OrganizedCloud& cloud, SegmentedObject& object);
+// cloud's points under it. `within`, when not empty, holds every pixel of
+// the mask (only it is looked at: the same result, sooner).
+void DescribeObject(const OrganizedCloud& cloud, SegmentedObject& object,
+                    const cv::Rect& within = cv::Rect());
 
 // The share of the mask's pixels with depth that stand on `table`
-// (TableScene::standing), [0, 1] (1 for a mask without depth).
-double StandingShare(const TableScene& table, const cv::Mat& mask);
+// (TableScene::standing), [0, 1] (1 for a mask without depth). `within`
+// as DescribeObject's.
+double StandingShare(const TableScene& table, const cv::Mat& mask,
+                     const cv::Rect& within = cv::Rect());
 
 // Where to seed the next object of a scene whose `covered` pixels are in
 // masks already: on the largest piece (by VisibleArea) of `free` (pixels
@@ -138,7 +142,9 @@ std::optional<cv::Point> CoverSeed(const OrganizedCloud& cloud,
 // The area the mask's points show the camera, m^2: each pixel with depth z
 // covers z^2 / (fx fy) facing the camera (a lower bound of the surface's
 // area, exact for a face seen head-on).
-double VisibleArea(const OrganizedCloud& cloud, const cv::Mat& mask);
+// `within` as DescribeObject's.
+double VisibleArea(const OrganizedCloud& cloud, const cv::Mat& mask,
+                   const cv::Rect& within = cv::Rect());
 
 // Results in the scene's (processing) pixels mapped to the frame as sent:
 // points' pixels; an object's seed, mask, box and area (its centroid and

@@ -175,15 +175,22 @@ absl::Status Validate(const CosOptions& options) {
   return absl::OkStatus();
 }
 
+cv::Rect PatchesBox(const CosScene& scene, const std::vector<int>& patches) {
+  cv::Rect box;
+  for (const int p : patches) box |= scene.label_boxes[p];
+  return box;
+}
+
 cv::Mat PatchesMask(const CosScene& scene, const std::vector<int>& patches) {
   std::vector<unsigned char> in(scene.patches.patches.size(), 0);
   for (const int p : patches) in[p] = 1;
   const cv::Mat& labels = scene.patches.labels;
   cv::Mat mask(labels.size(), CV_8UC1, cv::Scalar(0));
-  for (int v = 0; v < labels.rows; ++v) {
+  const cv::Rect box = PatchesBox(scene, patches);
+  for (int v = box.y; v < box.br().y; ++v) {
     const int* label = labels.ptr<int>(v);
     unsigned char* out = mask.ptr<unsigned char>(v);
-    for (int u = 0; u < labels.cols; ++u) {
+    for (int u = box.x; u < box.br().x; ++u) {
       if (label[u] >= 0 && in[label[u]]) out[u] = 255;
     }
   }
@@ -261,14 +268,30 @@ absl::StatusOr<CosScene> BuildCosScene(const OrganizedCloud& cloud,
   }
   std::vector<int> on_plane(n, 0);
   std::vector<int> size(n, 0);
+  std::vector<cv::Vec4i> extent(
+      n, cv::Vec4i(cloud.width(), cloud.height(), -1, -1));
   for (int v = 0; v < scene.patches.labels.rows; ++v) {
     const int* label = scene.patches.labels.ptr<int>(v);
     const uint8_t* inlier =
         have_inliers ? plane.inliers.ptr<uint8_t>(v) : nullptr;
     for (int u = 0; u < scene.patches.labels.cols; ++u) {
-      if (label[u] < 0) continue;
-      ++size[label[u]];
-      if (inlier != nullptr && inlier[u] != 0) ++on_plane[label[u]];
+      const int l = label[u];
+      if (l < 0) continue;
+      ++size[l];
+      if (inlier != nullptr && inlier[u] != 0) ++on_plane[l];
+      cv::Vec4i& e = extent[l];
+      e[0] = std::min(e[0], u);
+      e[1] = std::min(e[1], v);
+      e[2] = std::max(e[2], u);
+      e[3] = std::max(e[3], v);
+    }
+  }
+  scene.label_boxes.assign(n, cv::Rect());
+  for (int p = 0; p < n; ++p) {
+    const cv::Vec4i& e = extent[p];
+    if (e[2] >= 0) {
+      scene.label_boxes[p] =
+          cv::Rect(e[0], e[1], e[2] - e[0] + 1, e[3] - e[1] + 1);
     }
   }
   scene.support.assign(n, false);

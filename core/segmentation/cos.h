@@ -81,6 +81,9 @@ struct CosScene {
   std::vector<std::vector<Eigen::Vector3f>> samples;  // per patch
   std::vector<bool> support;                          // per patch
   std::vector<std::vector<int>> neighbours;           // per patch, sorted
+  // Per patch, the bounding box of its pixels in patches.labels (rims
+  // included; PlanarPatch::box is before the rims joined).
+  std::vector<cv::Rect> label_boxes;
   // "patches", "patch_features": how long building it took.
   std::vector<StageTiming> timings;
 };
@@ -96,6 +99,10 @@ absl::StatusOr<CosScene> BuildCosScene(const OrganizedCloud& cloud,
 
 // CV_8UC1 of the labels' size, 255 on the pixels of `patches`.
 cv::Mat PatchesMask(const CosScene& scene, const std::vector<int>& patches);
+
+// The bounding box of the pixels of `patches` (empty for none): where
+// PatchesMask can be non-zero.
+cv::Rect PatchesBox(const CosScene& scene, const std::vector<int>& patches);
 
 // Per patch: the ObjectId most of its pixels carry in `labels` (CV_32SC1 of
 // a LabelledFrame; 0 = table or none).

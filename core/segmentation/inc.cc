@@ -23,15 +23,21 @@ uint64_t PairKey(int a, int b) {
 
 // A pixel of the mask nearest its centroid (a point on the object to
 // report as the seed).
-cv::Point CentralPixel(const cv::Mat& mask) {
-  const cv::Moments m = cv::moments(mask, true);
+// The mask's pixel nearest its centroid (the first in raster order of
+// those as near); `box` holds every pixel of the mask.
+cv::Point CentralPixel(const cv::Mat& mask, const cv::Rect& box) {
+  if (box.empty()) return {0, 0};
+  const cv::Moments m = cv::moments(mask(box), true);
   if (m.m00 <= 0) return {0, 0};
-  const cv::Point2d c(m.m10 / m.m00, m.m01 / m.m00);
+  // The box's moments are of u - box.x and v - box.y, integers summed
+  // exactly: these are the whole mask's, bit for bit.
+  const cv::Point2d c((m.m10 + box.x * m.m00) / m.m00,
+                      (m.m01 + box.y * m.m00) / m.m00);
   cv::Point best(0, 0);
   double best_d = 1e30;
-  for (int v = 0; v < mask.rows; ++v) {
+  for (int v = box.y; v < box.br().y; ++v) {
     const unsigned char* row = mask.ptr<unsigned char>(v);
-    for (int u = 0; u < mask.cols; ++u) {
+    for (int u = box.x; u < box.br().x; ++u) {
       if (row[u] == 0) continue;
       const double d = (u - c.x) * (u - c.x) + (v - c.y) * (v - c.y);
       if (d < best_d) {
@@ -369,7 +375,8 @@ absl::StatusOr<std::optional<IncObject>> IncSegmenter::Next(
     removed_points_ += points;
     if (points < options_.min_object_points) continue;  // noise: next
     object.mask = PatchesMask(scene_.surfaces, group);
-    object.seed = CentralPixel(object.mask);
+    object.box = PatchesBox(scene_.surfaces, group);
+    object.seed = CentralPixel(object.mask, object.box);
     return object;
   }
 }

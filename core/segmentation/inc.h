@@ -94,6 +94,7 @@ absl::StatusOr<IncScene> BuildIncScene(CosScene surfaces,
 
 struct IncObject {
   cv::Mat mask;               // CV_8UC1, 255 on the object
+  cv::Rect box;               // the mask's bounding box
   std::vector<int> surfaces;  // its surfaces
   int seed_surface = -1;      // the most salient one, which started it
   cv::Point seed;             // a pixel of it near its centroid
