@@ -220,24 +220,28 @@ OrganizedCloud BackProject(const RgbdFrame& frame) {
   const int w = frame.width(), h = frame.height();
   cloud.xyz.create(h, w, CV_32FC3);
   cloud.normals.create(h, w, CV_32FC3);
-  cloud.normals.setTo(cv::Scalar::all(kNaN));
   const float inv_fx = static_cast<float>(1.0 / frame.intrinsics.fx);
   const float inv_fy = static_cast<float>(1.0 / frame.intrinsics.fy);
   const float cx = static_cast<float>(frame.intrinsics.cx);
   const float cy = static_cast<float>(frame.intrinsics.cy);
-  for (int v = 0; v < h; ++v) {
-    const float* depth = frame.depth.ptr<float>(v);
-    cv::Vec3f* out = cloud.xyz.ptr<cv::Vec3f>(v);
-    const float ny = (static_cast<float>(v) - cy) * inv_fy;
-    for (int u = 0; u < w; ++u) {
-      const float z = depth[u];
-      if (std::isnan(z)) {
-        out[u] = {kNaN, kNaN, kNaN};
-      } else {
-        out[u] = {(static_cast<float>(u) - cx) * inv_fx * z, ny * z, z};
+  // Rows in parallel ranges: each writes its own rows.
+  ParallelForRanges(h, [&](int begin, int end) {
+    for (int v = begin; v < end; ++v) {
+      const float* depth = frame.depth.ptr<float>(v);
+      cv::Vec3f* out = cloud.xyz.ptr<cv::Vec3f>(v);
+      cv::Vec3f* normal = cloud.normals.ptr<cv::Vec3f>(v);
+      const float ny = (static_cast<float>(v) - cy) * inv_fy;
+      for (int u = 0; u < w; ++u) {
+        const float z = depth[u];
+        if (std::isnan(z)) {
+          out[u] = {kNaN, kNaN, kNaN};
+        } else {
+          out[u] = {(static_cast<float>(u) - cx) * inv_fx * z, ny * z, z};
+        }
+        normal[u] = {kNaN, kNaN, kNaN};
       }
     }
-  }
+  });
   BridgeThinGaps(frame.intrinsics, cloud.xyz);
   return cloud;
 }

@@ -366,6 +366,19 @@ void RegisterDetectCases(const SceneList* scenes, const std::string& set,
              benchmark::DoNotOptimize(result);
              return result.status();
            });
+  // The same from the wire frame (raw rgb8 + 16UC1, decoded in the
+  // timing): what BM_DetectGrpc/default does in the server, so the pair's
+  // ratio is the service's own cost.
+  Register("BM_DetectRaw/default" + suffix, scenes, set, sweep, kDetectMs,
+           [](const BenchScene& scene) {
+             absl::StatusOr<RgbdFrame> frame =
+                 DecodeFrame(scene.raw_wire, BenchFrameLimits());
+             if (!frame.ok()) return frame.status();
+             absl::StatusOr<DetectResult> result =
+                 RunDetect(*frame, DetectOptions{});
+             benchmark::DoNotOptimize(result);
+             return result.status();
+           });
   for (const std::string_view channels : kDetectChannelSets) {
     const absl::StatusOr<std::vector<SaliencyOp>> ops =
         ParseSaliencyOps(channels);
