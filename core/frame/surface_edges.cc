@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "core/base/parallel.h"
@@ -12,6 +15,50 @@ namespace {
 
 // Focal length the pixel radius is given at (a Kinect's).
 constexpr double kReferenceFocalPx = 525.0;
+
+// A threshold no finite value exceeds: turns a test off.
+constexpr float kNever = std::numeric_limits<float>::infinity();
+
+// The thresholds of SurfaceEdgeOptions, kNever for a test turned off.
+struct PairTest {
+  float jump_fraction;  // depth_jump_fraction
+  float concave2;       // concave_curvature^2
+  float min_curvature;  // concave_min_curvature
+};
+
+// For the `n` pairs (p[u], q[u]): out[u] |= bit where the pair lies on two
+// surfaces (a depth jump, or a sharp concave crease: SurfaceEdgeOptions).
+// p and q point into rows of six planes `stride` floats apart: x, y, z,
+// then the normal's x, y, z. Without branches, so that it vectorises:
+// every comparison with a NaN is false, so a pixel without a point or a
+// normal makes no edge, and a test with an infinite threshold never fires.
+void MarkPairs(const float* __restrict p, const float* __restrict q, int stride,
+               int n, PairTest test, uint8_t bit, uint8_t* __restrict out) {
+  const float* __restrict px = p;
+  const float* __restrict py = p + stride;
+  const float* __restrict pz = p + 2 * stride;
+  const float* __restrict pnx = p + 3 * stride;
+  const float* __restrict pny = p + 4 * stride;
+  const float* __restrict pnz = p + 5 * stride;
+  const float* __restrict qx = q;
+  const float* __restrict qy = q + stride;
+  const float* __restrict qz = q + 2 * stride;
+  const float* __restrict qnx = q + 3 * stride;
+  const float* __restrict qny = q + 4 * stride;
+  const float* __restrict qnz = q + 5 * stride;
+  for (int u = 0; u < n; ++u) {
+    const float nearer = pz[u] < qz[u] ? pz[u] : qz[u];
+    const float dx = qx[u] - px[u], dy = qy[u] - py[u], dz = qz[u] - pz[u];
+    const bool jump = (dz < 0.0f ? -dz : dz) > test.jump_fraction * nearer;
+    const float len2 = dx * dx + dy * dy + dz * dz;
+    const float dn = (qnx[u] - pnx[u]) * dx + (qny[u] - pny[u]) * dy +
+                     (qnz[u] - pnz[u]) * dz;
+    // dn / |d| < -c without the square root: dn < 0 and dn^2 > c^2 |d|^2.
+    const bool crease = (dn < 0.0f) & (dn * dn > test.concave2 * len2) &
+                        (-dn > test.min_curvature * len2);
+    out[u] |= (jump | crease) ? bit : 0;
+  }
+}
 
 }  // namespace
 
@@ -55,42 +102,47 @@ cv::Mat FindSurfaceEdges(const OrganizedCloud& cloud,
   const bool jumps = options.depth_jump_fraction > 0.0f;
   const bool creases = options.concave_curvature > 0.0f;
   const float concave2 = options.concave_curvature * options.concave_curvature;
+  const PairTest test{jumps ? options.depth_jump_fraction : kNever,
+                      creases ? concave2 : kNever,
+                      options.concave_min_curvature};
   // First, bit k of pairs(v, u): p = (u, v) and q = p + steps[k] are on two
-  // surfaces. Rows in parallel: each writes its own row.
+  // surfaces. Rows in parallel: each writes its own row. Each range keeps
+  // the rows it reads as six planes of floats (x, y, z and the normal's),
+  // a ring of the r + 1 rows from v to v + r, so that the pair test runs
+  // on contiguous arrays and vectorises.
   cv::Mat pairs(h, w, CV_8UC1, cv::Scalar(0));
   ParallelForRanges(h, [&](int begin, int end) {
+    const int ring_rows = r + 1;
+    std::vector<float> ring(static_cast<size_t>(ring_rows) * 6 * w);
+    std::vector<int> held(ring_rows, -1);  // the row in each slot
+    const auto planes = [&](int y) {
+      float* planes = &ring[static_cast<size_t>(y % ring_rows) * 6 * w];
+      if (held[y % ring_rows] != y) {
+        held[y % ring_rows] = y;
+        const cv::Vec3f* xyz = cloud.xyz.ptr<cv::Vec3f>(y);
+        const cv::Vec3f* nrm = cloud.normals.ptr<cv::Vec3f>(y);
+        for (int c = 0; c < 3; ++c) {
+          float* point = planes + c * w;
+          float* normal = planes + (3 + c) * w;
+          for (int u = 0; u < w; ++u) {
+            point[u] = xyz[u][c];
+            normal[u] = nrm[u][c];
+          }
+        }
+      }
+      return static_cast<const float*>(planes);
+    };
     for (int v = begin; v < end; ++v) {
-      const cv::Vec3f* p_xyz = cloud.xyz.ptr<cv::Vec3f>(v);
-      const cv::Vec3f* p_nrm = cloud.normals.ptr<cv::Vec3f>(v);
       uint8_t* bits = pairs.ptr<uint8_t>(v);
       for (int k = 0; k < 4; ++k) {
         const cv::Point& s = steps[k];
         if (v + s.y >= h) continue;
-        const cv::Vec3f* q_xyz = cloud.xyz.ptr<cv::Vec3f>(v + s.y) + s.x;
-        const cv::Vec3f* q_nrm = cloud.normals.ptr<cv::Vec3f>(v + s.y) + s.x;
-        const uint8_t bit = static_cast<uint8_t>(1u << k);
+        const float* p = planes(v);
+        const float* q = planes(v + s.y);
         const int u_begin = std::max(0, -s.x);
         const int u_end = std::min(w, w - s.x);
-        for (int u = u_begin; u < u_end; ++u) {
-          const cv::Vec3f& p = p_xyz[u];
-          const cv::Vec3f& q = q_xyz[u];
-          if (std::isnan(p[2]) || std::isnan(q[2])) continue;
-          bool edge = false;
-          if (jumps && std::abs(q[2] - p[2]) >
-                           options.depth_jump_fraction * std::min(p[2], q[2])) {
-            edge = true;
-          } else if (creases && !std::isnan(p_nrm[u][2]) &&
-                     !std::isnan(q_nrm[u][2])) {
-            const cv::Vec3f d = q - p;
-            const float len2 = d.dot(d);
-            const float dn = (q_nrm[u] - p_nrm[u]).dot(d);
-            // dn / |d| < -c without the square root: dn < 0 and
-            // dn^2 > c^2 |d|^2.
-            edge = dn < 0.0f && dn * dn > concave2 * len2 &&
-                   -dn > options.concave_min_curvature * len2;
-          }
-          if (edge) bits[u] |= bit;
-        }
+        MarkPairs(p + u_begin, q + u_begin + s.x, w, u_end - u_begin, test,
+                  static_cast<uint8_t>(1u << k), bits + u_begin);
       }
     }
   });
