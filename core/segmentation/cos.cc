@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
+#include "core/base/parallel.h"
 #include "core/base/status_macros.h"
 #include "core/frame/osd_pcd.h"
 
@@ -106,15 +107,34 @@ void ExtendIntoUnlabelled(const OrganizedCloud& cloud, int passes,
   // the pixels that joined are looked at.
   std::vector<std::pair<int, int>> joined;  // (pixel, its new label)
   std::vector<int> candidates;
-  for (int i = 0; i < w * h; ++i) {
-    if (label[i] < 0) candidates.push_back(i);
-  }
   std::vector<int> seen_in_pass(static_cast<size_t>(w) * h, -1);
-  for (int pass = 0; pass < passes && !candidates.empty(); ++pass) {
+  for (int pass = 0; pass < passes; ++pass) {
     joined.clear();
-    for (const int i : candidates) {
-      const int l = joins(i % w, i / w);
-      if (l >= 0) joined.emplace_back(i, l);
+    if (pass == 0) {
+      // Every pixel without a patch: rows in parallel ranges, each
+      // collecting its joins, concatenated in raster order.
+      const int ranges = std::max(1, std::min(h, ParallelThreads() * 4));
+      std::vector<std::vector<std::pair<int, int>>> found(ranges);
+      ParallelFor(ranges, [&](int r) {
+        const int first = static_cast<int>(int64_t{h} * r / ranges);
+        const int last = static_cast<int>(int64_t{h} * (r + 1) / ranges);
+        for (int v = first; v < last; ++v) {
+          for (int u = 0; u < w; ++u) {
+            if (label[v * w + u] >= 0) continue;
+            const int l = joins(u, v);
+            if (l >= 0) found[r].emplace_back(v * w + u, l);
+          }
+        }
+      });
+      for (const auto& part : found) {
+        joined.insert(joined.end(), part.begin(), part.end());
+      }
+    } else {
+      if (candidates.empty()) break;
+      for (const int i : candidates) {
+        const int l = joins(i % w, i / w);
+        if (l >= 0) joined.emplace_back(i, l);
+      }
     }
     if (joined.empty()) break;
     for (const auto& [i, l] : joined) label[i] = l;
@@ -266,24 +286,51 @@ absl::StatusOr<CosScene> BuildCosScene(const OrganizedCloud& cloud,
   for (std::vector<int>& list : scene.neighbours) {
     std::sort(list.begin(), list.end());
   }
+  // Per patch: its pixels, those on the support plane, its box. Rows in
+  // parallel ranges, each counting into its own tallies, then summed.
+  struct Tally {
+    std::vector<int> on_plane, size;
+    std::vector<cv::Vec4i> extent;
+  };
+  const int rows = scene.patches.labels.rows;
+  const int ranges = std::max(1, std::min(rows, ParallelThreads() * 4));
+  std::vector<Tally> tallies(ranges);
+  const cv::Vec4i no_extent(cloud.width(), cloud.height(), -1, -1);
+  ParallelFor(ranges, [&](int r) {
+    Tally& t = tallies[r];
+    t.on_plane.assign(n, 0);
+    t.size.assign(n, 0);
+    t.extent.assign(n, no_extent);
+    const int first = static_cast<int>(int64_t{rows} * r / ranges);
+    const int last = static_cast<int>(int64_t{rows} * (r + 1) / ranges);
+    for (int v = first; v < last; ++v) {
+      const int* label = scene.patches.labels.ptr<int>(v);
+      const uint8_t* inlier =
+          have_inliers ? plane.inliers.ptr<uint8_t>(v) : nullptr;
+      for (int u = 0; u < scene.patches.labels.cols; ++u) {
+        const int l = label[u];
+        if (l < 0) continue;
+        ++t.size[l];
+        if (inlier != nullptr && inlier[u] != 0) ++t.on_plane[l];
+        cv::Vec4i& e = t.extent[l];
+        e[0] = std::min(e[0], u);
+        e[1] = std::min(e[1], v);
+        e[2] = std::max(e[2], u);
+        e[3] = std::max(e[3], v);
+      }
+    }
+  });
   std::vector<int> on_plane(n, 0);
   std::vector<int> size(n, 0);
-  std::vector<cv::Vec4i> extent(
-      n, cv::Vec4i(cloud.width(), cloud.height(), -1, -1));
-  for (int v = 0; v < scene.patches.labels.rows; ++v) {
-    const int* label = scene.patches.labels.ptr<int>(v);
-    const uint8_t* inlier =
-        have_inliers ? plane.inliers.ptr<uint8_t>(v) : nullptr;
-    for (int u = 0; u < scene.patches.labels.cols; ++u) {
-      const int l = label[u];
-      if (l < 0) continue;
-      ++size[l];
-      if (inlier != nullptr && inlier[u] != 0) ++on_plane[l];
-      cv::Vec4i& e = extent[l];
-      e[0] = std::min(e[0], u);
-      e[1] = std::min(e[1], v);
-      e[2] = std::max(e[2], u);
-      e[3] = std::max(e[3], v);
+  std::vector<cv::Vec4i> extent(n, no_extent);
+  for (const Tally& t : tallies) {
+    for (int p = 0; p < n; ++p) {
+      on_plane[p] += t.on_plane[p];
+      size[p] += t.size[p];
+      for (int k = 0; k < 2; ++k) {
+        extent[p][k] = std::min(extent[p][k], t.extent[p][k]);
+        extent[p][k + 2] = std::max(extent[p][k + 2], t.extent[p][k + 2]);
+      }
     }
   }
   scene.label_boxes.assign(n, cv::Rect());

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/parallel.h"
 
 extern "C" {
 #include "libqhull_r/qhull_ra.h"
@@ -123,25 +124,43 @@ std::vector<std::vector<float>> LabelColorHistograms(
   cv::Mat hsv;
   cv::cvtColor(rgb, hsv, cv::COLOR_RGB2HSV);  // H in [0, 180)
   const int colored_bins = options.hue_bins * options.saturation_bins;
-  for (int v = 0; v < labels.rows; ++v) {
-    const int* label = labels.ptr<int>(v);
-    const cv::Vec3b* pixel = hsv.ptr<cv::Vec3b>(v);
-    for (int u = 0; u < labels.cols; ++u) {
-      const int l = label[u];
-      if (l < 0 || l >= label_count) continue;
-      const int h = pixel[u][0];
-      const int s = pixel[u][1];
-      const int value = pixel[u][2];
-      int bin;
-      if (s < options.min_saturation || value < options.min_value) {
-        bin = colored_bins + value * options.gray_bins / 256;
-      } else {
-        const int hb =
-            std::min(h * options.hue_bins / 180, options.hue_bins - 1);
-        const int sb = s * options.saturation_bins / 256;
-        bin = hb * options.saturation_bins + sb;
+  // Rows in parallel ranges, each counting into its own histograms (counts
+  // of whole pixels: the sums are exact in any order).
+  const int ranges = std::max(1, std::min(labels.rows, ParallelThreads() * 4));
+  std::vector<std::vector<int>> counts(ranges);
+  ParallelFor(ranges, [&](int r) {
+    std::vector<int>& count = counts[r];
+    count.assign(static_cast<size_t>(label_count) * bins, 0);
+    const int first = static_cast<int>(int64_t{labels.rows} * r / ranges);
+    const int last = static_cast<int>(int64_t{labels.rows} * (r + 1) / ranges);
+    for (int v = first; v < last; ++v) {
+      const int* label = labels.ptr<int>(v);
+      const cv::Vec3b* pixel = hsv.ptr<cv::Vec3b>(v);
+      for (int u = 0; u < labels.cols; ++u) {
+        const int l = label[u];
+        if (l < 0 || l >= label_count) continue;
+        const int h = pixel[u][0];
+        const int s = pixel[u][1];
+        const int value = pixel[u][2];
+        int bin;
+        if (s < options.min_saturation || value < options.min_value) {
+          bin = colored_bins + value * options.gray_bins / 256;
+        } else {
+          const int hb =
+              std::min(h * options.hue_bins / 180, options.hue_bins - 1);
+          const int sb = s * options.saturation_bins / 256;
+          bin = hb * options.saturation_bins + sb;
+        }
+        ++count[static_cast<size_t>(l) * bins + bin];
       }
-      histograms[l][bin] += 1.0f;
+    }
+  });
+  for (const std::vector<int>& count : counts) {
+    for (int l = 0; l < label_count; ++l) {
+      for (int b = 0; b < bins; ++b) {
+        histograms[l][b] +=
+            static_cast<float>(count[static_cast<size_t>(l) * bins + b]);
+      }
     }
   }
   return histograms;
