@@ -117,11 +117,17 @@ absl::StatusOr<IncScene> BuildIncScene(CosScene surfaces,
   // Relations are only ever asked between object surfaces (the segmenter
   // starts with the support removed, training skips it), so the support's
   // pixels, and with them most of a frame, are left out of them.
-  cv::Mat object_labels = labels.clone();
-  for (int v = 0; v < object_labels.rows; ++v) {
+  // Everything below looks only at the object surfaces' bounding box.
+  cv::Rect box;
+  for (int l = 0; l < n; ++l) {
+    if (!scene.surfaces.support[l]) box |= scene.surfaces.label_boxes[l];
+  }
+  cv::Mat object_labels(labels.size(), CV_32SC1, cv::Scalar(-1));
+  for (int v = box.y; v < box.br().y; ++v) {
+    const int* from = labels.ptr<int>(v);
     int* label = object_labels.ptr<int>(v);
-    for (int u = 0; u < object_labels.cols; ++u) {
-      if (label[u] >= 0 && scene.surfaces.support[label[u]]) label[u] = -1;
+    for (int u = box.x; u < box.br().x; ++u) {
+      if (from[u] >= 0 && !scene.surfaces.support[from[u]]) label[u] = from[u];
     }
   }
   scene.relations = std::make_unique<RelationComputer>(
@@ -129,10 +135,10 @@ absl::StatusOr<IncScene> BuildIncScene(CosScene surfaces,
   // Eq. 3.6: a surface's saliency is the mean saliency of its points.
   std::vector<double> sum(n, 0.0);
   std::vector<int> count(n, 0);
-  for (int v = 0; v < labels.rows; ++v) {
-    const int* label = labels.ptr<int>(v);
+  for (int v = box.y; v < box.br().y; ++v) {
+    const int* label = object_labels.ptr<int>(v);
     const float* s = saliency_map.ptr<float>(v);
-    for (int u = 0; u < labels.cols; ++u) {
+    for (int u = box.x; u < box.br().x; ++u) {
       const int l = label[u];
       if (l < 0) continue;
       sum[l] += std::isnan(s[u]) ? 0.0 : s[u];
@@ -144,14 +150,12 @@ absl::StatusOr<IncScene> BuildIncScene(CosScene surfaces,
   // segmenter fits when it needs them.
   scene.points.assign(n, {});
   if (options.fuse_surfaces) {
-    for (int v = 0; v < labels.rows; ++v) {
-      const int* label = labels.ptr<int>(v);
+    for (int v = box.y; v < box.br().y; ++v) {
+      const int* label = object_labels.ptr<int>(v);
       const cv::Vec3f* xyz = cloud.xyz.ptr<cv::Vec3f>(v);
-      for (int u = 0; u < labels.cols; ++u) {
+      for (int u = box.x; u < box.br().x; ++u) {
         const int l = label[u];
-        if (l < 0 || scene.surfaces.support[l] || std::isnan(xyz[u][2])) {
-          continue;
-        }
+        if (l < 0 || std::isnan(xyz[u][2])) continue;
         scene.points[l].emplace_back(xyz[u][0], xyz[u][1], xyz[u][2]);
       }
     }

@@ -62,8 +62,10 @@ absl::Status Validate(const IncOptions& options);
 struct IncScene {
   CosScene surfaces;
   std::unique_ptr<RelationComputer> relations;
-  std::vector<double> saliency;  // per surface, eq. 3.6: mean of the map
-  std::vector<int> pixels;       // per surface, in the labels image
+  // Per surface, eq. 3.6: the mean of the map over its pixels (0 for the
+  // support's, which never start or join an object).
+  std::vector<double> saliency;
+  std::vector<int> pixels;  // per surface, in the labels image (0: support)
   // Per surface, its points (none for support ones), for the surface models
   // (options.fuse_surfaces), which the segmenter fits only for the
   // surfaces an object's growth reaches, when it first reaches them.
