@@ -252,8 +252,12 @@ absl::StatusOr<PreparedScene> PrepareSceneUnguarded(
           FindSurfaceEdges(scene.cloud, options.surface_edges);
     }
     if (UsesCloudPyramid(options)) {
+      // The geometric operators read the levels' points and normals only:
+      // no colour pyramid.
+      OrganizedCloud geometry = scene.cloud;  // shares the pixels
+      geometry.color = cv::Mat();
       absl::StatusOr<CloudPyramid> built =
-          BuildCloudPyramid(scene.cloud, CloudPyramidLevels(options));
+          BuildCloudPyramid(geometry, CloudPyramidLevels(options));
       if (built.ok()) {
         scene.pyramid = *std::move(built);
       } else {
