@@ -354,6 +354,21 @@ void RegisterPeerCases(const SceneList* scenes, const std::string& set,
              benchmark::DoNotOptimize(segmentation);
              return segmentation.status();
            });
+  // The same from the raw wire frame (decode, cloud and normals timed),
+  // as SegmentIncremental starts: BM_SegmentIncrementalGrpc/all's peer.
+  Register("BM_PeerLccpRaw" + suffix, scenes, set, sweep, kPeerLccpMs,
+           [](const BenchScene& scene) -> absl::Status {
+             FOVEA_ASSIGN_OR_RETURN(
+                 RgbdFrame frame,
+                 DecodeFrame(scene.raw_wire, BenchFrameLimits()));
+             FOVEA_ASSIGN_OR_RETURN(
+                 const OrganizedCloud cloud,
+                 BuildOrganizedCloud(frame, DetectOptions{}.normals));
+             absl::StatusOr<SceneSegmentation> segmentation =
+                 SegmentSceneLccp(cloud, LccpSceneOptions{});
+             benchmark::DoNotOptimize(segmentation);
+             return segmentation.status();
+           });
 }
 
 void RegisterDetectCases(const SceneList* scenes, const std::string& set,
