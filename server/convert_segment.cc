@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -56,6 +57,54 @@ absl::StatusOr<DetectOptions> ToNestedDetectOptions(
   return detect;
 }
 
+// The request's object_points, errors naming the field.
+absl::StatusOr<ObjectPointsOptions> ToObjectPointsOptions(
+    const v1::ObjectPointsOptions& in) {
+  ObjectPointsOptions out;
+  switch (in.format()) {
+    case v1::ObjectPointsOptions::FORMAT_UNSPECIFIED:
+      out.format = ObjectPointsFormat::kNone;
+      break;
+    case v1::ObjectPointsOptions::FORMAT_INDICES:
+      out.format = ObjectPointsFormat::kIndices;
+      break;
+    case v1::ObjectPointsOptions::FORMAT_XYZ:
+      out.format = ObjectPointsFormat::kXyz;
+      break;
+    default:
+      return absl::InvalidArgumentError(
+          absl::StrCat("object_points.format: unknown value ",
+                       static_cast<int>(in.format())));
+  }
+  if (in.max_points() > static_cast<uint32_t>(kMaxObjectPoints)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("object_points.max_points must be at most ",
+                     kMaxObjectPoints, ", got ", in.max_points()));
+  }
+  out.max_points = static_cast<int>(in.max_points());
+  return out;
+}
+
+v1::Quaternion ToProtoQuaternion(const Eigen::Quaternionf& q) {
+  v1::Quaternion out;
+  out.set_x(q.x());
+  out.set_y(q.y());
+  out.set_z(q.z());
+  out.set_w(q.w());
+  return out;
+}
+
+v1::OrientedBox ToProtoBox(const OrientedBox& box) {
+  v1::OrientedBox out;
+  *out.mutable_center() = ToPoint3(box.center);
+  *out.mutable_orientation() = ToProtoQuaternion(box.orientation);
+  v1::Vector3* size = out.mutable_size();
+  size->set_x(box.size.x());
+  size->set_y(box.size.y());
+  size->set_z(box.size.z());
+  return out;
+}
+
 }  // namespace
 
 absl::StatusOr<SegmentOptions> ToSegmentOptions(
@@ -84,6 +133,8 @@ absl::StatusOr<SegmentOptions> ToSegmentOptions(
   options.max_objects =
       static_cast<int>(std::min<uint32_t>(request.max_objects(), 1u << 20));
   if (request.has_cover_scene()) options.cover_scene = request.cover_scene();
+  FOVEA_ASSIGN_OR_RETURN(options.object_points,
+                         ToObjectPointsOptions(request.object_points()));
   return options;
 }
 
@@ -105,6 +156,8 @@ absl::StatusOr<IncrementalOptions> ToIncrementalOptions(
         "time_budget_seconds: must be a finite number >= 0, got ", budget));
   }
   options.time_budget_seconds = budget;
+  FOVEA_ASSIGN_OR_RETURN(options.object_points,
+                         ToObjectPointsOptions(request.object_points()));
   return options;
 }
 
@@ -177,6 +230,38 @@ v1::SegmentResponse ToObjectMessage(const SegmentedObject& object,
   *out->mutable_centroid() = ToPoint3(object.centroid);
   *out->mutable_extent() = ToPoint3(object.extent);
   out->set_seconds_since_request(object.seconds_since_start);
+  if (object.geometry.has_value()) {
+    const ObjectGeometry& g = *object.geometry;
+    *out->mutable_oriented_box() = ToProtoBox(g.box);
+    v1::Pose* frame = out->mutable_support_frame();
+    *frame->mutable_position() = ToPoint3(g.support_origin);
+    *frame->mutable_orientation() = ToProtoQuaternion(g.support_orientation);
+    *out->mutable_box_in_support() = ToProtoBox(g.box_in_support);
+    out->set_height_above_support(g.height_above_support);
+    out->set_footprint_area(g.footprint_area_m2);
+  }
+  if (!object.point_indices.empty()) {
+    v1::ObjectPoints* points = out->mutable_points();
+    points->mutable_indices()->Reserve(
+        static_cast<int>(object.point_indices.size()));
+    for (const int i : object.point_indices) {
+      points->add_indices(static_cast<uint32_t>(i));
+    }
+    points->set_count(static_cast<uint32_t>(object.point_indices.size()));
+  } else if (!object.points.empty()) {
+    v1::ObjectPoints* points = out->mutable_points();
+    std::string* xyz = points->mutable_xyz();
+    xyz->resize(object.points.size() * 3 * sizeof(float));
+    char* at = xyz->data();
+    static_assert(sizeof(float) == 4, "float32 on the wire");
+    static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
+                  "the wire's floats are little-endian, as this machine's");
+    for (const Eigen::Vector3f& p : object.points) {
+      std::memcpy(at, p.data(), 3 * sizeof(float));
+      at += 3 * sizeof(float);
+    }
+    points->set_count(static_cast<uint32_t>(object.points.size()));
+  }
   return message;
 }
 

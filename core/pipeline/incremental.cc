@@ -143,7 +143,10 @@ absl::StatusOr<SegmentSummary> RunUnguarded(const RgbdFrame& frame,
     object.mask = std::move(next->mask);
     object.score = next->score;
     DescribeObject(scene.cloud, object, next->box);
+    DescribeGeometry(scene.cloud, scene.plane, options.box_fit,
+                     options.object_points, object, next->box);
     ObjectToInput(scene.scale, object);
+    ObjectIndicesToInput(options.object_points, object);
     object.index = summary.objects++;
     object.seconds_since_start = SecondsSince(start);
     if (sinks.object) {
@@ -189,7 +192,8 @@ absl::Status Validate(const IncrementalOptions& options) {
         absl::StrCat("time_budget_seconds must be a non-negative number, got ",
                      options.time_budget_seconds));
   }
-  return absl::OkStatus();
+  FOVEA_RETURN_IF_ERROR(Validate(options.box_fit));
+  return Validate(options.object_points);
 }
 
 cv::Mat AttentionPointsSaliency(const std::vector<cv::Point>& points,

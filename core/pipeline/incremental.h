@@ -37,6 +37,9 @@ struct IncrementalOptions {
   double min_object_area_m2 = kMinObjectAreaM2;
   double time_budget_seconds = 0.0;  // 0: no budget; checked between objects
   IncOptions inc;
+  // Each object's box on the support (SegmentedObject::geometry).
+  BoxFitOptions box_fit;
+  ObjectPointsOptions object_points;
 };
 
 // INVALID_ARGUMENT naming the field.

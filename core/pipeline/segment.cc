@@ -130,6 +130,42 @@ void DescribeObject(const OrganizedCloud& cloud, SegmentedObject& object,
   }
 }
 
+absl::Status Validate(const ObjectPointsOptions& options) {
+  if (options.max_points < 0 || options.max_points > kMaxObjectPoints) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("object_points.max_points must be in [0, ",
+                     kMaxObjectPoints, "], got ", options.max_points));
+  }
+  return absl::OkStatus();
+}
+
+void DescribeGeometry(const OrganizedCloud& cloud, const SupportPlane& plane,
+                      const BoxFitOptions& box_fit,
+                      const ObjectPointsOptions& points,
+                      SegmentedObject& object, const cv::Rect& within) {
+  std::vector<Eigen::Vector3f> visible =
+      MaskPoints(cloud, object.mask, Within(object.mask, within));
+  absl::StatusOr<ObjectGeometry> geometry =
+      FitSupportAlignedBox(visible, plane, box_fit);
+  object.geometry.reset();
+  if (geometry.ok()) object.geometry = *std::move(geometry);
+  object.points.clear();
+  if (points.format == ObjectPointsFormat::kXyz) {
+    for (const int i :
+         EvenSample(static_cast<int>(visible.size()), points.max_points)) {
+      object.points.push_back(visible[i]);
+    }
+  }
+}
+
+void ObjectIndicesToInput(const ObjectPointsOptions& points,
+                          SegmentedObject& object) {
+  object.point_indices.clear();
+  if (points.format == ObjectPointsFormat::kIndices) {
+    object.point_indices = MaskIndices(object.mask, points.max_points);
+  }
+}
+
 std::optional<cv::Point> CoverSeed(const OrganizedCloud& cloud,
                                    const cv::Mat& free, double min_area_m2,
                                    cv::Mat& piece) {
@@ -412,8 +448,11 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
     object.mask = std::move(cut->mask);
     object.score = cut->score;
     DescribeObject(scene.cloud, object);
+    DescribeGeometry(scene.cloud, scene.plane, options.box_fit,
+                     options.object_points, object, object.box);
     covered.setTo(255, object.mask);
     ObjectToInput(scene.scale, object);
+    ObjectIndicesToInput(options.object_points, object);
     object.index = summary.objects++;
     object.seconds_since_start = SecondsSince(start);
     if (sinks.object) {
@@ -524,7 +563,8 @@ absl::Status Validate(const SegmentOptions& options) {
         absl::StrCat("seeds: ", options.seeds.size(), " given, at most ",
                      kMaxAttentionPoints, " allowed"));
   }
-  return absl::OkStatus();
+  FOVEA_RETURN_IF_ERROR(Validate(options.box_fit));
+  return Validate(options.object_points);
 }
 
 absl::StatusOr<SegmentSummary> RunSegment(const RgbdFrame& frame,

@@ -17,6 +17,7 @@
 #include "core/frame/osd_pcd.h"
 #include "core/frame/rgbd_frame.h"
 #include "core/pipeline/detect.h"
+#include "core/pipeline/object_geometry.h"
 #include "core/segmentation/cos.h"
 #include "core/segmentation/ebs.h"
 #include "core/segmentation/linear_svm.h"
@@ -67,6 +68,26 @@ std::string_view SegmentMethodName(SegmentMethod method);  // "cos", "ebs"
 // A row's name; INVALID_ARGUMENT naming the known ones otherwise.
 absl::StatusOr<SegmentMethod> ParseSegmentMethod(std::string_view text);
 
+// Which of an object's points come back with it.
+enum class ObjectPointsFormat {
+  kNone,     // none
+  kIndices,  // organized indices v * width + u in the frame as sent
+  kXyz,      // 3D points, metres, camera frame (pixels with depth only)
+};
+
+struct ObjectPointsOptions {
+  ObjectPointsFormat format = ObjectPointsFormat::kNone;
+  // At most this many, evenly spread over the object in raster order; 0:
+  // all of them. [0, kMaxObjectPoints].
+  int max_points = 0;
+};
+
+// Largest ObjectPointsOptions::max_points (a 1920x1080 frame's pixels).
+inline constexpr int kMaxObjectPoints = 1920 * 1080;
+
+// INVALID_ARGUMENT naming the field ("object_points.max_points").
+absl::Status Validate(const ObjectPointsOptions& options);
+
 struct SegmentOptions {
   SegmentMethod method = SegmentMethod::kCos;
   // Seeds: these pixels (x = column u, y = row v), in this order, when not
@@ -90,6 +111,9 @@ struct SegmentOptions {
   CosOptions cos;
   // EBS's contour search at each seed.
   PolarContourOptions ebs_contour;
+  // Each object's box on the support (SegmentedObject::geometry).
+  BoxFitOptions box_fit;
+  ObjectPointsOptions object_points;
 };
 
 // INVALID_ARGUMENT naming the field: detect.*, cos.*, a negative
@@ -115,6 +139,13 @@ struct SegmentedObject {
   // and the axis-aligned size.
   Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
   Eigen::Vector3f extent = Eigen::Vector3f::Zero();
+  // The box standing on the support that holds the object's points
+  // (FitSupportAlignedBox); none when it has fewer than 3 with depth.
+  std::optional<ObjectGeometry> geometry;
+  // As ObjectPointsOptions asked: organized indices into the frame as sent,
+  // or 3D points (metres, camera frame); empty otherwise.
+  std::vector<int> point_indices;
+  std::vector<Eigen::Vector3f> points;
   double seconds_since_start = 0.0;  // since RunSegment's `start`
 };
 
@@ -123,6 +154,22 @@ struct SegmentedObject {
 // the mask (only it is looked at: the same result, sooner).
 void DescribeObject(const OrganizedCloud& cloud, SegmentedObject& object,
                     const cv::Rect& within = cv::Rect());
+
+// Fills the object's geometry (its box on `plane`) and, for
+// ObjectPointsFormat::kXyz, its points, from the mask (at the cloud's
+// size) and the cloud's points under it; `within` as DescribeObject's.
+// Indices are taken later, from the mask at the frame's size
+// (ObjectIndicesToInput).
+void DescribeGeometry(const OrganizedCloud& cloud, const SupportPlane& plane,
+                      const BoxFitOptions& box_fit,
+                      const ObjectPointsOptions& points,
+                      SegmentedObject& object,
+                      const cv::Rect& within = cv::Rect());
+
+// For ObjectPointsFormat::kIndices, the object's organized indices from its
+// mask as sent (after ObjectToInput).
+void ObjectIndicesToInput(const ObjectPointsOptions& points,
+                          SegmentedObject& object);
 
 // The share of the mask's pixels with depth that stand on `table`
 // (TableScene::standing), [0, 1] (1 for a mask without depth). `within`
