@@ -263,6 +263,25 @@ std::string DescribeSegmentMessage(const fovea::v1::SegmentResponse& message,
         o.box().height(), o.score(), FormatPoint(o.centroid()),
         FormatPoint(o.extent()), o.seed().u(), o.seed().v(),
         o.seconds_since_request() * 1e3));
+    if (o.has_oriented_box()) {
+      const fovea::v1::OrientedBox& b = o.box_in_support();
+      const fovea::v1::Quaternion& q = b.orientation();
+      // The box in the support frame turns about z only.
+      const double yaw_deg =
+          2.0 * std::atan2(q.z(), q.w()) * 180.0 / 3.14159265358979323846;
+      parts.push_back(absl::StrFormat(
+          "  on the support: box %.3f x %.3f x %.3f m, yaw %.0f deg, top "
+          "%.3f m above it, footprint %.4f m^2, centre %s m (camera)",
+          b.size().x(), b.size().y(), b.size().z(), yaw_deg,
+          o.height_above_support(), o.footprint_area(),
+          FormatPoint(o.oriented_box().center())));
+    }
+    if (o.points().count() > 0) {
+      parts.push_back(absl::StrFormat("  %d points (%s)", o.points().count(),
+                                      o.points().indices_size() > 0
+                                          ? "organized indices"
+                                          : "xyz, float32"));
+    }
   }
   if (message.last()) {
     const fovea::v1::SegmentSummary& s = message.summary();

@@ -97,6 +97,12 @@ ABSL_FLAG(std::string, seeds, "",
           "the server's attention points (e.g. where a person pointed); "
           "segment-incremental: attention points, a Gaussian of saliency at "
           "each, the first the most salient");
+ABSL_FLAG(std::string, object_points, "",
+          "segment: each object's points too: xyz (float32, metres, camera "
+          "frame) | indices (v * width + u); empty: none");
+ABSL_FLAG(int32_t, max_points, 0,
+          "segment: with --object_points, at most this many per object, "
+          "evenly spread (0: all)");
 ABSL_FLAG(double, time_budget_ms, 0.0,
           "segment-incremental: time budget, milliseconds, 0 = none");
 
@@ -297,6 +303,22 @@ absl::StatusOr<SegmentParameters> SegmentParametersFromFlags() {
         "max_objects, time_budget_ms: must be >= 0");
   }
   FOVEA_ASSIGN_OR_RETURN(segment.seeds, ParseSeeds(absl::GetFlag(FLAGS_seeds)));
+  const std::string points = absl::GetFlag(FLAGS_object_points);
+  if (points == "xyz") {
+    segment.object_points.set_format(
+        fovea::v1::ObjectPointsOptions::FORMAT_XYZ);
+  } else if (points == "indices") {
+    segment.object_points.set_format(
+        fovea::v1::ObjectPointsOptions::FORMAT_INDICES);
+  } else if (!points.empty()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--object_points: '", points, "' is not xyz or indices"));
+  }
+  if (absl::GetFlag(FLAGS_max_points) < 0) {
+    return absl::InvalidArgumentError("--max_points: must be >= 0");
+  }
+  segment.object_points.set_max_points(
+      static_cast<uint32_t>(absl::GetFlag(FLAGS_max_points)));
   return segment;
 }
 

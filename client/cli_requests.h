@@ -46,6 +46,8 @@ struct SegmentParameters {
   double time_budget_ms = 0.0;  // --time_budget_ms, >= 0; 0 = none
   // --seeds: pixels (u, v) = (column, row), in the order given.
   std::vector<std::pair<uint32_t, uint32_t>> seeds;
+  // --object_points (xyz | indices) and --max_points: each object's points.
+  fovea::v1::ObjectPointsOptions object_points;
 };
 
 // The segmentation flags; INVALID_ARGUMENT naming a bad one (an unknown

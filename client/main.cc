@@ -279,6 +279,7 @@ int RunSegment(bool incremental) {
     *request.mutable_detect_options() = *std::move(options);
     request.set_max_objects(static_cast<uint32_t>(segment->max_objects));
     request.set_time_budget_seconds(segment->time_budget_ms / 1e3);
+    *request.mutable_object_points() = segment->object_points;
     for (const auto& [u, v] : segment->seeds) {
       fovea::v1::AttentionPixel* point = request.add_attention_points();
       point->set_u(u);
@@ -293,6 +294,7 @@ int RunSegment(bool incremental) {
     *request.mutable_detect_options() = *std::move(options);
     request.set_method(segment->method);
     request.set_max_objects(static_cast<uint32_t>(segment->max_objects));
+    *request.mutable_object_points() = segment->object_points;
     for (const auto& [u, v] : segment->seeds) {
       fovea::v1::AttentionPixel* seed = request.add_seeds();
       seed->set_u(u);

@@ -17,7 +17,7 @@ import sys
 import grpc
 import numpy as np
 
-from fovea_client import FoveaClient, decode_rle, frame_from_files
+from fovea_client import FoveaClient, decode_rle, frame_from_files, object_box
 from fovea.v1 import detect_pb2, segment_pb2
 
 # Intrinsics of a 640x480 Kinect-like camera, pixels.
@@ -133,6 +133,15 @@ def main(argv):
                           f"{b.width}x{b.height}, centroid ({c.x:.3f}, "
                           f"{c.y:.3f}, {c.z:.3f}) m, score {o.score:.2f}, "
                           f"{o.seconds_since_request:.3f} s")
+                    box = object_box(o)
+                    if box is not None:
+                        yaw = np.degrees(np.arctan2(
+                            box.rotation_in_support[1, 0],
+                            box.rotation_in_support[0, 0]))
+                        print(f"  box on the support: {box.size[0]:.3f} x "
+                              f"{box.size[1]:.3f} x {box.size[2]:.3f} m, "
+                              f"yaw {yaw:.0f} deg, top "
+                              f"{box.height_above_support:.3f} m above it")
                 if response.last:
                     s = response.summary
                     print(f"done: {s.object_count} objects, stop "

@@ -5,8 +5,10 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <future>
 #include <memory>
 #include <string>
@@ -530,6 +532,89 @@ TEST_F(ServerTest, SegmentStreamsPointsThenObjectsThenTheSummary) {
   EXPECT_EQ(MetricValue(text, "grpc_server_msg_sent_total",
                         {"grpc_method=\"Segment\""}),
             static_cast<double>(call.messages.size()));
+}
+
+// Every object comes with its box standing on the support (the box's z
+// axis is the support frame's, its base on the plane for an object on the
+// table, above it for one resting on another), and with the points asked
+// for: indices into the frame that lie
+// in the object's mask, or float32 triples on the object's box.
+TEST_F(ServerTest, ObjectsCarryTheirBoxOnTheSupportAndThePointsAskedFor) {
+  StartServer();
+  v1::SegmentIncrementalRequest request;
+  *request.mutable_frame() = MakeSyntheticRequest(3, false).request.frame();
+  request.mutable_object_points()->set_format(
+      v1::ObjectPointsOptions::FORMAT_XYZ);
+  request.mutable_object_points()->set_max_points(200);
+  grpc::ClientContext context;
+  auto reader = stub_->SegmentIncremental(&context, request);
+  std::vector<v1::SegmentResponse> messages;
+  v1::SegmentResponse response;
+  while (reader->Read(&response)) messages.push_back(response);
+  ASSERT_TRUE(reader->Finish().ok());
+  ASSERT_GE(messages.size(), 3u);
+  for (size_t i = 1; i + 1 < messages.size(); ++i) {
+    const v1::ObjectResult& object = messages[i].object();
+    ASSERT_TRUE(object.has_oriented_box()) << i;
+    const v1::OrientedBox& box = object.oriented_box();
+    EXPECT_GT(box.size().x(), 0.01);
+    EXPECT_GE(box.size().x(), box.size().y());
+    const Eigen::Quaterniond q(box.orientation().w(), box.orientation().x(),
+                               box.orientation().y(), box.orientation().z());
+    EXPECT_NEAR(q.norm(), 1.0, 1e-6);
+    const Eigen::Quaterniond s(object.support_frame().orientation().w(),
+                               object.support_frame().orientation().x(),
+                               object.support_frame().orientation().y(),
+                               object.support_frame().orientation().z());
+    // Both z axes are the support normal.
+    EXPECT_GT((q * Eigen::Vector3d::UnitZ()).dot(s * Eigen::Vector3d::UnitZ()),
+              0.9999);
+    // The top above the plane: the box's height for an object on the
+    // table, more for one resting on another.
+    EXPECT_GE(object.height_above_support(), box.size().z() - 1e-6);
+    EXPECT_NEAR(object.footprint_area(), box.size().x() * box.size().y(), 1e-9);
+    // The xyz points: at most 200, each inside the box (with the trimmed
+    // 1 % of heights a few mm out).
+    const v1::ObjectPoints& points = object.points();
+    ASSERT_GT(points.count(), 0u);
+    EXPECT_LE(points.count(), 200u);
+    ASSERT_EQ(points.xyz().size(), points.count() * 12u);
+    EXPECT_EQ(points.indices_size(), 0);
+    const Eigen::Vector3d centre(box.center().x(), box.center().y(),
+                                 box.center().z());
+    int inside = 0;
+    for (uint32_t k = 0; k < points.count(); ++k) {
+      float xyz[3];
+      std::memcpy(xyz, points.xyz().data() + 12 * k, sizeof xyz);
+      const Eigen::Vector3d local =
+          q.conjugate() * (Eigen::Vector3d(xyz[0], xyz[1], xyz[2]) - centre);
+      inside += std::abs(local.x()) <= box.size().x() / 2 + 0.005 &&
+                std::abs(local.y()) <= box.size().y() / 2 + 0.005 &&
+                std::abs(local.z()) <= box.size().z() / 2 + 0.005;
+    }
+    EXPECT_GT(inside, static_cast<int>(points.count() * 0.95)) << i;
+  }
+  // Indices, as many as the mask has pixels, each on the mask.
+  v1::SegmentRequest segment;
+  *segment.mutable_frame() = request.frame();
+  segment.mutable_object_points()->set_format(
+      v1::ObjectPointsOptions::FORMAT_INDICES);
+  const SegmentCall call = CallSegment(*stub_, segment);
+  ASSERT_TRUE(call.status.ok()) << call.status.error_message();
+  ASSERT_GE(call.messages.size(), 3u);
+  const v1::ObjectResult& first = call.messages[1].object();
+  EXPECT_EQ(first.points().count(), first.area());
+  EXPECT_EQ(first.points().indices_size(), static_cast<int>(first.area()));
+  const uint32_t index = first.points().indices(first.area() / 2);
+  const cv::Rect box(first.box().u(), first.box().v(), first.box().width(),
+                     first.box().height());
+  EXPECT_TRUE(box.contains(cv::Point(index % 640, index / 640)));
+  // Too many points asked for is refused naming the field.
+  segment.mutable_object_points()->set_max_points(1u << 30);
+  const SegmentCall refused = CallSegment(*stub_, segment);
+  EXPECT_EQ(refused.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(refused.status.error_message(),
+              HasSubstr("object_points.max_points"));
 }
 
 TEST_F(ServerTest, SegmentKeepsGivenSeedsAndStopsAtMaxObjects) {

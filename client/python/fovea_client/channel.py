@@ -9,12 +9,13 @@ retried on UNAVAILABLE before any reply arrived.
 
 import ipaddress
 import json
+from typing import Any, List, Tuple
 
 HEALTH_CHECKED_SERVICE = "fovea.v1.Perception"
 MOST_ATTEMPTS = 5  # gRPC ignores more
 
 
-def channel_target(servers):
+def channel_target(servers: str) -> str:
     """The gRPC target for `servers`; ValueError naming a bad entry.
 
     One target passes unchanged (a DNS name reaches every address it
@@ -65,7 +66,8 @@ def channel_target(servers):
     return ("ipv6:" if 6 in families else "ipv4:") + ",".join(entries)
 
 
-def channel_options(max_message_bytes, max_attempts=4, balanced=True):
+def channel_options(max_message_bytes: int, max_attempts: int = 4,
+                    balanced: bool = True) -> List[Tuple[str, Any]]:
     """grpc channel options: message sizes and the service config.
 
     balanced: round robin over the SERVING replicas with retries on

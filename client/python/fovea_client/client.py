@@ -1,6 +1,9 @@
 """A small blocking client for fovea.v1.Perception (perception.proto)."""
 
+from typing import Any, Iterator, Optional, Sequence, Tuple
+
 import grpc
+import numpy as np
 
 from fovea.health.v1 import health_pb2
 from fovea.v1 import detect_pb2, perception_pb2, perception_pb2_grpc, segment_pb2
@@ -14,7 +17,7 @@ _HEALTH_CHECK = "/grpc.health.v1.Health/Check"
 _MAX_MESSAGE_BYTES = 64 * 1024 * 1024
 
 
-def detect_options(**options):
+def detect_options(**options: Any) -> detect_pb2.DetectOptions:
     """DetectOptions (detect.proto) from keyword arguments.
 
     Fields are named as in the proto: max_points=5, extraction="MSR",
@@ -33,6 +36,18 @@ def detect_options(**options):
     return message
 
 
+def _points_options(object_points: Optional[str],
+                    max_points: int) -> segment_pb2.ObjectPointsOptions:
+    """ObjectPointsOptions from "xyz", "indices" or None."""
+    formats = {None: "FORMAT_UNSPECIFIED", "xyz": "FORMAT_XYZ",
+               "indices": "FORMAT_INDICES"}
+    if object_points not in formats:
+        raise ValueError(f"object_points: {object_points!r} is not 'xyz', "
+                         "'indices' or None")
+    return segment_pb2.ObjectPointsOptions(format=formats[object_points],
+                                           max_points=max_points)
+
+
 class FoveaClient:
     """Channels to a Fovea server or its replicas.
 
@@ -47,8 +62,10 @@ class FoveaClient:
     deadline). With `channel`, every call goes through it as it is.
     """
 
-    def __init__(self, target, channel=None, max_attempts=4, tls_ca=None,
-                 tls_cert=None, tls_key=None):
+    def __init__(self, target: str, channel: Optional[grpc.Channel] = None,
+                 max_attempts: int = 4, tls_ca: Optional[bytes] = None,
+                 tls_cert: Optional[bytes] = None,
+                 tls_key: Optional[bytes] = None) -> None:
         """tls_ca: PEM bytes of the CAs to trust; given, the channel uses
         TLS. tls_cert, tls_key: PEM bytes of a client certificate and its
         key, for a server that requires one (mutual TLS)."""
@@ -80,30 +97,34 @@ class FoveaClient:
             request_serializer=health_pb2.HealthCheckRequest.SerializeToString,
             response_deserializer=health_pb2.HealthCheckResponse.FromString)
 
-    def close(self):
+    def close(self) -> None:
         self._channel.close()
         if self._health_channel is not self._channel:
             self._health_channel.close()
 
-    def __enter__(self):
+    def __enter__(self) -> "FoveaClient":
         return self
 
-    def __exit__(self, *exc):
+    def __exit__(self, *exc: Any) -> None:
         self.close()
 
-    def health(self, service="fovea.v1.Perception", timeout=5.0):
+    def health(self, service: str = "fovea.v1.Perception",
+               timeout: Optional[float] = 5.0) -> str:
         """The grpc.health.v1 status name, e.g. "SERVING"."""
         response = self._health(
             health_pb2.HealthCheckRequest(service=service), timeout=timeout)
         return health_pb2.HealthCheckResponse.ServingStatus.Name(response.status)
 
-    def capabilities(self, timeout=None):
+    def capabilities(self, timeout: Optional[float] = None
+                     ) -> perception_pb2.Capabilities:
         """The server's Capabilities (perception.proto)."""
         return self._stub.GetCapabilities(
             perception_pb2.GetCapabilitiesRequest(), timeout=timeout)
 
-    def detect(self, color_rgb, depth_m, fx, fy, cx, cy, timeout=None,
-               request_id="", **options):
+    def detect(self, color_rgb: np.ndarray, depth_m: np.ndarray, fx: float,
+               fy: float, cx: float, cy: float,
+               timeout: Optional[float] = None, request_id: str = "",
+               **options: Any) -> detect_pb2.DetectResponse:
         """Attention points for one frame: a DetectResponse (detect.proto).
 
         color_rgb: (H, W, 3) uint8 RGB; depth_m: (H, W) float32 metres
@@ -116,13 +137,20 @@ class FoveaClient:
             options=detect_options(**options))
         return self.detect_request(request, timeout=timeout)
 
-    def detect_request(self, request, timeout=None):
+    def detect_request(self, request: detect_pb2.DetectRequest,
+                       timeout: Optional[float] = None
+                       ) -> detect_pb2.DetectResponse:
         """Detect with a ready DetectRequest (e.g. a frame_from_files one)."""
         return self._stub.Detect(request, timeout=timeout)
 
-    def segment(self, color_rgb, depth_m, fx, fy, cx, cy, method="COS",
-                max_objects=0, seeds=(), timeout=None, request_id="",
-                cover_scene=None, **options):
+    def segment(self, color_rgb: np.ndarray, depth_m: np.ndarray, fx: float,
+                fy: float, cx: float, cy: float, method: str = "COS",
+                max_objects: int = 0,
+                seeds: Sequence[Tuple[int, int]] = (),
+                timeout: Optional[float] = None, request_id: str = "",
+                cover_scene: Optional[bool] = None,
+                object_points: Optional[str] = None, max_points: int = 0,
+                **options: Any) -> Iterator[segment_pb2.SegmentResponse]:
         """Object masks for one frame, as a generator of SegmentResponse.
 
         Messages are yielded as they arrive: first the attention points,
@@ -131,6 +159,9 @@ class FoveaClient:
         or "EBS". seeds: (u, v) pixels to use instead of attention points.
         cover_scene: after the seeds, seed what no mask holds yet (None:
         the server's default, on without seeds, off with them).
+        object_points: "xyz" or "indices" for each object's points (see
+        object_points()), at most max_points of them (0: all); every
+        object carries its box on the support either way (object_box()).
         `options` are DetectOptions fields for the attention points.
         Breaking out of the loop early cancels the call.
         """
@@ -139,29 +170,40 @@ class FoveaClient:
             frame=frame_from_numpy(color_rgb, depth_m, fx, fy, cx, cy),
             method=method, max_objects=max_objects,
             seeds=[detect_pb2.AttentionPixel(u=u, v=v) for u, v in seeds],
-            detect_options=detect_options(**options))
+            detect_options=detect_options(**options),
+            object_points=_points_options(object_points, max_points))
         if cover_scene is not None:
             request.cover_scene = cover_scene
         return self.segment_request(request, timeout=timeout)
 
-    def segment_request(self, request, timeout=None):
+    def segment_request(self, request: segment_pb2.SegmentRequest,
+                        timeout: Optional[float] = None
+                        ) -> Iterator[segment_pb2.SegmentResponse]:
         """Segment with a ready SegmentRequest; a generator as segment()."""
         return self._stream(self._stub.Segment(request, timeout=timeout))
 
-    def segment_incremental(self, color_rgb, depth_m, fx, fy, cx, cy,
-                            max_objects=0, time_budget_seconds=0.0,
-                            timeout=None, request_id="", **options):
-        """Anytime incremental segmentation (INC); a generator as segment()."""
+    def segment_incremental(self, color_rgb: np.ndarray, depth_m: np.ndarray,
+                            fx: float, fy: float, cx: float, cy: float,
+                            max_objects: int = 0,
+                            time_budget_seconds: float = 0.0,
+                            timeout: Optional[float] = None,
+                            request_id: str = "",
+                            object_points: Optional[str] = None,
+                            max_points: int = 0, **options: Any
+                            ) -> Iterator[segment_pb2.SegmentResponse]:
+        """Anytime incremental segmentation (INC); a generator as segment()
+        (object_points and max_points as there)."""
         request = segment_pb2.SegmentIncrementalRequest(
             request_id=request_id,
             frame=frame_from_numpy(color_rgb, depth_m, fx, fy, cx, cy),
             max_objects=max_objects, time_budget_seconds=time_budget_seconds,
-            detect_options=detect_options(**options))
+            detect_options=detect_options(**options),
+            object_points=_points_options(object_points, max_points))
         return self._stream(
             self._stub.SegmentIncremental(request, timeout=timeout))
 
     @staticmethod
-    def _stream(call):
+    def _stream(call: Any) -> Iterator[segment_pb2.SegmentResponse]:
         try:
             yield from call
         finally:

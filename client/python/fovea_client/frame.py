@@ -15,8 +15,10 @@ def _raw_image(array, encoding):
         step=data.strides[0], data=data.tobytes())
 
 
-def frame_from_numpy(color_rgb, depth, fx, fy, cx, cy, depth_scale=0.001,
-                     frame_id="", stamp_ns=0):
+def frame_from_numpy(color_rgb: np.ndarray, depth: np.ndarray, fx: float,
+                     fy: float, cx: float, cy: float,
+                     depth_scale: float = 0.001, frame_id: str = "",
+                     stamp_ns: int = 0) -> frame_pb2.Frame:
     """A Frame from a colour and a depth array of the same size.
 
     color_rgb: (H, W, 3) uint8, RGB order; sent as raw "rgb8".
@@ -53,8 +55,10 @@ def frame_from_numpy(color_rgb, depth, fx, fy, cx, cy, depth_scale=0.001,
         depth_scale=depth_scale, frame_id=frame_id, stamp_ns=stamp_ns)
 
 
-def frame_from_files(color_bytes, depth_bytes, fx, fy, cx, cy,
-                     depth_scale=0.001, frame_id="", stamp_ns=0):
+def frame_from_files(color_bytes: bytes, depth_bytes: bytes, fx: float,
+                     fy: float, cx: float, cy: float,
+                     depth_scale: float = 0.001, frame_id: str = "",
+                     stamp_ns: int = 0) -> frame_pb2.Frame:
     """A Frame from whole PNG/JPEG files, sent as they are (compressed form).
 
     color_bytes: a PNG or JPEG colour image. depth_bytes: a 16-bit grey PNG

@@ -10,7 +10,7 @@ import numpy as np
 from fovea.v1 import segment_pb2
 
 
-def decode_rle(rle):
+def decode_rle(rle: segment_pb2.RleMask) -> np.ndarray:
     """Decodes an RleMask into a boolean array of shape (height, width).
 
     Raises ValueError when the runs do not cover height * width pixels
@@ -30,7 +30,7 @@ def decode_rle(rle):
     return flat.reshape((width, height)).T.copy()
 
 
-def encode_rle(mask):
+def encode_rle(mask: np.ndarray) -> segment_pb2.RleMask:
     """Encodes a 2-D mask (any dtype; non-zero is inside) as an RleMask.
 
     The inverse of decode_rle. Raises ValueError for an array that is not
