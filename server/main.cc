@@ -101,6 +101,16 @@ ABSL_FLAG(
     "Folder of the trained models (cos_svm.txt, ...; see models/README.md). "
     "The server does not start without them.");
 ABSL_FLAG(std::string, log_level, "info", "debug, info, warn or error.");
+ABSL_FLAG(std::string, record_dir, "",
+          "Flight recorder: keep recorded calls (frames as PNG, requests and "
+          "responses as JSON) in this folder, for fovea-eval replay. Empty: "
+          "off.");
+ABSL_FLAG(int, record_max_mb, 1024,
+          "The flight recorder's files never take more than this many MiB: "
+          "the oldest records go first.");
+ABSL_FLAG(double, record_sample, 1.0,
+          "The share of calls the flight recorder keeps, (0, 1]: 0.1 keeps "
+          "every tenth.");
 
 int main(int argc, char** argv) {
   absl::SetProgramUsageMessage(
@@ -147,7 +157,10 @@ int main(int argc, char** argv) {
        "tls_key",
        "tls_client_ca",
        "models_dir",
-       "log_level"},
+       "log_level",
+       "record_dir",
+       "record_max_mb",
+       "record_sample"},
       [](const char* name) { return std::getenv(name); });
   if (!from_env.ok()) {
     LogError(from_env.ToString());
@@ -205,6 +218,9 @@ int main(int argc, char** argv) {
   config.tls_key = absl::GetFlag(FLAGS_tls_key);
   config.tls_client_ca = absl::GetFlag(FLAGS_tls_client_ca);
   config.models_dir = absl::GetFlag(FLAGS_models_dir);
+  config.record_dir = absl::GetFlag(FLAGS_record_dir);
+  config.record_max_bytes = int64_t{absl::GetFlag(FLAGS_record_max_mb)} << 20;
+  config.record_sample = absl::GetFlag(FLAGS_record_sample);
 
   absl::StatusOr<std::unique_ptr<fovea::server::FoveaServer>> server =
       fovea::server::FoveaServer::Start(config);

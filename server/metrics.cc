@@ -102,6 +102,11 @@ class Metrics {
     return shed_family_.Add({{"reason", std::string(reason)}});
   }
 
+  prometheus::Counter& Recorded(std::string_view outcome) {
+    return recorder_family_.Add({{"outcome", std::string(outcome)}});
+  }
+  prometheus::Gauge& recorder_bytes() { return recorder_bytes_; }
+
   prometheus::Gauge& inflight() { return inflight_; }
   prometheus::Gauge& open_fds() { return open_fds_; }
   prometheus::Gauge& fd_limit() { return fd_limit_; }
@@ -197,6 +202,19 @@ class Metrics {
                         .Help("Time a Detect job waited for a worker, seconds.")
                         .Register(*registry_)
                         .Add({}, StageBuckets())),
+        recorder_family_(prometheus::BuildCounter()
+                             .Name("fovea_recorder_records_total")
+                             .Help("Calls the flight recorder handled, by "
+                                   "outcome: written, written_without_frame, "
+                                   "queue_full (dropped: the writer was "
+                                   "behind), too_large, error.")
+                             .Register(*registry_)),
+        recorder_bytes_(prometheus::BuildGauge()
+                            .Name("fovea_recorder_bytes")
+                            .Help("Bytes the flight recorder's files take "
+                                  "(at most --record_max_mb).")
+                            .Register(*registry_)
+                            .Add({})),
         build_info_family_(prometheus::BuildGauge()
                                .Name("fovea_build_info")
                                .Help("Always 1; the label is the server "
@@ -247,6 +265,8 @@ class Metrics {
   prometheus::Counter& refused_;
   prometheus::Gauge& inflight_;
   prometheus::Histogram& queue_wait_;
+  prometheus::Family<prometheus::Counter>& recorder_family_;
+  prometheus::Gauge& recorder_bytes_;
   prometheus::Family<prometheus::Gauge>& build_info_family_;
   std::array<MethodSeries, kMethods.size()> methods_;
 };
@@ -324,6 +344,14 @@ void RecordDescriptors(int open, int limit, int64_t refused_total) {
   const double delta =
       static_cast<double>(refused_total) - metrics.refused().Value();
   if (delta > 0) metrics.refused().Increment(delta);
+}
+
+void RecordRecorderOutcome(std::string_view outcome) {
+  Metrics::Get().Recorded(outcome).Increment();
+}
+
+void SetRecorderBytes(int64_t bytes) {
+  Metrics::Get().recorder_bytes().Set(static_cast<double>(bytes));
 }
 
 void IncrementInflight() { Metrics::Get().inflight().Increment(); }

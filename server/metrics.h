@@ -90,6 +90,11 @@ void DecrementInflight();
 // fovea_connections_refused_total (counter, set to `refused_total`:
 // connections the accept guard closed or delayed).
 void RecordDescriptors(int open, int limit, int64_t refused_total);
+// The flight recorder (flight_recorder.h): fovea_recorder_records_total
+// {outcome} (written, written_without_frame, queue_full, too_large, error)
+// and fovea_recorder_bytes, the size of what it holds on disk.
+void RecordRecorderOutcome(std::string_view outcome);
+void SetRecorderBytes(int64_t bytes);
 
 // The registry in Prometheus' text format, as /metrics serves it.
 std::string MetricsText();

@@ -17,6 +17,8 @@
 #include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/time/clock.h"
+#include "absl/time/time.h"
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/base/tsan.h"
@@ -60,6 +62,7 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
     }
     options_ = *std::move(options);
     submitted_ = Clock::now();
+    record_ = config.recorder != nullptr && config.recorder->ShouldRecord();
     TsanHappensBefore(this);  // before the reactions (OnCancel)
     // The worker sees all of this through the queue's lock.
     if (!SubmitGated(work, gate_, [this] { Run(); })) {
@@ -88,6 +91,22 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
   // cannot see it; they are empty in other builds.)
   void OnDone() override {
     TsanHappensAfter(this);
+    if (record_) {
+      // The call is over: its request and answer go to the recorder (the
+      // response is gRPC's, deleted after this; it was sent already).
+      RecordedCall recorded;
+      recorded.method = "Detect";
+      recorded.request = std::move(request_);
+      if (end_code_ == absl::StatusCode::kOk) {
+        auto response = std::make_unique<v1::DetectResponse>();
+        response->Swap(response_);
+        recorded.responses.push_back(std::move(response));
+      }
+      recorded.code = absl::StatusCodeToString(end_code_);
+      recorded.seconds = SecondsSince(start_);
+      recorded.unix_micros = absl::ToUnixMicros(absl::Now());
+      config_.recorder->Submit(std::move(recorded));
+    }
     TsanHappensBefore(&config_);  // before the service's destruction
     delete this;
   }
@@ -137,6 +156,7 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
 
   // The last thing the reactor does: OnDone may delete it right after.
   void Complete(const absl::Status& status) {
+    end_code_ = status.code();
     const grpc::Status end = call_.EndUnary(status);
     TsanHappensBefore(this);  // before OnDone
     Finish(end);
@@ -145,11 +165,15 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
   const ServiceConfig& config_;  // the service's; outlives every call
   // gRPC's, valid until OnDone.
   grpc::CallbackServerContext* const context_;
-  const std::unique_ptr<const v1::DetectRequest> request_;
+  // Moved to the recorder in OnDone, when recorded.
+  std::unique_ptr<const v1::DetectRequest> request_;
   v1::DetectResponse* const response_;  // gRPC's, valid until OnDone
   CallRecord call_;
+  const Clock::time_point start_ = Clock::now();
   DetectOptions options_;
   Clock::time_point submitted_;
+  bool record_ = false;  // offered to config_.recorder when done
+  absl::StatusCode end_code_ = absl::StatusCode::kUnknown;
   const std::shared_ptr<JobGate> gate_ = std::make_shared<JobGate>();
 };
 
@@ -196,6 +220,7 @@ class StreamReactor final
       return;
     }
     options_ = *std::move(options);
+    record_ = config.recorder != nullptr && config.recorder->ShouldRecord();
     TsanHappensBefore(this);  // before the reactions (OnCancel, ...)
     if (!SubmitGated(work, gate_, [this] { Run(); })) {
       FinishOnce(absl::ResourceExhaustedError(
@@ -253,6 +278,19 @@ class StreamReactor final
 
   void OnDone() override {
     TsanHappensAfter(this);
+    if (record_) {
+      RecordedCall recorded;
+      recorded.method = std::string(method_);
+      recorded.request = std::move(request_);
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        recorded.responses = std::move(recorded_);
+      }
+      recorded.code = absl::StatusCodeToString(end_code_);
+      recorded.seconds = SecondsSince(start_);
+      recorded.unix_micros = absl::ToUnixMicros(absl::Now());
+      config_.recorder->Submit(std::move(recorded));
+    }
     TsanHappensBefore(&config_);  // before the service's destruction
     delete this;
   }
@@ -313,6 +351,9 @@ class StreamReactor final
               pending_bytes_ + bytes <= kMaxPendingBytes);
     });
     if (broken_) return BrokenStatus();
+    if (record_) {
+      recorded_.push_back(std::make_unique<v1::SegmentResponse>(message));
+    }
     pending_bytes_ += bytes;
     pending_.push_back(std::move(message));
     if (!writing_) StartNextWriteLocked();
@@ -375,6 +416,7 @@ class StreamReactor final
   // Records the call's end and finishes it: the reactor's last touch, as
   // OnDone may delete it right after.
   void EndCall(const absl::Status& status) {
+    end_code_ = status.code();
     const grpc::Status end = call_.EndStream(status);
     TsanHappensBefore(this);
     Finish(end);
@@ -405,10 +447,15 @@ class StreamReactor final
   const Handle handle_;
   const ServiceConfig& config_;
   grpc::CallbackServerContext* const context_;  // gRPC's, valid until OnDone
-  const std::unique_ptr<const Request> request_;
+  // Moved to the recorder in OnDone, when recorded.
+  std::unique_ptr<const Request> request_;
   CallRecord call_;
   const Clock::time_point start_;
   Options options_;
+  bool record_ = false;  // offered to config_.recorder when done
+  absl::StatusCode end_code_ = absl::StatusCode::kUnknown;
+  // When recorded, a copy of each message sent; guarded by mutex_.
+  std::vector<std::unique_ptr<const google::protobuf::Message>> recorded_;
 
   std::mutex mutex_;
   std::condition_variable changed_;

@@ -12,6 +12,7 @@
 #include "core/frame/frame_decode.h"
 #include "core/pipeline/segment.h"
 #include "fovea/v1/perception.grpc.pb.h"
+#include "server/flight_recorder.h"
 #include "server/work_queue.h"
 
 namespace fovea::server {
@@ -51,6 +52,10 @@ struct ServiceConfig {
   // (name, version) pairs for GetCapabilities.
   SegmentModels segment_models;
   std::vector<std::pair<std::string, std::string>> model_versions;
+  // The flight recorder (not owned: it outlives the service), or null:
+  // then no call is recorded. Detect, Segment and SegmentIncremental calls
+  // that start work are offered to it as they end (flight_recorder.h).
+  FlightRecorder* recorder = nullptr;
 };
 
 // fovea.v1.Perception on gRPC's callback API. Handlers are thin: they

@@ -166,6 +166,15 @@ absl::Status Validate(const ServerConfig& config) {
   if (config.listen.empty()) {
     return absl::InvalidArgumentError("--listen: empty, expected host:port");
   }
+  if (!config.record_dir.empty()) {
+    RecorderConfig recorder;
+    recorder.dir = config.record_dir;
+    recorder.max_bytes = config.record_max_bytes;
+    recorder.sample = config.record_sample;
+    if (absl::Status s = Validate(recorder); !s.ok()) {
+      return absl::InvalidArgumentError(absl::StrCat("--", s.message()));
+    }
+  }
   if (config.concurrency < 1) {
     return absl::InvalidArgumentError(
         absl::StrCat("--concurrency: ", config.concurrency, " is below 1"));
@@ -268,6 +277,14 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
   service.on_stream_cancelled = config.on_stream_cancelled;
   service.segment_models = server->models_->View();
   service.model_versions = server->models_->versions;
+  if (!config.record_dir.empty()) {
+    RecorderConfig recorder;
+    recorder.dir = config.record_dir;
+    recorder.max_bytes = config.record_max_bytes;
+    recorder.sample = config.record_sample;
+    FOVEA_ASSIGN_OR_RETURN(server->recorder_, FlightRecorder::Start(recorder));
+    service.recorder = server->recorder_.get();
+  }
   server->service_ = std::make_unique<PerceptionService>(std::move(service),
                                                          server->work_.get());
 
@@ -322,6 +339,14 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
       config.queue, config.max_message_bytes,
       static_cast<int>(config.memory_quota_bytes >> 20),
       config.limits.max_width, config.limits.max_height));
+  if (server->recorder_ != nullptr) {
+    LogInfo(absl::StrFormat(
+        "flight recorder: %.0f %% of the calls into %s, at most %d MiB (%d "
+        "MiB held now)",
+        100.0 * config.record_sample, config.record_dir,
+        static_cast<int>(config.record_max_bytes >> 20),
+        static_cast<int>(server->recorder_->bytes() >> 20)));
+  }
 
   if (config.warm_up) {
     FoveaServer* self = server.get();

@@ -14,6 +14,7 @@
 #include "core/base/mutex.h"
 #include "core/frame/frame_decode.h"
 #include "core/pipeline/models.h"
+#include "server/flight_recorder.h"
 #include "server/metrics.h"
 #include "server/perception_service.h"
 #include "server/work_queue.h"
@@ -84,6 +85,12 @@ struct ServerConfig {
   // Folder of the trained models (LoadModels); start-up fails when a model
   // is missing or corrupt.
   std::string models_dir = FOVEA_DEFAULT_MODELS_DIR;
+  // The flight recorder (flight_recorder.h): record_dir empty is off;
+  // otherwise record_sample of the calls (0, 1] are kept there, within
+  // record_max_bytes.
+  std::string record_dir;
+  int64_t record_max_bytes = int64_t{1} << 30;
+  double record_sample = 1.0;
   // Test hooks, null in production: see ServiceConfig::before_detect_job,
   // ServiceConfig::at_stage_boundary and ServiceConfig::on_stream_cancelled.
   std::function<void()> before_detect_job;
@@ -175,6 +182,8 @@ class FoveaServer {
   std::unique_ptr<LoadedModels> models_;  // the service points into it
   std::unique_ptr<ThreadPool> pool_;      // the workers' helpers
   std::unique_ptr<WorkQueue> work_;
+  // Before service_: the calls hand themselves to it until the last ends.
+  std::unique_ptr<FlightRecorder> recorder_;
   std::shared_ptr<ServiceState> service_state_;
   double drain_delay_s_ = 0.0;
   std::unique_ptr<PerceptionService> service_;

@@ -1,0 +1,409 @@
+#include "server/flight_recorder.h"
+
+#include <google/protobuf/util/json_util.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+#include <regex>
+#include <system_error>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "core/frame/image_codec.h"
+#include "core/frame/image_header.h"
+#include "fovea/v1/frame.pb.h"
+#include "server/log.h"
+#include "server/metrics.h"
+
+namespace fovea::server {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Metres per unit of the 16-bit depth PNG a 32FC1 frame is stored as:
+// 0.1 mm, up to 6.5 m.
+constexpr double kFloatDepthScale = 1e-4;
+// Metres per unit when a request leaves depth_scale 0 (frame.proto).
+constexpr double kDefaultDepthScale = 1e-3;
+
+// A record's folder name: the sequence on 8 digits, a dash, the method.
+const std::regex& RecordName() {
+  static const std::regex* const name =
+      new std::regex(R"(^(\d{8})-([A-Za-z]+)$)");
+  return *name;
+}
+
+std::string ToJson(const google::protobuf::Message& message) {
+  std::string json;
+  google::protobuf::util::JsonPrintOptions options;
+  options.preserve_proto_field_names = true;
+  if (!google::protobuf::util::MessageToJsonString(message, &json, options)
+           .ok()) {
+    return "{}";
+  }
+  return json;
+}
+
+// The files of one record, names and contents, or why the frame could not
+// be kept.
+struct Files {
+  std::vector<std::pair<std::string, std::string>> files;
+  std::string frame_problem;
+  int64_t bytes() const {
+    int64_t total = 0;
+    for (const auto& [name, data] : files) total += data.size();
+    return total;
+  }
+};
+
+// A raw image's rows as a cv::Mat header over its bytes (no copy); empty
+// when its fields do not describe its data.
+cv::Mat RawView(const v1::Image& image, int type, size_t pixel_bytes) {
+  const size_t row = static_cast<size_t>(image.width()) * pixel_bytes;
+  const size_t step = image.step() == 0 ? row : image.step();
+  if (image.width() == 0 || image.height() == 0 || step < row ||
+      image.data().size() < step * (image.height() - 1) + row) {
+    return cv::Mat();
+  }
+  return cv::Mat(static_cast<int>(image.height()),
+                 static_cast<int>(image.width()), type,
+                 const_cast<char*>(image.data().data()), step);
+}
+
+// The colour image as a file: the compressed one as sent, a raw one as
+// an RGB PNG.
+absl::Status ColourFile(const v1::Image& color, Files& out) {
+  if (!color.compressed().empty()) {
+    const std::string& file = color.compressed();
+    out.files.emplace_back(IsJpegFile(file) ? "color.jpg" : "color.png", file);
+    return absl::OkStatus();
+  }
+  const bool rgb = color.encoding() == "rgb8";
+  if (!rgb && color.encoding() != "bgr8") {
+    return absl::InvalidArgumentError(
+        absl::StrCat("colour encoding '", color.encoding(), "'"));
+  }
+  const cv::Mat view = RawView(color, CV_8UC3, 3);
+  if (view.empty()) return absl::InvalidArgumentError("colour image size");
+  cv::Mat bgr;  // EncodePng's order in memory
+  if (rgb) {
+    cv::cvtColor(view, bgr, cv::COLOR_RGB2BGR);
+  } else {
+    bgr = view;
+  }
+  absl::StatusOr<std::string> png = EncodePng(bgr);
+  if (!png.ok()) return png.status();
+  out.files.emplace_back("color.png", *std::move(png));
+  return absl::OkStatus();
+}
+
+// The depth image as a 16-bit PNG file and the scale it is in.
+absl::StatusOr<double> DepthFile(const v1::Frame& frame, Files& out) {
+  const v1::Image& depth = frame.depth();
+  const double scale =
+      frame.depth_scale() > 0.0 ? frame.depth_scale() : kDefaultDepthScale;
+  if (!depth.compressed().empty()) {
+    out.files.emplace_back("depth.png", depth.compressed());
+    return scale;
+  }
+  if (depth.is_bigendian()) return absl::InvalidArgumentError("big-endian");
+  cv::Mat units;
+  double units_scale = scale;
+  if (depth.encoding() == "16UC1") {
+    units = RawView(depth, CV_16UC1, 2);  // the units exactly as sent
+  } else if (depth.encoding() == "32FC1") {
+    const cv::Mat metres = RawView(depth, CV_32FC1, 4);
+    if (!metres.empty()) {
+      units.create(metres.size(), CV_16UC1);
+      for (int v = 0; v < metres.rows; ++v) {
+        const float* in = metres.ptr<float>(v);
+        uint16_t* o = units.ptr<uint16_t>(v);
+        for (int u = 0; u < metres.cols; ++u) {
+          const double value = std::round(in[u] / kFloatDepthScale);
+          // NaN, 0, negative or beyond the 16 bits: no data.
+          o[u] = value >= 1.0 && value <= 65535.0 ? static_cast<uint16_t>(value)
+                                                  : uint16_t{0};
+        }
+      }
+      units_scale = kFloatDepthScale;
+    }
+  } else {
+    return absl::InvalidArgumentError(
+        absl::StrCat("depth encoding '", depth.encoding(), "'"));
+  }
+  if (units.empty()) return absl::InvalidArgumentError("depth image size");
+  absl::StatusOr<std::string> png = EncodePng(units);
+  if (!png.ok()) return png.status();
+  out.files.emplace_back("depth.png", *std::move(png));
+  return units_scale;
+}
+
+// Everything a record holds, in memory.
+Files MakeFiles(const RecordedCall& call, int64_t sequence) {
+  Files out;
+  std::unique_ptr<google::protobuf::Message> request(call.request->New());
+  request->CopyFrom(*call.request);
+  const google::protobuf::FieldDescriptor* field =
+      request->GetDescriptor()->FindFieldByName("frame");
+  if (field != nullptr &&
+      field->type() == google::protobuf::FieldDescriptor::TYPE_MESSAGE) {
+    auto* frame = static_cast<v1::Frame*>(
+        request->GetReflection()->MutableMessage(request.get(), field));
+    absl::Status colour = ColourFile(frame->color(), out);
+    absl::StatusOr<double> scale =
+        colour.ok() ? DepthFile(*frame, out) : absl::StatusOr<double>(colour);
+    if (scale.ok()) {
+      // The request as replay sends it: the images as the files above.
+      frame->mutable_color()->Clear();
+      frame->mutable_depth()->Clear();
+      frame->set_depth_scale(*scale);
+    } else {
+      out.frame_problem = std::string(scale.status().message());
+      out.files.clear();
+      frame->mutable_color()->clear_data();
+      frame->mutable_color()->clear_compressed();
+      frame->mutable_depth()->clear_data();
+      frame->mutable_depth()->clear_compressed();
+    }
+  }
+  out.files.emplace_back("request.json", ToJson(*request) + "\n");
+  std::string responses;
+  for (const auto& response : call.responses) {
+    absl::StrAppend(&responses, ToJson(*response), "\n");
+  }
+  out.files.emplace_back("responses.jsonl", std::move(responses));
+  out.files.emplace_back(
+      "meta.json",
+      absl::StrFormat("{\"method\":\"%s\",\"sequence\":%d,\"unix_micros\":%d,"
+                      "\"code\":\"%s\",\"seconds\":%.6f,\"frame\":\"%s\"}\n",
+                      call.method, sequence, call.unix_micros, call.code,
+                      call.seconds,
+                      out.frame_problem.empty() ? "recorded" : "unreadable"));
+  return out;
+}
+
+// Bytes of the files in a folder (not recursing).
+int64_t FolderBytes(const fs::path& folder) {
+  int64_t total = 0;
+  std::error_code error;
+  for (const fs::directory_entry& entry :
+       fs::directory_iterator(folder, error)) {
+    if (entry.is_regular_file(error)) total += entry.file_size(error);
+  }
+  return total;
+}
+
+int64_t ApproximateBytes(const RecordedCall& call) {
+  int64_t bytes = call.request->ByteSizeLong();
+  for (const auto& response : call.responses) bytes += response->ByteSizeLong();
+  return bytes;
+}
+
+}  // namespace
+
+absl::Status Validate(const RecorderConfig& config) {
+  if (config.dir.empty()) {
+    return absl::InvalidArgumentError("record_dir: empty");
+  }
+  if (config.max_bytes <= 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "record_max_mb: must be > 0, got ", config.max_bytes >> 20));
+  }
+  if (!(config.sample > 0.0 && config.sample <= 1.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("record_sample: must be in (0, 1], got ", config.sample));
+  }
+  if (config.max_pending < 1 || config.max_pending_bytes < 1) {
+    return absl::InvalidArgumentError(
+        "record queue: max_pending and max_pending_bytes must be >= 1");
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<std::unique_ptr<FlightRecorder>> FlightRecorder::Start(
+    const RecorderConfig& config) {
+  if (absl::Status s = Validate(config); !s.ok()) return s;
+  std::unique_ptr<FlightRecorder> recorder(new FlightRecorder(config));
+  if (absl::Status s = recorder->TakeStock(); !s.ok()) return s;
+  recorder->writer_ = std::thread([r = recorder.get()] { r->Write(); });
+  return recorder;
+}
+
+FlightRecorder::FlightRecorder(const RecorderConfig& config)
+    : config_(config) {}
+
+FlightRecorder::~FlightRecorder() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+  }
+  changed_.notify_all();
+  if (writer_.joinable()) writer_.join();
+}
+
+absl::Status FlightRecorder::TakeStock() {
+  std::error_code error;
+  fs::create_directories(config_.dir, error);
+  if (error) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "record_dir: cannot make ", config_.dir, ": ", error.message()));
+  }
+  std::vector<Record> found;
+  for (const fs::directory_entry& entry :
+       fs::directory_iterator(config_.dir, error)) {
+    const std::string name = entry.path().filename().string();
+    std::smatch match;
+    if (!entry.is_directory(error)) continue;
+    if (name.rfind(".tmp-", 0) == 0) {  // a record cut off half-written
+      fs::remove_all(entry.path(), error);
+      continue;
+    }
+    if (!std::regex_match(name, match, RecordName())) continue;
+    found.push_back({std::stoll(match[1].str()), entry.path().string(),
+                     FolderBytes(entry.path())});
+  }
+  if (error) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "record_dir: cannot read ", config_.dir, ": ", error.message()));
+  }
+  std::sort(found.begin(), found.end(), [](const Record& a, const Record& b) {
+    return a.sequence < b.sequence;
+  });
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (Record& record : found) {
+    total_bytes_ += record.bytes;
+    next_sequence_ = record.sequence + 1;
+    records_.push_back(std::move(record));
+  }
+  // Within this run's budget, which may be smaller than the last one's.
+  while (!records_.empty() && total_bytes_ > config_.max_bytes) {
+    fs::remove_all(records_.front().path, error);
+    total_bytes_ -= records_.front().bytes;
+    records_.pop_front();
+  }
+  SetRecorderBytes(total_bytes_);
+  return absl::OkStatus();
+}
+
+bool FlightRecorder::ShouldRecord() {
+  // Call i is recorded when floor(i * sample) steps up: exactly that
+  // share, evenly spread.
+  const uint64_t i = calls_seen_.fetch_add(1, std::memory_order_relaxed) + 1;
+  return std::floor(i * config_.sample) > std::floor((i - 1) * config_.sample);
+}
+
+void FlightRecorder::Submit(RecordedCall call) {
+  const int64_t bytes = ApproximateBytes(call);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (stopping_ || static_cast<int>(queue_.size()) >= config_.max_pending ||
+        (!queue_.empty() &&
+         queued_bytes_ + bytes > config_.max_pending_bytes)) {
+      RecordRecorderOutcome("queue_full");
+      return;
+    }
+    queued_bytes_ += bytes;
+    queue_.push_back(std::move(call));
+  }
+  changed_.notify_all();
+}
+
+void FlightRecorder::Flush() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  changed_.wait(lock, [this] { return queue_.empty() && writing_ == 0; });
+}
+
+int64_t FlightRecorder::bytes() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return total_bytes_;
+}
+
+void FlightRecorder::set_before_write_for_test(std::function<void()> hook) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  before_write_ = std::move(hook);
+}
+
+void FlightRecorder::Write() {
+  while (true) {
+    RecordedCall call;
+    std::function<void()> hook;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      changed_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+      if (queue_.empty()) return;  // stopping, nothing left
+      call = std::move(queue_.front());
+      queue_.pop_front();
+      queued_bytes_ -= std::min(queued_bytes_, ApproximateBytes(call));
+      writing_ = 1;
+      hook = before_write_;
+    }
+    if (hook) hook();
+    WriteOne(std::move(call));
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      writing_ = 0;
+    }
+    changed_.notify_all();
+  }
+}
+
+void FlightRecorder::WriteOne(RecordedCall call) {
+  const int64_t sequence = next_sequence_;
+  const Files files = MakeFiles(call, sequence);
+  const int64_t bytes = files.bytes();
+  if (bytes > config_.max_bytes) {
+    RecordRecorderOutcome("too_large");
+    return;
+  }
+  std::error_code error;
+  // Room first: the oldest records go until this one fits.
+  while (!records_.empty()) {
+    int64_t total;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      total = total_bytes_;
+    }
+    if (total + bytes <= config_.max_bytes) break;
+    fs::remove_all(records_.front().path, error);
+    std::lock_guard<std::mutex> lock(mutex_);
+    total_bytes_ -= records_.front().bytes;
+    records_.pop_front();
+  }
+  const std::string name = absl::StrFormat("%08d-%s", sequence, call.method);
+  const fs::path temporary = fs::path(config_.dir) / (".tmp-" + name);
+  const fs::path final_path = fs::path(config_.dir) / name;
+  fs::create_directories(temporary, error);
+  bool ok = !error;
+  for (const auto& [file, data] : files.files) {
+    if (!ok) break;
+    std::ofstream out(temporary / file, std::ios::binary);
+    out.write(data.data(), static_cast<std::streamsize>(data.size()));
+    ok = static_cast<bool>(out);
+  }
+  if (ok) fs::rename(temporary, final_path, error);
+  if (!ok || error) {
+    fs::remove_all(temporary, error);
+    RecordRecorderOutcome("error");
+    LogWarn(absl::StrCat("flight recorder: could not write ",
+                         final_path.string(), "; call not recorded"));
+    return;
+  }
+  next_sequence_ = sequence + 1;
+  records_.push_back({sequence, final_path.string(), bytes});
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    total_bytes_ += bytes;
+    SetRecorderBytes(total_bytes_);
+  }
+  RecordRecorderOutcome(files.frame_problem.empty() ? "written"
+                                                    : "written_without_frame");
+}
+
+}  // namespace fovea::server
