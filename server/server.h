@@ -142,6 +142,8 @@ class FoveaServer {
   FoveaServer& operator=(const FoveaServer&) = delete;
 
   int port() const { return port_; }
+  // The flight recorder; null when --record_dir is empty.
+  FlightRecorder* recorder() const { return recorder_.get(); }
   // 0 without a metrics endpoint.
   int metrics_port() const;
 

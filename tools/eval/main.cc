@@ -21,6 +21,9 @@
 #include "core/pipeline/models.h"
 #include "core/segmentation/svm_training.h"
 #include "core/synth/synth_scene.h"
+#ifdef FOVEA_EVAL_REPLAY
+#include "tools/eval/replay.h"
+#endif
 #include "tools/eval/detect_eval.h"
 #include "tools/eval/inc_eval.h"
 #include "tools/eval/json_lines.h"
@@ -131,6 +134,11 @@ ABSL_FLAG(std::string, sizes, "640x480",
 ABSL_FLAG(std::string, models, FOVEA_DEFAULT_MODELS_DIR,
           "segment, rooms, raw: the trained models, as the server loads "
           "them.");
+ABSL_FLAG(std::string, server, "",
+          "replay: the server the recorded calls go to, HOST:PORT (or any "
+          "fovea-client target).");
+ABSL_FLAG(bool, fail_on_change, false,
+          "replay: exit 3 when any record's answer changed.");
 ABSL_FLAG(std::string, filter, "",
           "sweep: only the rows whose label saliency/pyramid/combine/norm/"
           "extract contains this.");
@@ -705,7 +713,10 @@ int main(int argc, char** argv) {
       "inc|cos|ebs|pcl-lccp|pcl-euclidean] [--models DIR] [--json] [--out "
       "DIR]   (synthetic rooms, held out: support, recall, false objects)\n"
       "  fovea-eval raw --data DIR [--method inc|cos|...]   (each raw "
-      "frames/<scene>_*.png against its cropped learn/<scene>.pcd)");
+      "frames/<scene>_*.png against its cropped learn/<scene>.pcd)\n"
+      "  fovea-eval replay DIR --server HOST:PORT [--json] "
+      "[--fail_on_change]   (the calls fovea-server --record_dir kept, sent "
+      "again: points moved, masks' IoU, objects found or lost, time)");
   std::vector<char*> args = absl::ParseCommandLine(argc, argv);
   if (args.size() < 2) {
     std::fprintf(stderr, "%s\n",
@@ -718,6 +729,15 @@ int main(int argc, char** argv) {
   if (command == "segment") return fovea::eval::RunSegmentEval();
   if (command == "rooms") return fovea::eval::RunRoomsCommand();
   if (command == "raw") return fovea::eval::RunRawCommand();
+#ifdef FOVEA_EVAL_REPLAY
+  if (command == "replay") {
+    fovea::eval::ReplayOptions options;
+    options.server = absl::GetFlag(FLAGS_server);
+    return fovea::eval::RunReplay(args.size() > 2 ? args[2] : "", options,
+                                  absl::GetFlag(FLAGS_json),
+                                  absl::GetFlag(FLAGS_fail_on_change));
+  }
+#endif
   std::fprintf(stderr, "fovea-eval: unknown command '%s'\n%s\n",
                command.c_str(),
                std::string(absl::ProgramUsageMessage()).c_str());
