@@ -16,9 +16,19 @@
 #include "core/base/status_macros.h"
 #include "core/frame/image_codec.h"
 #include "google/protobuf/util/json_util.h"
+#include "proto/enum_names.h"
 
 namespace fovea::client {
 namespace {
+
+// An enum value's name without its enum's prefix, in lower case
+// (proto/enum_names.h): "simple" for PYRAMID_SIMPLE.
+std::string ShortName(const google::protobuf::EnumDescriptor* type, int value) {
+  const google::protobuf::EnumValueDescriptor* found =
+      type->FindValueByNumber(value);
+  return found != nullptr ? fovea::v1::ShortEnumName(*found)
+                          : std::to_string(value);
+}
 
 using PointList = google::protobuf::RepeatedPtrField<fovea::v1::AttentionPoint>;
 
@@ -287,8 +297,9 @@ std::string DescribeSegmentMessage(const fovea::v1::SegmentResponse& message,
     const fovea::v1::SegmentSummary& s = message.summary();
     std::string last = absl::StrFormat(
         "last: %s, %d objects, coverage %.3f, server total %.1f ms",
-        fovea::v1::StopReason_Name(s.stop_reason()), s.object_count(),
-        s.scene_coverage(), s.seconds_total() * 1e3);
+        absl::AsciiStrToUpper(
+            ShortName(fovea::v1::StopReason_descriptor(), s.stop_reason())),
+        s.object_count(), s.scene_coverage(), s.seconds_total() * 1e3);
     for (const fovea::v1::StageTiming& t : s.timings()) {
       absl::StrAppend(
           &last, absl::StrFormat(", %s %.1f ms", t.stage(), t.seconds() * 1e3));
@@ -301,7 +312,8 @@ std::string DescribeSegmentMessage(const fovea::v1::SegmentResponse& message,
                          absl::StrJoin(parts, "; "));
 }
 
-void PrintCapabilities(const fovea::v1::Capabilities& c, std::ostream& out) {
+void PrintCapabilities(const fovea::v1::GetCapabilitiesResponse& c,
+                       std::ostream& out) {
   auto join_enum = [](const auto& values, auto name) {
     std::vector<std::string> names;
     for (int v : values) names.push_back(name(v));
@@ -328,19 +340,20 @@ void PrintCapabilities(const fovea::v1::Capabilities& c, std::ostream& out) {
       }));
   out << absl::StrFormat("%-22s %s\n", "pyramids",
                          join_enum(c.pyramids(), [](int v) {
-                           return fovea::v1::Pyramid_Name(v);
+                           return ShortName(fovea::v1::Pyramid_descriptor(), v);
                          }));
-  out << absl::StrFormat("%-22s %s\n", "normalizations",
-                         join_enum(c.normalizations(), [](int v) {
-                           return fovea::v1::Normalization_Name(v);
-                         }));
-  out << absl::StrFormat("%-22s %s\n", "extractions",
-                         join_enum(c.extractions(), [](int v) {
-                           return fovea::v1::Extraction_Name(v);
-                         }));
+  out << absl::StrFormat(
+      "%-22s %s\n", "normalizations", join_enum(c.normalizations(), [](int v) {
+        return ShortName(fovea::v1::Normalization_descriptor(), v);
+      }));
+  out << absl::StrFormat(
+      "%-22s %s\n", "extractions", join_enum(c.extractions(), [](int v) {
+        return ShortName(fovea::v1::Extraction_descriptor(), v);
+      }));
   out << absl::StrFormat("%-22s %s\n", "segmentation methods",
                          join_enum(c.segmentation_methods(), [](int v) {
-                           return fovea::v1::SegmentationMethod_Name(v);
+                           return ShortName(
+                               fovea::v1::SegmentationMethod_descriptor(), v);
                          }));
   out << absl::StrFormat("%-22s %s\n", "segment incremental",
                          c.segment_incremental() ? "yes" : "no");

@@ -34,7 +34,7 @@ void PrintDetectTable(const fovea::v1::DetectResponse& response,
 std::string DescribeSegmentMessage(const fovea::v1::SegmentResponse& message,
                                    absl::Duration since_start);
 
-void PrintCapabilities(const fovea::v1::Capabilities& capabilities,
+void PrintCapabilities(const fovea::v1::GetCapabilitiesResponse& capabilities,
                        std::ostream& out);
 
 // Writes into `dir` (created if missing): response.json; overlay.png, the

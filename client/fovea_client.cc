@@ -71,11 +71,11 @@ FoveaClient::Health(const std::string& service, absl::Duration deadline) {
   return response.status();
 }
 
-absl::StatusOr<fovea::v1::Capabilities> FoveaClient::GetCapabilities(
+absl::StatusOr<fovea::v1::GetCapabilitiesResponse> FoveaClient::GetCapabilities(
     absl::Duration deadline) {
   grpc::ClientContext context;
   PrepareContext(deadline, options_, context);
-  fovea::v1::Capabilities response;
+  fovea::v1::GetCapabilitiesResponse response;
   const grpc::Status status = perception_->GetCapabilities(
       &context, fovea::v1::GetCapabilitiesRequest(), &response);
   if (!status.ok()) return ToAbslStatus(status);

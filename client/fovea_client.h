@@ -63,7 +63,7 @@ class FoveaClient {
   absl::StatusOr<grpc::health::v1::HealthCheckResponse::ServingStatus> Health(
       const std::string& service, absl::Duration deadline);
 
-  absl::StatusOr<fovea::v1::Capabilities> GetCapabilities(
+  absl::StatusOr<fovea::v1::GetCapabilitiesResponse> GetCapabilities(
       absl::Duration deadline);
 
   absl::StatusOr<fovea::v1::DetectResponse> Detect(

@@ -175,7 +175,7 @@ int RunHealth() {
 int RunCapabilities() {
   absl::StatusOr<std::unique_ptr<FoveaClient>> client = MakeClient();
   if (!client.ok()) return FailLocal(client.status());
-  absl::StatusOr<fovea::v1::Capabilities> capabilities =
+  absl::StatusOr<fovea::v1::GetCapabilitiesResponse> capabilities =
       (*client)->GetCapabilities(Deadline());
   if (!capabilities.ok()) return Fail(kExitCallFailed, capabilities.status());
   if (absl::GetFlag(FLAGS_json)) {

@@ -15,6 +15,7 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
 #include "core/base/status_macros.h"
+#include "proto/enum_names.h"
 
 namespace fovea::client {
 namespace {
@@ -43,7 +44,7 @@ const NameTable<Enum>* DescriptorNames(
   for (int i = 0; i < values->value_count(); ++i) {
     const google::protobuf::EnumValueDescriptor* value = values->value(i);
     if (value->number() == 0) continue;
-    table->spellings.push_back(absl::AsciiStrToLower(value->name()));
+    table->spellings.push_back(fovea::v1::ShortEnumName(*value));
     table->names.emplace_back(table->spellings.back(),
                               static_cast<Enum>(value->number()));
   }
@@ -116,25 +117,26 @@ absl::StatusOr<fovea::v1::Extraction> ParseExtraction(absl::string_view text) {
 
 absl::StatusOr<fovea::v1::Pyramid> ParsePyramid(absl::string_view text) {
   static const auto* const kNames =
-      new NameTable<fovea::v1::Pyramid>{{"none", fovea::v1::NONE},
-                                        {"simple", fovea::v1::SIMPLE},
-                                        {"itti", fovea::v1::ITTI_PYRAMID}};
+      new NameTable<fovea::v1::Pyramid>{{"none", fovea::v1::PYRAMID_NONE},
+                                        {"simple", fovea::v1::PYRAMID_SIMPLE},
+                                        {"itti", fovea::v1::PYRAMID_ITTI}};
   return Lookup("pyramid", text, *kNames);
 }
 
 absl::StatusOr<fovea::v1::Normalization> ParseNormalization(
     absl::string_view text) {
-  static const auto* const kNames =
-      new NameTable<fovea::v1::Normalization>{{"lin", fovea::v1::LIN},
-                                              {"nms", fovea::v1::NMS},
-                                              {"nlm", fovea::v1::NLM}};
+  static const auto* const kNames = new NameTable<fovea::v1::Normalization>{
+      {"lin", fovea::v1::NORMALIZATION_LIN},
+      {"nms", fovea::v1::NORMALIZATION_NMS},
+      {"nlm", fovea::v1::NORMALIZATION_NLM}};
   return Lookup("norm", text, *kNames);
 }
 
 absl::StatusOr<fovea::v1::LevelCombination> ParseLevelCombination(
     absl::string_view text) {
   static const auto* const kNames = new NameTable<fovea::v1::LevelCombination>{
-      {"sum", fovea::v1::LEVELS_SUM}, {"max", fovea::v1::LEVELS_MAX}};
+      {"sum", fovea::v1::LEVEL_COMBINATION_SUM},
+      {"max", fovea::v1::LEVEL_COMBINATION_MAX}};
   return Lookup("combine", text, *kNames);
 }
 
@@ -202,7 +204,9 @@ std::string SaliencyName(fovea::v1::SaliencyOperator op) {
   for (const auto& [name, value] : SaliencyNames()) {
     if (value == op) return std::string(name);
   }
-  return absl::AsciiStrToLower(fovea::v1::SaliencyOperator_Name(op));
+  const auto* value =
+      fovea::v1::SaliencyOperator_descriptor()->FindValueByNumber(op);
+  return value != nullptr ? fovea::v1::ShortEnumName(*value) : std::string();
 }
 
 }  // namespace fovea::client

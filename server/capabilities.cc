@@ -67,10 +67,10 @@ std::vector<ExtractionKind> ImplementedExtractions() {
   });
 }
 
-v1::Capabilities BuildCapabilities(
+v1::GetCapabilitiesResponse BuildCapabilities(
     const FrameLimits& limits, uint64_t max_message_bytes,
     const std::vector<std::pair<std::string, std::string>>& model_versions) {
-  v1::Capabilities out;
+  v1::GetCapabilitiesResponse out;
   out.set_server_version(std::string(ServerVersion()));
   for (const char* encoding : {"rgb8", "bgr8"})
     out.add_color_encodings(encoding);

@@ -28,7 +28,7 @@ std::vector<ExtractionKind> ImplementedExtractions();
 // 16UC1, 32FC1), compressed formats (png, jpeg), the frame limits and
 // largest message, the implemented operators and strategies above, no
 // segmentation methods or models yet, and core's default DetectOptions.
-v1::Capabilities BuildCapabilities(
+v1::GetCapabilitiesResponse BuildCapabilities(
     const FrameLimits& limits, uint64_t max_message_bytes,
     const std::vector<std::pair<std::string, std::string>>& model_versions =
         {});

@@ -13,6 +13,7 @@
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/pipeline/saliency_registry.h"
+#include "proto/enum_names.h"
 #include "server/convert.h"
 
 namespace fovea::server {
@@ -36,8 +37,8 @@ absl::StatusOr<SaliencyOp> FromProto(v1::SaliencyOperator op,
   }
   const SaliencyOperator* row = nullptr;
   if (v1::SaliencyOperator_IsValid(op)) {
-    row = FindSaliencyOperator(
-        absl::AsciiStrToLower(v1::SaliencyOperator_Name(op)));
+    row = FindSaliencyOperator(v1::ShortEnumName(
+        *v1::SaliencyOperator_descriptor()->FindValueByNumber(op)));
   }
   if (row == nullptr) return UnknownEnumValue(field, op);
   return row->op;
@@ -49,13 +50,13 @@ absl::Status FromProto(v1::Pyramid in, PyramidKind& out) {
   switch (in) {
     case v1::PYRAMID_UNSPECIFIED:
       return absl::OkStatus();
-    case v1::NONE:
+    case v1::PYRAMID_NONE:
       out = PyramidKind::kNone;
       return absl::OkStatus();
-    case v1::SIMPLE:
+    case v1::PYRAMID_SIMPLE:
       out = PyramidKind::kSimple;
       return absl::OkStatus();
-    case v1::ITTI_PYRAMID:
+    case v1::PYRAMID_ITTI:
       out = PyramidKind::kItti;
       return absl::OkStatus();
     default:
@@ -67,10 +68,10 @@ absl::Status FromProto(v1::LevelCombination in, LevelCombination& out) {
   switch (in) {
     case v1::LEVEL_COMBINATION_UNSPECIFIED:
       return absl::OkStatus();
-    case v1::LEVELS_SUM:
+    case v1::LEVEL_COMBINATION_SUM:
       out = LevelCombination::kSum;
       return absl::OkStatus();
-    case v1::LEVELS_MAX:
+    case v1::LEVEL_COMBINATION_MAX:
       out = LevelCombination::kMax;
       return absl::OkStatus();
     default:
@@ -82,13 +83,13 @@ absl::Status FromProto(v1::Normalization in, NormalizationKind& out) {
   switch (in) {
     case v1::NORMALIZATION_UNSPECIFIED:
       return absl::OkStatus();
-    case v1::LIN:
+    case v1::NORMALIZATION_LIN:
       out = NormalizationKind::kLin;
       return absl::OkStatus();
-    case v1::NMS:
+    case v1::NORMALIZATION_NMS:
       out = NormalizationKind::kNms;
       return absl::OkStatus();
-    case v1::NLM:
+    case v1::NORMALIZATION_NLM:
       out = NormalizationKind::kNlm;
       return absl::OkStatus();
     default:
@@ -117,8 +118,8 @@ absl::Status FromProto(v1::Extraction in, ExtractionKind& out) {
   if (!v1::Extraction_IsValid(in)) {
     return UnknownEnumValue("options.extraction", in);
   }
-  absl::StatusOr<ExtractionKind> kind =
-      ParseExtraction(absl::AsciiStrToLower(v1::Extraction_Name(in)));
+  absl::StatusOr<ExtractionKind> kind = ParseExtraction(
+      v1::ShortEnumName(*v1::Extraction_descriptor()->FindValueByNumber(in)));
   if (!kind.ok()) return UnknownEnumValue("options.extraction", in);
   out = *kind;
   return absl::OkStatus();
@@ -294,8 +295,11 @@ v1::SaliencyOperator ToProtoEnum(SaliencyOp op) {
   v1::SaliencyOperator value = v1::SALIENCY_OPERATOR_UNSPECIFIED;
   const SaliencyOperator* row = FindSaliencyOperator(op);
   if (row != nullptr) {
-    v1::SaliencyOperator_Parse(absl::AsciiStrToUpper(AbslView(row->name)),
-                               &value);
+    const auto* found = v1::FindEnumValueByShortName(
+        *v1::SaliencyOperator_descriptor(), row->name);
+    if (found != nullptr) {
+      value = static_cast<v1::SaliencyOperator>(found->number());
+    }
   }
   return value;
 }
@@ -303,11 +307,11 @@ v1::SaliencyOperator ToProtoEnum(SaliencyOp op) {
 v1::Pyramid ToProtoEnum(PyramidKind pyramid) {
   switch (pyramid) {
     case PyramidKind::kNone:
-      return v1::NONE;
+      return v1::PYRAMID_NONE;
     case PyramidKind::kSimple:
-      return v1::SIMPLE;
+      return v1::PYRAMID_SIMPLE;
     case PyramidKind::kItti:
-      return v1::ITTI_PYRAMID;
+      return v1::PYRAMID_ITTI;
   }
   return v1::PYRAMID_UNSPECIFIED;
 }
@@ -315,9 +319,9 @@ v1::Pyramid ToProtoEnum(PyramidKind pyramid) {
 v1::LevelCombination ToProtoEnum(LevelCombination combination) {
   switch (combination) {
     case LevelCombination::kSum:
-      return v1::LEVELS_SUM;
+      return v1::LEVEL_COMBINATION_SUM;
     case LevelCombination::kMax:
-      return v1::LEVELS_MAX;
+      return v1::LEVEL_COMBINATION_MAX;
   }
   return v1::LEVEL_COMBINATION_UNSPECIFIED;
 }
@@ -325,11 +329,11 @@ v1::LevelCombination ToProtoEnum(LevelCombination combination) {
 v1::Normalization ToProtoEnum(NormalizationKind normalization) {
   switch (normalization) {
     case NormalizationKind::kLin:
-      return v1::LIN;
+      return v1::NORMALIZATION_LIN;
     case NormalizationKind::kNms:
-      return v1::NMS;
+      return v1::NORMALIZATION_NMS;
     case NormalizationKind::kNlm:
-      return v1::NLM;
+      return v1::NORMALIZATION_NLM;
   }
   return v1::NORMALIZATION_UNSPECIFIED;
 }
@@ -346,8 +350,9 @@ v1::Fusion ToProtoEnum(FusionKind fusion) {
 
 v1::Extraction ToProtoEnum(ExtractionKind extraction) {
   v1::Extraction value = v1::EXTRACTION_UNSPECIFIED;
-  v1::Extraction_Parse(
-      absl::AsciiStrToUpper(AbslView(ExtractionName(extraction))), &value);
+  const auto* found = v1::FindEnumValueByShortName(*v1::Extraction_descriptor(),
+                                                   ExtractionName(extraction));
+  if (found != nullptr) value = static_cast<v1::Extraction>(found->number());
   return value;
 }
 

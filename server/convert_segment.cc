@@ -13,6 +13,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
+#include "proto/enum_names.h"
 #include "server/convert.h"
 #include "server/convert_internal.h"
 
@@ -118,8 +119,9 @@ absl::StatusOr<SegmentOptions> ToSegmentOptions(
   if (request.method() != v1::SEGMENTATION_METHOD_UNSPECIFIED) {
     absl::StatusOr<SegmentMethod> method = absl::InvalidArgumentError("");
     if (v1::SegmentationMethod_IsValid(request.method())) {
-      method = ParseSegmentMethod(
-          absl::AsciiStrToLower(v1::SegmentationMethod_Name(request.method())));
+      method = ParseSegmentMethod(v1::ShortEnumName(
+          *v1::SegmentationMethod_descriptor()->FindValueByNumber(
+              request.method())));
     }
     if (!method.ok()) {
       return absl::InvalidArgumentError(absl::StrCat(
@@ -163,8 +165,11 @@ absl::StatusOr<IncrementalOptions> ToIncrementalOptions(
 
 v1::SegmentationMethod ToProtoEnum(SegmentMethod method) {
   v1::SegmentationMethod value = v1::SEGMENTATION_METHOD_UNSPECIFIED;
-  v1::SegmentationMethod_Parse(
-      absl::AsciiStrToUpper(AbslView(SegmentMethodName(method))), &value);
+  const auto* found = v1::FindEnumValueByShortName(
+      *v1::SegmentationMethod_descriptor(), SegmentMethodName(method));
+  if (found != nullptr) {
+    value = static_cast<v1::SegmentationMethod>(found->number());
+  }
   return value;
 }
 

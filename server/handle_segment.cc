@@ -13,13 +13,13 @@ namespace {
 v1::StopReason ToStopReason(SegmentStop stop) {
   switch (stop) {
     case SegmentStop::kMaxObjects:
-      return v1::MAX_OBJECTS;
+      return v1::STOP_REASON_MAX_OBJECTS;
     case SegmentStop::kTimeBudget:
-      return v1::TIME_BUDGET;
+      return v1::STOP_REASON_TIME_BUDGET;
     case SegmentStop::kDone:
       break;
   }
-  return v1::DONE;
+  return v1::STOP_REASON_DONE;
 }
 
 // Decodes the frame, runs `run` with sinks that send each message, then
@@ -65,9 +65,10 @@ absl::Status Stream(std::string_view method, const v1::Frame& wire_frame,
     RecordStage(timing.stage, timing.seconds);
   }
   const v1::StopReason reason = ToStopReason(summary->stop);
-  RecordStopReason(method, reason == v1::MAX_OBJECTS   ? "max_objects"
-                           : reason == v1::TIME_BUDGET ? "time_budget"
-                                                       : "done");
+  RecordStopReason(method, reason == v1::STOP_REASON_MAX_OBJECTS ? "max_objects"
+                           : reason == v1::STOP_REASON_TIME_BUDGET
+                               ? "time_budget"
+                               : "done");
   return context.send(ToSummaryMessage(*summary, reason, request_id));
 }
 

@@ -506,9 +506,10 @@ PerceptionService::PerceptionService(ServiceConfig config, WorkQueue* work)
                             }));
   MarkMethodCallback(
       3, new grpc::internal::CallbackUnaryHandler<grpc::ByteBuffer,
-                                                  v1::Capabilities>(
+                                                  v1::GetCapabilitiesResponse>(
              [this](grpc::CallbackServerContext* context,
-                    const grpc::ByteBuffer* body, v1::Capabilities* response) {
+                    const grpc::ByteBuffer* body,
+                    v1::GetCapabilitiesResponse* response) {
                return OnGetCapabilities(context, body, response);
              }));
   // gRPC's threads call the methods below; what was built here (and the
@@ -551,7 +552,7 @@ PerceptionService::OnSegmentIncremental(grpc::CallbackServerContext* context,
 
 grpc::ServerUnaryReactor* PerceptionService::OnGetCapabilities(
     grpc::CallbackServerContext* context, const grpc::ByteBuffer* body,
-    v1::Capabilities* response) {
+    v1::GetCapabilitiesResponse* response) {
   TsanHappensAfter(&config_);
   CallRecord call("GetCapabilities", "", *config_.state);
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();

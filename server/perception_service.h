@@ -108,11 +108,11 @@ class PerceptionService final : public v1::Perception::CallbackService {
       grpc::CallbackServerContext* context, const grpc::ByteBuffer* body);
   grpc::ServerUnaryReactor* OnGetCapabilities(
       grpc::CallbackServerContext* context, const grpc::ByteBuffer* body,
-      v1::Capabilities* response);
+      v1::GetCapabilitiesResponse* response);
 
   const ServiceConfig config_;
   WorkQueue* const work_;  // not owned
-  const v1::Capabilities capabilities_;
+  const v1::GetCapabilitiesResponse capabilities_;
 };
 
 }  // namespace fovea::server

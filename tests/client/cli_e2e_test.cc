@@ -18,6 +18,7 @@
 #include "gmock/gmock.h"
 #include "google/protobuf/util/json_util.h"
 #include "gtest/gtest.h"
+#include "proto/enum_names.h"
 #include "server/server.h"
 #include "tests/client/cli_test_util.h"
 
@@ -118,7 +119,7 @@ TEST_F(FoveaClientCliE2eTest, EveryOperatorRunsFromTheCommandLine) {
   int operators = 0;
   for (int i = 0; i < values->value_count(); ++i) {
     if (values->value(i)->number() == 0) continue;
-    const std::string name = absl::AsciiStrToLower(values->value(i)->name());
+    const std::string name = fovea::v1::ShortEnumName(*values->value(i));
     std::string extra;
     if (name == "target_color") extra = " --target_color 200,30,30";
     if (name == "location_prior") {

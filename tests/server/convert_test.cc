@@ -42,9 +42,9 @@ TEST(ToDetectOptionsTest, SurfaceEdgeSplitIsDefaultUnlessSet) {
 
 TEST(ToDetectOptionsTest, ChannelsWithZeroWeightWeighOne) {
   v1::DetectOptions in;
-  in.add_saliency()->set_op(v1::PH);
+  in.add_saliency()->set_op(v1::SALIENCY_OPERATOR_PH);
   v1::WeightedOperator* sh = in.add_saliency();
-  sh->set_op(v1::SH);
+  sh->set_op(v1::SALIENCY_OPERATOR_SH);
   sh->set_weight(0.25);
   in.set_max_points(3);
   in.set_return_channel_maps(true);
@@ -61,9 +61,9 @@ TEST(ToDetectOptionsTest, ChannelsWithZeroWeightWeighOne) {
 
 TEST(ToDetectOptionsTest, NegativeWeightIsInvalidAndNamed) {
   v1::DetectOptions in;
-  in.add_saliency()->set_op(v1::RSO);
+  in.add_saliency()->set_op(v1::SALIENCY_OPERATOR_RSO);
   v1::WeightedOperator* ph = in.add_saliency();
-  ph->set_op(v1::PH);
+  ph->set_op(v1::SALIENCY_OPERATOR_PH);
   ph->set_weight(-1.0);
   absl::Status status = ToDetectOptions(in).status();
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
@@ -98,7 +98,7 @@ TEST(ToDetectOptionsTest, ValueOutsideTheEnumIsInvalidAndNamed) {
 
 TEST(ToDetectOptionsTest, TopDownCuesAreCopiedAndRequired) {
   v1::DetectOptions in;
-  in.add_saliency()->set_op(v1::TARGET_COLOR);
+  in.add_saliency()->set_op(v1::SALIENCY_OPERATOR_TARGET_COLOR);
   absl::Status status = ToDetectOptions(in).status();
   EXPECT_EQ(status.code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(status.message(), HasSubstr("options.target_color_rgb"));
@@ -110,7 +110,7 @@ TEST(ToDetectOptionsTest, TopDownCuesAreCopiedAndRequired) {
   EXPECT_EQ(out->target_color.rgb[1], 200);
 
   v1::DetectOptions prior;
-  prior.add_saliency()->set_op(v1::LOCATION_PRIOR);
+  prior.add_saliency()->set_op(v1::SALIENCY_OPERATOR_LOCATION_PRIOR);
   status = ToDetectOptions(prior).status();
   EXPECT_THAT(status.message(), HasSubstr("options.location_prior"));
   prior.mutable_location_prior()->set_u(100);
@@ -124,10 +124,10 @@ TEST(ToDetectOptionsTest, TopDownCuesAreCopiedAndRequired) {
 
 TEST(ToDetectOptionsTest, EveryStrategyOfTheThesisIsAccepted) {
   v1::DetectOptions in;
-  in.add_saliency()->set_op(v1::SYM3D);
-  in.set_pyramid(v1::ITTI_PYRAMID);
-  in.set_normalization(v1::NLM);
-  in.set_extraction(v1::TJ);
+  in.add_saliency()->set_op(v1::SALIENCY_OPERATOR_SYM3D);
+  in.set_pyramid(v1::PYRAMID_ITTI);
+  in.set_normalization(v1::NORMALIZATION_NLM);
+  in.set_extraction(v1::EXTRACTION_TJ);
   absl::StatusOr<DetectOptions> out = ToDetectOptions(in);
   ASSERT_TRUE(out.ok()) << out.status();
   EXPECT_EQ(out->pyramid, PyramidKind::kItti);
@@ -436,13 +436,17 @@ TEST(EncodeSaliencyPngTest, RefusesAMapOfAnotherType) {
 }
 
 TEST(CapabilitiesTest, ListWhatCoreValidates) {
-  const v1::Capabilities capabilities = BuildCapabilities(FrameLimits(), 1000);
+  const v1::GetCapabilitiesResponse capabilities =
+      BuildCapabilities(FrameLimits(), 1000);
   std::vector<int> ops(capabilities.saliency_operators().begin(),
                        capabilities.saliency_operators().end());
   // Every operator; each one listed passes core's Validate.
-  EXPECT_THAT(ops, ::testing::IsSupersetOf({v1::PH, v1::SH, v1::RSO, v1::SYM3D,
-                                            v1::ITTI, v1::HAREL, v1::HOU,
-                                            v1::KOOTSTRA}));
+  EXPECT_THAT(ops,
+              ::testing::IsSupersetOf(
+                  {v1::SALIENCY_OPERATOR_PH, v1::SALIENCY_OPERATOR_SH,
+                   v1::SALIENCY_OPERATOR_RSO, v1::SALIENCY_OPERATOR_SYM3D,
+                   v1::SALIENCY_OPERATOR_ITTI, v1::SALIENCY_OPERATOR_HAREL,
+                   v1::SALIENCY_OPERATOR_HOU, v1::SALIENCY_OPERATOR_KOOTSTRA}));
   for (int op : ops) {
     v1::DetectOptions options;
     options.add_saliency()->set_op(static_cast<v1::SaliencyOperator>(op));
@@ -451,9 +455,11 @@ TEST(CapabilitiesTest, ListWhatCoreValidates) {
     options.mutable_location_prior()->set_u(10);
     EXPECT_TRUE(ToDetectOptions(options).ok()) << op;
   }
-  EXPECT_THAT(capabilities.pyramids(), ::testing::Contains(v1::NONE));
-  EXPECT_THAT(capabilities.normalizations(), ::testing::Contains(v1::LIN));
-  EXPECT_THAT(capabilities.extractions(), ::testing::Contains(v1::MSR));
+  EXPECT_THAT(capabilities.pyramids(), ::testing::Contains(v1::PYRAMID_NONE));
+  EXPECT_THAT(capabilities.normalizations(),
+              ::testing::Contains(v1::NORMALIZATION_LIN));
+  EXPECT_THAT(capabilities.extractions(),
+              ::testing::Contains(v1::EXTRACTION_MSR));
   EXPECT_EQ(capabilities.max_width(), FrameLimits().max_width);
   EXPECT_EQ(capabilities.max_message_bytes(), 1000u);
   EXPECT_THAT(capabilities.compressed_formats(),

@@ -15,6 +15,7 @@
 #include "core/pipeline/saliency_registry.h"
 #include "fovea/v1/detect.pb.h"
 #include "fovea/v1/segment.pb.h"
+#include "proto/enum_names.h"
 #include "server/capabilities.h"
 #include "server/convert.h"
 
@@ -22,7 +23,8 @@ namespace fovea::server {
 namespace {
 
 TEST(RegistriesTest, EveryRowIsReachableThroughEveryLayer) {
-  const v1::Capabilities capabilities = BuildCapabilities(FrameLimits{}, 0, {});
+  const v1::GetCapabilitiesResponse capabilities =
+      BuildCapabilities(FrameLimits{}, 0, {});
   const std::set<int> listed(capabilities.saliency_operators().begin(),
                              capabilities.saliency_operators().end());
   std::set<std::string> names;
@@ -41,8 +43,10 @@ TEST(RegistriesTest, EveryRowIsReachableThroughEveryLayer) {
     EXPECT_THAT(*parsed, ::testing::ElementsAre(row.op));
     // The wire: a value of that name, converted both ways.
     v1::SaliencyOperator value = v1::SALIENCY_OPERATOR_UNSPECIFIED;
-    ASSERT_TRUE(v1::SaliencyOperator_Parse(absl::AsciiStrToUpper(name), &value))
-        << "no SaliencyOperator value " << absl::AsciiStrToUpper(name);
+    ASSERT_TRUE(v1::SaliencyOperator_Parse(
+        "SALIENCY_OPERATOR_" + absl::AsciiStrToUpper(name), &value))
+        << "no SaliencyOperator value SALIENCY_OPERATOR_"
+        << absl::AsciiStrToUpper(name);
     EXPECT_EQ(ToProtoEnum(row.op), value);
     v1::DetectOptions wire;
     wire.add_saliency()->set_op(value);
@@ -72,7 +76,7 @@ TEST(RegistriesTest, EveryRowIsReachableThroughEveryLayer) {
     if (values->value(i)->number() == v1::SALIENCY_OPERATOR_UNSPECIFIED) {
       continue;
     }
-    EXPECT_TRUE(names.count(absl::AsciiStrToLower(values->value(i)->name())))
+    EXPECT_TRUE(names.count(v1::ShortEnumName(*values->value(i))))
         << values->value(i)->name() << " has no registry row";
   }
   EXPECT_EQ(names.size(), static_cast<size_t>(values->value_count() - 1));
@@ -80,14 +84,16 @@ TEST(RegistriesTest, EveryRowIsReachableThroughEveryLayer) {
 
 // The same for the other two tables: extractions and segmentation methods.
 TEST(RegistriesTest, ExtractionsAndSegmentMethodsAreReachableToo) {
-  const v1::Capabilities capabilities = BuildCapabilities(FrameLimits{}, 0, {});
+  const v1::GetCapabilitiesResponse capabilities =
+      BuildCapabilities(FrameLimits{}, 0, {});
   const std::set<int> extractions(capabilities.extractions().begin(),
                                   capabilities.extractions().end());
   for (const Extraction& row : Extractions()) {
     const std::string name(row.name);
     SCOPED_TRACE(name);
     v1::Extraction value = v1::EXTRACTION_UNSPECIFIED;
-    ASSERT_TRUE(v1::Extraction_Parse(absl::AsciiStrToUpper(name), &value));
+    ASSERT_TRUE(v1::Extraction_Parse(
+        "EXTRACTION_" + absl::AsciiStrToUpper(name), &value));
     EXPECT_EQ(ToProtoEnum(row.kind), value);
     v1::DetectOptions wire;
     wire.set_extraction(value);
@@ -108,8 +114,8 @@ TEST(RegistriesTest, ExtractionsAndSegmentMethodsAreReachableToo) {
     const std::string name(row.name);
     SCOPED_TRACE(name);
     v1::SegmentationMethod value = v1::SEGMENTATION_METHOD_UNSPECIFIED;
-    ASSERT_TRUE(
-        v1::SegmentationMethod_Parse(absl::AsciiStrToUpper(name), &value));
+    ASSERT_TRUE(v1::SegmentationMethod_Parse(
+        "SEGMENTATION_METHOD_" + absl::AsciiStrToUpper(name), &value));
     EXPECT_EQ(ToProtoEnum(row.method), value);
     v1::SegmentRequest request;
     request.set_method(value);

@@ -223,7 +223,8 @@ TEST_F(ServerTest, BadSceneHintsAreInvalidArgumentNamingTheField) {
 TEST_F(ServerTest, CueWithoutItsValueAndTooManyPointsAreInvalid) {
   StartServer();
   v1::DetectRequest request = MakeSyntheticRequest(1, false).request;
-  request.mutable_options()->add_saliency()->set_op(v1::TARGET_COLOR);
+  request.mutable_options()->add_saliency()->set_op(
+      v1::SALIENCY_OPERATOR_TARGET_COLOR);
   v1::DetectResponse response;
   grpc::Status status = Detect(request, &response);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
@@ -398,10 +399,10 @@ TEST_F(ServerTest, Sym3dOnAnIttiPyramidWithTJunctionsFindsObjects) {
   StartServer();
   SyntheticRequest synthetic = MakeSyntheticRequest(2, false);
   v1::DetectOptions* options = synthetic.request.mutable_options();
-  options->add_saliency()->set_op(v1::SYM3D);
-  options->set_pyramid(v1::ITTI_PYRAMID);
-  options->set_normalization(v1::NLM);
-  options->set_extraction(v1::TJ);
+  options->add_saliency()->set_op(v1::SALIENCY_OPERATOR_SYM3D);
+  options->set_pyramid(v1::PYRAMID_ITTI);
+  options->set_normalization(v1::NORMALIZATION_NLM);
+  options->set_extraction(v1::EXTRACTION_TJ);
   v1::DetectResponse response;
   const grpc::Status status = Detect(synthetic.request, &response);
   ASSERT_TRUE(status.ok()) << status.error_message();
@@ -506,7 +507,7 @@ TEST_F(ServerTest, SegmentStreamsPointsThenObjectsThenTheSummary) {
   EXPECT_FALSE(call.messages.front().has_object());
   const v1::SegmentResponse& last = call.messages.back();
   EXPECT_TRUE(last.last());
-  EXPECT_EQ(last.summary().stop_reason(), v1::DONE);
+  EXPECT_EQ(last.summary().stop_reason(), v1::STOP_REASON_DONE);
   const int objects = static_cast<int>(call.messages.size()) - 2;
   EXPECT_EQ(last.summary().object_count(), static_cast<uint32_t>(objects));
   double previous = 0.0;
@@ -638,7 +639,8 @@ TEST_F(ServerTest, SegmentKeepsGivenSeedsAndStopsAtMaxObjects) {
   EXPECT_EQ(call.messages.front().attention_points(0).u(),
             points.points(1).u());
   EXPECT_EQ(call.messages.back().summary().object_count(), 1u);
-  EXPECT_EQ(call.messages.back().summary().stop_reason(), v1::MAX_OBJECTS);
+  EXPECT_EQ(call.messages.back().summary().stop_reason(),
+            v1::STOP_REASON_MAX_OBJECTS);
 }
 
 TEST_F(ServerTest,
@@ -681,7 +683,7 @@ TEST_F(ServerTest, SegmentIncrementalStreamsObjectsInOrderAndStops) {
   EXPECT_GT(messages.front().attention_points_size(), 0);
   const v1::SegmentSummary& summary = messages.back().summary();
   EXPECT_TRUE(messages.back().last());
-  EXPECT_EQ(summary.stop_reason(), v1::DONE);
+  EXPECT_EQ(summary.stop_reason(), v1::STOP_REASON_DONE);
   EXPECT_GT(summary.scene_coverage(), 0.9);  // run to the end
   for (size_t i = 1; i + 1 < messages.size(); ++i) {
     EXPECT_EQ(messages[i].object().index(), i - 1);
@@ -694,7 +696,8 @@ TEST_F(ServerTest, SegmentIncrementalStreamsObjectsInOrderAndStops) {
   messages.clear();
   while (one_reader->Read(&response)) messages.push_back(response);
   ASSERT_TRUE(one_reader->Finish().ok());
-  EXPECT_EQ(messages.back().summary().stop_reason(), v1::MAX_OBJECTS);
+  EXPECT_EQ(messages.back().summary().stop_reason(),
+            v1::STOP_REASON_MAX_OBJECTS);
   EXPECT_EQ(messages.back().summary().object_count(), 1u);
   request.set_max_objects(0);
   request.set_time_budget_seconds(1e-9);
@@ -703,7 +706,8 @@ TEST_F(ServerTest, SegmentIncrementalStreamsObjectsInOrderAndStops) {
   messages.clear();
   while (budget_reader->Read(&response)) messages.push_back(response);
   ASSERT_TRUE(budget_reader->Finish().ok());
-  EXPECT_EQ(messages.back().summary().stop_reason(), v1::TIME_BUDGET);
+  EXPECT_EQ(messages.back().summary().stop_reason(),
+            v1::STOP_REASON_TIME_BUDGET);
   const std::string text = Scrape();
   EXPECT_EQ(MetricValue(text, "fovea_segment_stops_total",
                         {"grpc_method=\"SegmentIncremental\"",
@@ -791,7 +795,7 @@ TEST_F(ServerTest, SegmentCancelledAfterTheFirstMessageEndsCancelled) {
 TEST_F(ServerTest, CapabilitiesReportWhatCoreImplements) {
   StartServer();
   grpc::ClientContext context;
-  v1::Capabilities capabilities;
+  v1::GetCapabilitiesResponse capabilities;
   ASSERT_TRUE(stub_
                   ->GetCapabilities(&context, v1::GetCapabilitiesRequest(),
                                     &capabilities)
@@ -799,13 +803,18 @@ TEST_F(ServerTest, CapabilitiesReportWhatCoreImplements) {
   EXPECT_EQ(capabilities.server_version(), ServerVersion());
   EXPECT_THAT(capabilities.saliency_operators(),
               ::testing::UnorderedElementsAre(
-                  v1::PH, v1::SH, v1::RSO, v1::SYM3D, v1::ITTI, v1::HAREL,
-                  v1::HOU, v1::KOOTSTRA, v1::TARGET_COLOR, v1::LOCATION_PRIOR));
+                  v1::SALIENCY_OPERATOR_PH, v1::SALIENCY_OPERATOR_SH,
+                  v1::SALIENCY_OPERATOR_RSO, v1::SALIENCY_OPERATOR_SYM3D,
+                  v1::SALIENCY_OPERATOR_ITTI, v1::SALIENCY_OPERATOR_HAREL,
+                  v1::SALIENCY_OPERATOR_HOU, v1::SALIENCY_OPERATOR_KOOTSTRA,
+                  v1::SALIENCY_OPERATOR_TARGET_COLOR,
+                  v1::SALIENCY_OPERATOR_LOCATION_PRIOR));
   EXPECT_THAT(capabilities.extractions(),
-              ::testing::UnorderedElementsAre(v1::MSR, v1::WTA, v1::TJ));
-  EXPECT_THAT(
-      capabilities.pyramids(),
-      ::testing::UnorderedElementsAre(v1::NONE, v1::SIMPLE, v1::ITTI_PYRAMID));
+              ::testing::UnorderedElementsAre(
+                  v1::EXTRACTION_MSR, v1::EXTRACTION_WTA, v1::EXTRACTION_TJ));
+  EXPECT_THAT(capabilities.pyramids(),
+              ::testing::UnorderedElementsAre(
+                  v1::PYRAMID_NONE, v1::PYRAMID_SIMPLE, v1::PYRAMID_ITTI));
   EXPECT_THAT(capabilities.color_encodings(),
               ::testing::ElementsAre("rgb8", "bgr8"));
   EXPECT_THAT(capabilities.depth_encodings(),
@@ -814,7 +823,8 @@ TEST_F(ServerTest, CapabilitiesReportWhatCoreImplements) {
   // The largest raw 1920x1080 frame and 1 MiB.
   EXPECT_EQ(capabilities.max_message_bytes(), 1920u * 1080u * 7u + (1u << 20));
   EXPECT_THAT(capabilities.segmentation_methods(),
-              ::testing::ElementsAre(v1::COS, v1::EBS));
+              ::testing::ElementsAre(v1::SEGMENTATION_METHOD_COS,
+                                     v1::SEGMENTATION_METHOD_EBS));
   ASSERT_EQ(capabilities.models_size(), 3);
   EXPECT_EQ(capabilities.models(0).name(), "cos_svm");
   EXPECT_THAT(capabilities.models(0).version(), ::testing::StartsWith("cos-"));
@@ -1009,7 +1019,7 @@ TEST_F(ServerTest, ShutdownLetsInFlightCallFinish) {
         grpc::ClientContext context;
         context.set_deadline(std::chrono::system_clock::now() +
                              std::chrono::seconds(2));
-        v1::Capabilities capabilities;
+        v1::GetCapabilitiesResponse capabilities;
         return !stub_
                     ->GetCapabilities(&context, v1::GetCapabilitiesRequest(),
                                       &capabilities)

@@ -31,7 +31,7 @@ using ::testing::HasSubstr;
 // geometry used to blow up).
 v1::DetectRequest ShRequest() {
   v1::DetectRequest request = MakeSyntheticRequest(1, false).request;
-  request.mutable_options()->add_saliency()->set_op(v1::SH);
+  request.mutable_options()->add_saliency()->set_op(v1::SALIENCY_OPERATOR_SH);
   return request;
 }
 
@@ -129,7 +129,7 @@ TEST_F(HostileRequestTest, HundredThousandRepeatedOperatorsAreRefusedQuickly) {
   v1::DetectRequest request = MakeSyntheticRequest(1, false).request;
   constexpr int kRepeats = 100000;
   for (int i = 0; i < kRepeats; ++i) {
-    request.mutable_options()->add_saliency()->set_op(v1::PH);
+    request.mutable_options()->add_saliency()->set_op(v1::SALIENCY_OPERATOR_PH);
   }
   const auto start = std::chrono::steady_clock::now();
   v1::DetectResponse response;

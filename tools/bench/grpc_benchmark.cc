@@ -1,8 +1,10 @@
 #include "tools/bench/grpc_benchmark.h"
 
 #include <grpcpp/grpcpp.h>
+#include <stdlib.h>
 
 #include <chrono>
+#include <filesystem>
 #include <memory>
 #include <string_view>
 #include <thread>
@@ -32,6 +34,7 @@ constexpr auto kWarmUpPoll = std::chrono::milliseconds(10);
 struct Loopback {
   std::unique_ptr<server::FoveaServer> server;
   std::unique_ptr<v1::Perception::Stub> stub;
+  std::string records;  // the recorder's folder, removed at the end
 };
 
 int& LoopbackThreads() {
@@ -39,19 +42,32 @@ int& LoopbackThreads() {
   return threads;
 }
 
-std::unique_ptr<Loopback>& LoopbackInstance() {
+// The loopback server, and one with the flight recorder on (every call
+// recorded, into a temporary folder of at most kRecordedMaxBytes).
+std::unique_ptr<Loopback>& LoopbackInstance(bool recorded = false) {
   static auto* loopback = new std::unique_ptr<Loopback>;
-  return *loopback;
+  static auto* recording = new std::unique_ptr<Loopback>;
+  return recorded ? *recording : *loopback;
 }
 
-absl::StatusOr<Loopback*> StartLoopback() {
-  std::unique_ptr<Loopback>& loopback = LoopbackInstance();
+constexpr int64_t kRecordedMaxBytes = int64_t{256} << 20;
+
+absl::StatusOr<Loopback*> StartLoopback(bool recorded = false) {
+  std::unique_ptr<Loopback>& loopback = LoopbackInstance(recorded);
   if (loopback != nullptr) return loopback.get();
   server::SetLogLevel(server::LogLevel::kWarn);  // no line per call
   server::ServerConfig config;
   config.listen = "127.0.0.1:0";
   config.concurrency = 1;
   config.threads_per_request = LoopbackThreads();
+  if (recorded) {
+    char folder[] = "/tmp/fovea-bench-records-XXXXXX";
+    if (mkdtemp(folder) == nullptr) {
+      return absl::InternalError("cannot make a folder for the records");
+    }
+    config.record_dir = folder;
+    config.record_max_bytes = kRecordedMaxBytes;
+  }
   FOVEA_ASSIGN_OR_RETURN(std::unique_ptr<server::FoveaServer> started,
                          server::FoveaServer::Start(config));
   const auto deadline = std::chrono::steady_clock::now() + kWarmUpTimeout;
@@ -63,6 +79,7 @@ absl::StatusOr<Loopback*> StartLoopback() {
   }
   auto made = std::make_unique<Loopback>();
   made->server = std::move(started);
+  made->records = config.record_dir;
   made->stub = v1::Perception::NewStub(
       grpc::CreateChannel(absl::StrCat("127.0.0.1:", made->server->port()),
                           grpc::InsecureChannelCredentials()));
@@ -87,8 +104,8 @@ v1::DetectRequest MakeRequest(const BenchScene& scene,
   }
   if (ops.empty()) return request;  // the server's defaults
   // The foundation's configuration, as BM_Detect runs it.
-  options.set_pyramid(v1::NONE);
-  options.set_extraction(v1::MSR);
+  options.set_pyramid(v1::PYRAMID_NONE);
+  options.set_extraction(v1::EXTRACTION_MSR);
   options.set_split_at_surface_edges(false);
   options.set_max_points(DetectOptions{}.max_points);
   return request;
@@ -96,8 +113,9 @@ v1::DetectRequest MakeRequest(const BenchScene& scene,
 
 void BenchmarkGrpcDetect(benchmark::State& state, const SceneList& scenes,
                          const std::string& set_name,
-                         const std::vector<SaliencyOp>& ops) {
-  absl::StatusOr<Loopback*> loopback = StartLoopback();
+                         const std::vector<SaliencyOp>& ops,
+                         bool recorded = false) {
+  absl::StatusOr<Loopback*> loopback = StartLoopback(recorded);
   if (!loopback.ok()) {
     state.SkipWithError(loopback.status().ToString().c_str());
     return;
@@ -213,9 +231,19 @@ void RegisterGrpcBenchmarks(const SceneList* scenes,
                                      kGrpcDetectMs))
         ->Unit(benchmark::kMillisecond);
   }
+  // The same default Detect on a server whose flight recorder keeps every
+  // call: the recorder's cost on a call (BM_DetectGrpc/default's pair).
+  benchmark::RegisterBenchmark(
+      absl::StrCat("BM_DetectGrpcRecorded/default", suffix).c_str(),
+      [scenes, set_name](benchmark::State& state) {
+        BenchmarkGrpcDetect(state, *scenes, set_name, {}, /*recorded=*/true);
+      })
+      ->Iterations(SweepIterations(sweep, static_cast<int>(scenes->size()),
+                                   kGrpcDetectMs))
+      ->Unit(benchmark::kMillisecond);
   for (const auto& [name, method] :
-       {std::pair<const char*, v1::SegmentationMethod>{"cos", v1::COS},
-        {"ebs", v1::EBS}}) {
+       {std::pair<const char*, v1::SegmentationMethod>{"cos", v1::SEGMENTATION_METHOD_COS},
+        {"ebs", v1::SEGMENTATION_METHOD_EBS}}) {
     for (const int max_objects : {1, 0}) {
       benchmark::RegisterBenchmark(
           absl::StrCat("BM_SegmentGrpc/", name,
@@ -245,11 +273,16 @@ void RegisterGrpcBenchmarks(const SceneList* scenes,
 }
 
 void StopGrpcServer() {
-  std::unique_ptr<Loopback>& loopback = LoopbackInstance();
-  if (loopback == nullptr) return;
-  loopback->stub.reset();
-  loopback->server->Shutdown(absl::Seconds(1));
-  loopback.reset();
+  for (const bool recorded : {false, true}) {
+    std::unique_ptr<Loopback>& loopback = LoopbackInstance(recorded);
+    if (loopback == nullptr) continue;
+    loopback->stub.reset();
+    loopback->server->Shutdown(absl::Seconds(1));
+    const std::string records = loopback->records;
+    loopback.reset();  // the recorder writes what it holds, then stops
+    std::error_code ignored;
+    if (!records.empty()) std::filesystem::remove_all(records, ignored);
+  }
 }
 
 }  // namespace fovea::bench

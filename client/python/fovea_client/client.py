@@ -17,22 +17,70 @@ _HEALTH_CHECK = "/grpc.health.v1.Health/Check"
 _MAX_MESSAGE_BYTES = 64 * 1024 * 1024
 
 
+def _enum_prefix(enum_descriptor) -> str:
+    """SALIENCY_OPERATOR_ for SaliencyOperator (proto/enum_names.h)."""
+    name = enum_descriptor.name
+    out = []
+    for i, c in enumerate(name):
+        if i > 0 and c.isupper() and not name[i - 1].isupper():
+            out.append("_")
+        out.append(c.upper())
+    return "".join(out) + "_"
+
+
+def _enum_value(enum_descriptor, value):
+    """An enum value given as a number, its full name or its short name
+    ("msr", "MSR" or "EXTRACTION_MSR"); ValueError naming the known ones
+    otherwise."""
+    if not isinstance(value, str):
+        return value
+    by_name = enum_descriptor.values_by_name
+    for candidate in (value.upper(), _enum_prefix(enum_descriptor) + value.upper()):
+        if candidate in by_name:
+            return by_name[candidate].number
+    known = ", ".join(v.name[len(_enum_prefix(enum_descriptor)):].lower()
+                      for v in enum_descriptor.values if v.number != 0)
+    raise ValueError(f"{enum_descriptor.name}: unknown value {value!r} "
+                     f"(known: {known})")
+
+
+def _with_enum_values(descriptor, fields: dict) -> dict:
+    """`fields` with enum names turned into numbers, nested dicts too."""
+    out = {}
+    for key, value in fields.items():
+        field = descriptor.fields_by_name.get(key)
+        if field is None:
+            raise ValueError(f"{descriptor.name} has no field {key!r}")
+        if field.enum_type is not None:
+            if isinstance(value, (list, tuple)):
+                value = [_enum_value(field.enum_type, v) for v in value]
+            else:
+                value = _enum_value(field.enum_type, value)
+        elif field.message_type is not None and isinstance(value, dict):
+            value = _with_enum_values(field.message_type, value)
+        out[key] = value
+    return out
+
+
 def detect_options(**options: Any) -> detect_pb2.DetectOptions:
     """DetectOptions (detect.proto) from keyword arguments.
 
-    Fields are named as in the proto: max_points=5, extraction="MSR",
-    pyramid="SIMPLE", split_at_surface_edges=False, ... Enum values may be
-    given by name. `saliency` may be a list of operator names ("rso", "ph")
+    Fields are named as in the proto: max_points=5, extraction="msr",
+    pyramid="simple", split_at_surface_edges=False, ... Enum values may be
+    given by their short name (any case, without the enum's prefix) or
+    their full one ("EXTRACTION_MSR"). `saliency` may be a list of operator names ("rso", "ph")
     or of (name, weight) pairs. Messages may be dicts, e.g. what the robot
     knows of the scene: scene={"gravity": {"x": 0, "y": 0.7, "z": 0.7},
     "sensor": "SENSOR_MODEL_ACTIVE_STEREO", "workspace": {"max_depth_m":
     2.0}}. Raises ValueError for an unknown field.
     """
     saliency = options.pop("saliency", None)
-    message = detect_pb2.DetectOptions(**options)
+    message = detect_pb2.DetectOptions(
+        **_with_enum_values(detect_pb2.DetectOptions.DESCRIPTOR, options))
+    operators = detect_pb2.SaliencyOperator.DESCRIPTOR
     for entry in saliency or ():
         name, weight = (entry, 0.0) if isinstance(entry, str) else entry
-        message.saliency.add(op=name.upper(), weight=weight)
+        message.saliency.add(op=_enum_value(operators, name), weight=weight)
     return message
 
 
@@ -116,7 +164,7 @@ class FoveaClient:
         return health_pb2.HealthCheckResponse.ServingStatus.Name(response.status)
 
     def capabilities(self, timeout: Optional[float] = None
-                     ) -> perception_pb2.Capabilities:
+                     ) -> perception_pb2.GetCapabilitiesResponse:
         """The server's Capabilities (perception.proto)."""
         return self._stub.GetCapabilities(
             perception_pb2.GetCapabilitiesRequest(), timeout=timeout)
@@ -168,7 +216,9 @@ class FoveaClient:
         request = segment_pb2.SegmentRequest(
             request_id=request_id,
             frame=frame_from_numpy(color_rgb, depth_m, fx, fy, cx, cy),
-            method=method, max_objects=max_objects,
+            method=_enum_value(segment_pb2.SegmentationMethod.DESCRIPTOR,
+                               method),
+            max_objects=max_objects,
             seeds=[detect_pb2.AttentionPixel(u=u, v=v) for u, v in seeds],
             detect_options=detect_options(**options),
             object_points=_points_options(object_points, max_points))
