@@ -92,8 +92,10 @@ TEST(ParseEnumsTest, ShortNamesMapToProtoEnums) {
   EXPECT_EQ(*ParseLevelCombination("max"), fovea::v1::LEVEL_COMBINATION_MAX);
   EXPECT_EQ(*ParseFusion("sum"), fovea::v1::FUSION_SUM);
   EXPECT_EQ(*ParseFusion("max"), fovea::v1::FUSION_MAX);
-  EXPECT_EQ(*ParseSegmentationMethod("cos"), fovea::v1::SEGMENTATION_METHOD_COS);
-  EXPECT_EQ(*ParseSegmentationMethod("ebs"), fovea::v1::SEGMENTATION_METHOD_EBS);
+  EXPECT_EQ(*ParseSegmentationMethod("cos"),
+            fovea::v1::SEGMENTATION_METHOD_COS);
+  EXPECT_EQ(*ParseSegmentationMethod("ebs"),
+            fovea::v1::SEGMENTATION_METHOD_EBS);
 }
 
 TEST(ParseEnumsTest, UnknownNamesNameTheFlag) {

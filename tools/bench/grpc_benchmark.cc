@@ -242,7 +242,8 @@ void RegisterGrpcBenchmarks(const SceneList* scenes,
                                    kGrpcDetectMs))
       ->Unit(benchmark::kMillisecond);
   for (const auto& [name, method] :
-       {std::pair<const char*, v1::SegmentationMethod>{"cos", v1::SEGMENTATION_METHOD_COS},
+       {std::pair<const char*, v1::SegmentationMethod>{
+            "cos", v1::SEGMENTATION_METHOD_COS},
         {"ebs", v1::SEGMENTATION_METHOD_EBS}}) {
     for (const int max_objects : {1, 0}) {
       benchmark::RegisterBenchmark(
