@@ -5,10 +5,12 @@
 
 #include <chrono>
 #include <filesystem>
+#include <iterator>
 #include <memory>
 #include <string_view>
 #include <thread>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -42,31 +44,42 @@ int& LoopbackThreads() {
   return threads;
 }
 
-// The loopback server, and one with the flight recorder on (every call
-// recorded, into a temporary folder of at most kRecordedMaxBytes).
-std::unique_ptr<Loopback>& LoopbackInstance(bool recorded = false) {
-  static auto* loopback = new std::unique_ptr<Loopback>;
-  static auto* recording = new std::unique_ptr<Loopback>;
-  return recorded ? *recording : *loopback;
+// Whether the loopback server's flight recorder is on, and for which share
+// of the calls (into a temporary folder of at most kRecordedMaxBytes).
+enum class Recording { kOff, kEveryCall, kOneInTen };
+constexpr Recording kRecordings[] = {Recording::kOff, Recording::kEveryCall,
+                                     Recording::kOneInTen};
+
+double RecordSample(Recording recording) {
+  return recording == Recording::kOneInTen ? 0.1 : 1.0;
+}
+
+// One loopback server per recording mode.
+std::unique_ptr<Loopback>& LoopbackInstance(
+    Recording recording = Recording::kOff) {
+  static auto* loopbacks =
+      new std::unique_ptr<Loopback>[std::size(kRecordings)];
+  return loopbacks[static_cast<int>(recording)];
 }
 
 constexpr int64_t kRecordedMaxBytes = int64_t{256} << 20;
 
-absl::StatusOr<Loopback*> StartLoopback(bool recorded = false) {
-  std::unique_ptr<Loopback>& loopback = LoopbackInstance(recorded);
+absl::StatusOr<Loopback*> StartLoopback(Recording recording = Recording::kOff) {
+  std::unique_ptr<Loopback>& loopback = LoopbackInstance(recording);
   if (loopback != nullptr) return loopback.get();
   server::SetLogLevel(server::LogLevel::kWarn);  // no line per call
   server::ServerConfig config;
   config.listen = "127.0.0.1:0";
   config.concurrency = 1;
   config.threads_per_request = LoopbackThreads();
-  if (recorded) {
+  if (recording != Recording::kOff) {
     char folder[] = "/tmp/fovea-bench-records-XXXXXX";
     if (mkdtemp(folder) == nullptr) {
       return absl::InternalError("cannot make a folder for the records");
     }
     config.record_dir = folder;
     config.record_max_bytes = kRecordedMaxBytes;
+    config.record_sample = RecordSample(recording);
   }
   FOVEA_ASSIGN_OR_RETURN(std::unique_ptr<server::FoveaServer> started,
                          server::FoveaServer::Start(config));
@@ -114,8 +127,8 @@ v1::DetectRequest MakeRequest(const BenchScene& scene,
 void BenchmarkGrpcDetect(benchmark::State& state, const SceneList& scenes,
                          const std::string& set_name,
                          const std::vector<SaliencyOp>& ops,
-                         bool recorded = false) {
-  absl::StatusOr<Loopback*> loopback = StartLoopback(recorded);
+                         Recording recording = Recording::kOff) {
+  absl::StatusOr<Loopback*> loopback = StartLoopback(recording);
   if (!loopback.ok()) {
     state.SkipWithError(loopback.status().ToString().c_str());
     return;
@@ -232,15 +245,21 @@ void RegisterGrpcBenchmarks(const SceneList* scenes,
         ->Unit(benchmark::kMillisecond);
   }
   // The same default Detect on a server whose flight recorder keeps every
-  // call: the recorder's cost on a call (BM_DetectGrpc/default's pair).
-  benchmark::RegisterBenchmark(
-      absl::StrCat("BM_DetectGrpcRecorded/default", suffix).c_str(),
-      [scenes, set_name](benchmark::State& state) {
-        BenchmarkGrpcDetect(state, *scenes, set_name, {}, /*recorded=*/true);
-      })
-      ->Iterations(SweepIterations(sweep, static_cast<int>(scenes->size()),
-                                   kGrpcDetectMs))
-      ->Unit(benchmark::kMillisecond);
+  // call, and one that keeps one call in ten (--record_sample 0.1): the
+  // recorder's cost on a call (BM_DetectGrpc/default's pairs).
+  for (const auto& [name, recording] :
+       {std::pair<const char*, Recording>{"BM_DetectGrpcRecorded",
+                                          Recording::kEveryCall},
+        {"BM_DetectGrpcSampled", Recording::kOneInTen}}) {
+    benchmark::RegisterBenchmark(
+        absl::StrCat(name, "/default", suffix).c_str(),
+        [scenes, set_name, recording = recording](benchmark::State& state) {
+          BenchmarkGrpcDetect(state, *scenes, set_name, {}, recording);
+        })
+        ->Iterations(SweepIterations(sweep, static_cast<int>(scenes->size()),
+                                     kGrpcDetectMs))
+        ->Unit(benchmark::kMillisecond);
+  }
   for (const auto& [name, method] :
        {std::pair<const char*, v1::SegmentationMethod>{
             "cos", v1::SEGMENTATION_METHOD_COS},
@@ -274,8 +293,8 @@ void RegisterGrpcBenchmarks(const SceneList* scenes,
 }
 
 void StopGrpcServer() {
-  for (const bool recorded : {false, true}) {
-    std::unique_ptr<Loopback>& loopback = LoopbackInstance(recorded);
+  for (const Recording recording : kRecordings) {
+    std::unique_ptr<Loopback>& loopback = LoopbackInstance(recording);
     if (loopback == nullptr) continue;
     loopback->stub.reset();
     loopback->server->Shutdown(absl::Seconds(1));
