@@ -73,8 +73,16 @@ TEST(ReplayTest, RecordedCallsReplayUnchangedAndAChangedAnswerIsReported) {
     }
     ASSERT_TRUE(reader->Finish().ok());
   }
-  (*s)->recorder()->Flush();
+  // A call is handed to the recorder when the server is done with it,
+  // which can be after the client has its status: wait for the records
+  // (each appears whole), at most 30 s on a loaded machine.
   const fs::path records = dir / "records";
+  for (int i = 0; i < 3000 && !(fs::exists(records / "00000001-Detect") &&
+                                fs::exists(records / "00000002-Segment"));
+       ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  (*s)->recorder()->Flush();
   // A new server (not recording) is what the calls are replayed on.
   config.record_dir.clear();
   absl::StatusOr<std::unique_ptr<server::FoveaServer>> fresh =
