@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -11,6 +12,7 @@
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
+#include "core/base/check.h"
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "proto/enum_names.h"
@@ -177,12 +179,30 @@ v1::RleMask ToRleMask(const cv::Mat& mask) {
   v1::RleMask rle;
   rle.set_height(static_cast<uint32_t>(mask.rows));
   rle.set_width(static_cast<uint32_t>(mask.cols));
-  // Column-major runs, starting with a (possibly empty) run of zeros.
+  if (mask.empty()) return rle;
+  FOVEA_CHECK(mask.type() == CV_8UC1);
+  // Column-major runs, starting with a (possibly empty) run of zeros. An
+  // object covers a small part of the frame: only the columns and rows of
+  // its bounding box are read (down a column is a stride of a whole row,
+  // so reading every pixel that way cost 0.3 ms per 640x480 mask); what
+  // lies around the box is zeros, counted in bulk.
+  const cv::Rect box = cv::boundingRect(mask);
   bool inside = false;
   uint32_t run = 0;
-  for (int u = 0; u < mask.cols; ++u) {
-    for (int v = 0; v < mask.rows; ++v) {
-      const bool here = mask.at<unsigned char>(v, u) != 0;
+  const auto zeros = [&](int count) {
+    if (count == 0) return;
+    if (inside) {
+      rle.add_counts(run);
+      run = 0;
+      inside = false;
+    }
+    run += static_cast<uint32_t>(count);
+  };
+  zeros(box.x * mask.rows);
+  for (int u = box.x; u < box.x + box.width; ++u) {
+    zeros(box.y);
+    for (int v = box.y; v < box.y + box.height; ++v) {
+      const bool here = mask.ptr<unsigned char>(v)[u] != 0;
       if (here != inside) {
         rle.add_counts(run);
         run = 0;
@@ -190,8 +210,10 @@ v1::RleMask ToRleMask(const cv::Mat& mask) {
       }
       ++run;
     }
+    zeros(mask.rows - box.y - box.height);
   }
-  if (mask.total() > 0) rle.add_counts(run);
+  zeros((mask.cols - box.x - box.width) * mask.rows);
+  rle.add_counts(run);
   return rle;
 }
 

@@ -1,9 +1,11 @@
 #include "server/convert.h"
 
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
 
@@ -433,6 +435,88 @@ TEST(EncodeSaliencyPngTest, RefusesAMapOfAnotherType) {
             absl::StatusCode::kInternal);
   EXPECT_EQ(EncodeSaliencyPng(cv::Mat()).status().code(),
             absl::StatusCode::kInternal);
+}
+
+// COCO RLE by its definition: every pixel down each column in turn, a new
+// run at each change, starting with zeros.
+std::vector<uint32_t> RunsPixelByPixel(const cv::Mat& mask) {
+  std::vector<uint32_t> runs;
+  bool inside = false;
+  uint32_t run = 0;
+  for (int u = 0; u < mask.cols; ++u) {
+    for (int v = 0; v < mask.rows; ++v) {
+      const bool here = mask.at<unsigned char>(v, u) != 0;
+      if (here != inside) {
+        runs.push_back(run);
+        run = 0;
+        inside = here;
+      }
+      ++run;
+    }
+  }
+  if (!mask.empty()) runs.push_back(run);
+  return runs;
+}
+
+std::vector<uint32_t> Counts(const v1::RleMask& rle) {
+  return {rle.counts().begin(), rle.counts().end()};
+}
+
+TEST(ToRleMaskTest, RunsAreThoseOfEveryPixelDownEachColumn) {
+  // Objects touching each border of the frame, its corners, the bottom of
+  // their own box in some columns, and masks of one pixel: the runs that
+  // cross from a column into the next, and the box's edges, are where a
+  // reader of the box alone could go wrong.
+  std::vector<cv::Mat> masks;
+  const auto blank = [] { return cv::Mat(48, 64, CV_8UC1, cv::Scalar(0)); };
+  masks.push_back(blank());                                    // nothing
+  masks.push_back(cv::Mat(48, 64, CV_8UC1, cv::Scalar(255)));  // all
+  for (const cv::Point corner : {cv::Point(0, 0), cv::Point(63, 0),
+                                 cv::Point(0, 47), cv::Point(63, 47)}) {
+    cv::Mat one = blank();
+    one.at<unsigned char>(corner) = 1;
+    masks.push_back(one);
+  }
+  cv::Mat left = blank();
+  left(cv::Rect(0, 10, 5, 20)).setTo(1);  // on the left border
+  masks.push_back(left);
+  cv::Mat bottom = blank();
+  bottom(cv::Rect(20, 30, 9, 18)).setTo(7);  // down to the last row
+  masks.push_back(bottom);
+  cv::Mat top_right = blank();
+  top_right(cv::Rect(50, 0, 14, 6)).setTo(255);
+  masks.push_back(top_right);
+  cv::Mat two = blank();  // two parts: the box spans a gap
+  cv::circle(two, {15, 15}, 6, cv::Scalar(255), cv::FILLED);
+  cv::circle(two, {45, 35}, 8, cv::Scalar(255), cv::FILLED);
+  masks.push_back(two);
+  cv::Mat ring = blank();  // holes inside the box
+  cv::circle(ring, {32, 24}, 12, cv::Scalar(255), 3);
+  masks.push_back(ring);
+  cv::RNG rng(17);
+  for (int i = 0; i < 20; ++i) {
+    cv::Mat noise(48, 64, CV_8UC1);
+    rng.fill(noise, cv::RNG::UNIFORM, 0, 2);
+    masks.push_back(noise);
+  }
+  // A view into a larger image (rows not contiguous).
+  cv::Mat larger(60, 80, CV_8UC1, cv::Scalar(0));
+  cv::circle(larger, {40, 30}, 10, cv::Scalar(255), cv::FILLED);
+  masks.push_back(larger(cv::Rect(30, 20, 40, 30)));
+  for (size_t i = 0; i < masks.size(); ++i) {
+    SCOPED_TRACE(i);
+    const v1::RleMask rle = ToRleMask(masks[i]);
+    EXPECT_EQ(rle.height(), static_cast<uint32_t>(masks[i].rows));
+    EXPECT_EQ(rle.width(), static_cast<uint32_t>(masks[i].cols));
+    EXPECT_EQ(Counts(rle), RunsPixelByPixel(masks[i]));
+  }
+}
+
+TEST(ToRleMaskTest, AMaskWithoutPixelsHasNoRuns) {
+  const v1::RleMask rle = ToRleMask(cv::Mat(0, 0, CV_8UC1));
+  EXPECT_EQ(rle.height(), 0u);
+  EXPECT_EQ(rle.width(), 0u);
+  EXPECT_EQ(rle.counts_size(), 0);
 }
 
 TEST(CapabilitiesTest, ListWhatCoreValidates) {
