@@ -18,16 +18,19 @@
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/pipeline/detect.h"
+#include "core/pipeline/segment.h"
 #include "fovea/v1/perception.grpc.pb.h"
 #include "server/convert.h"
 #include "server/log.h"
 #include "server/server.h"
+#include "tools/bench/stage_benchmarks.h"
 
 namespace fovea::bench {
 namespace {
 
 // Rough cost per call, milliseconds (sizes the passes, see SweepIterations).
 constexpr double kGrpcDetectMs = 40.0;
+constexpr double kObjectMessagesMs = 1.0;
 // How long to wait for the server's warm-up.
 constexpr auto kWarmUpTimeout = std::chrono::seconds(60);
 constexpr auto kWarmUpPoll = std::chrono::milliseconds(10);
@@ -219,6 +222,49 @@ void BenchmarkGrpcIncremental(benchmark::State& state, const SceneList& scenes,
   });
 }
 
+// Building and serialising the stream's object messages for one frame:
+// what the server does for each object on its way to the client. The
+// objects are COS's with the default options, cut once per scene before
+// the timing.
+void BenchmarkObjectMessages(benchmark::State& state, const SceneList& scenes,
+                             const std::string& set_name) {
+  const absl::StatusOr<LoadedModels>& models = BenchModels();
+  if (!models.ok()) {
+    state.SkipWithError(models.status().ToString().c_str());
+    return;
+  }
+  std::unordered_map<const BenchScene*, std::vector<SegmentedObject>> objects;
+  size_t count = 0;
+  for (const auto& scene : scenes) {
+    std::vector<SegmentedObject>& kept = objects[scene.get()];
+    SegmentSinks sinks;
+    sinks.object = [&kept](SegmentedObject object) {
+      kept.push_back(std::move(object));
+      return absl::OkStatus();
+    };
+    const absl::StatusOr<SegmentSummary> summary =
+        RunSegment(scene->frame, SegmentOptions{}, models->View(), sinks);
+    if (!summary.ok()) {
+      state.SkipWithError(summary.status().ToString().c_str());
+      return;
+    }
+    count += kept.size();
+  }
+  std::string wire;
+  SweepScenes(state, scenes, set_name, [&](const BenchScene& scene) {
+    for (const SegmentedObject& object : objects.at(&scene)) {
+      if (!server::ToObjectMessage(object, scene.name)
+               .SerializeToString(&wire)) {
+        return absl::InternalError("an object message did not serialise");
+      }
+      benchmark::DoNotOptimize(wire);
+    }
+    return absl::OkStatus();
+  });
+  state.counters["objects_per_frame"] =
+      static_cast<double>(count) / static_cast<double>(scenes.size());
+}
+
 }  // namespace
 
 void SetGrpcThreadsPerRequest(int threads) { LoopbackThreads() = threads; }
@@ -290,6 +336,14 @@ void RegisterGrpcBenchmarks(const SceneList* scenes,
                                      2 * kGrpcDetectMs))
         ->Unit(benchmark::kMillisecond);
   }
+  benchmark::RegisterBenchmark(
+      absl::StrCat("BM_ObjectMessages/cos", suffix).c_str(),
+      [scenes, set_name](benchmark::State& state) {
+        BenchmarkObjectMessages(state, *scenes, set_name);
+      })
+      ->Iterations(SweepIterations(sweep, static_cast<int>(scenes->size()),
+                                   kObjectMessagesMs))
+      ->Unit(benchmark::kMillisecond);
 }
 
 void StopGrpcServer() {

@@ -299,14 +299,6 @@ void RegisterSurfaceModelCases(const SceneList* scenes, const std::string& set,
   }
 }
 
-// The models of the source tree's models/ (the server's default), loaded
-// once.
-const absl::StatusOr<LoadedModels>& BenchModels() {
-  static const auto* models =
-      new absl::StatusOr<LoadedModels>(LoadModels(FOVEA_BENCH_MODELS_DIR));
-  return *models;
-}
-
 // Segment in-process with the default options: "first" stops after the
 // first object (the time a robot waits for it), "all" cuts one object per
 // attention point.
@@ -481,6 +473,12 @@ void RegisterAttentionCases(const SceneList* scenes, const std::string& set,
 }
 
 }  // namespace
+
+const absl::StatusOr<LoadedModels>& BenchModels() {
+  static const auto* models =
+      new absl::StatusOr<LoadedModels>(LoadModels(FOVEA_BENCH_MODELS_DIR));
+  return *models;
+}
 
 int64_t SweepIterations(const SweepOptions& sweep, int scene_count,
                         double expected_ms) {

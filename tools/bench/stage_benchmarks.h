@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "core/pipeline/models.h"
 #include "tools/bench/bench_inputs.h"
 
 namespace fovea::bench {
@@ -25,6 +27,10 @@ struct SweepOptions {
   int passes = 0;
   double target_repetition_seconds = 0.5;
 };
+
+// The models of the source tree's models/ (the server's default), loaded
+// once.
+const absl::StatusOr<LoadedModels>& BenchModels();
 
 // Iterations for one repetition of a case expected to take `expected_ms`
 // per frame on `scene_count` scenes: a multiple of `scene_count`.
