@@ -156,25 +156,69 @@ void BenchmarkGrpcDetect(benchmark::State& state, const SceneList& scenes,
 }
 
 // Reads a segmentation stream to its end; its status.
+// Reads a stream to its end. With `first_object`, the seconds from `start`
+// to the first object message (to the end when there is none) are set as
+// the iteration's time (cases that UseManualTime): what a robot waits
+// before it can act.
 absl::Status ReadStream(
-    std::unique_ptr<grpc::ClientReader<v1::SegmentResponse>> reader) {
+    std::unique_ptr<grpc::ClientReader<v1::SegmentResponse>> reader,
+    benchmark::State* first_object = nullptr,
+    std::chrono::steady_clock::time_point start = {}) {
   v1::SegmentResponse response;
   int messages = 0;
-  while (reader->Read(&response)) ++messages;
+  bool timed = false;
+  while (reader->Read(&response)) {
+    ++messages;
+    if (first_object != nullptr && !timed && response.has_object()) {
+      first_object->SetIterationTime(
+          std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                        start)
+              .count());
+      timed = true;
+    }
+  }
   const grpc::Status status = reader->Finish();
   benchmark::DoNotOptimize(messages);
-  return status.ok()
-             ? absl::OkStatus()
-             : absl::Status(static_cast<absl::StatusCode>(status.error_code()),
-                            status.error_message());
+  if (!status.ok()) {
+    return absl::Status(static_cast<absl::StatusCode>(status.error_code()),
+                        status.error_message());
+  }
+  if (first_object != nullptr &&
+      !timed) {  // no object: the robot knows at the end
+    first_object->SetIterationTime(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+            .count());
+  }
+  return absl::OkStatus();
+}
+
+// How much of a segmentation stream a case times.
+enum class StreamTiming {
+  kFirst,        // the whole call with max_objects 1
+  kAll,          // the whole call, every object
+  kFirstObject,  // max_objects 1, until the object message arrives
+};
+constexpr StreamTiming kStreamTimings[] = {
+    StreamTiming::kFirst, StreamTiming::kAll, StreamTiming::kFirstObject};
+
+const char* StreamTimingName(StreamTiming timing) {
+  switch (timing) {
+    case StreamTiming::kFirst:
+      return "first";
+    case StreamTiming::kAll:
+      return "all";
+    case StreamTiming::kFirstObject:
+      return "first_object";
+  }
+  return "";
 }
 
 // One Segment call per scene with the server's default options and
-// `method`; max_objects 1 ends the stream after the first object (the time
-// to the first mask), 0 cuts them all.
+// `method`, timed as `timing` says.
 void BenchmarkGrpcSegment(benchmark::State& state, const SceneList& scenes,
                           const std::string& set_name,
-                          v1::SegmentationMethod method, int max_objects) {
+                          v1::SegmentationMethod method, StreamTiming timing) {
+  const int max_objects = timing == StreamTiming::kAll ? 0 : 1;
   absl::StatusOr<Loopback*> loopback = StartLoopback();
   if (!loopback.ok()) {
     state.SkipWithError(loopback.status().ToString().c_str());
@@ -192,15 +236,19 @@ void BenchmarkGrpcSegment(benchmark::State& state, const SceneList& scenes,
   }
   SweepScenes(state, scenes, set_name, [&](const BenchScene& scene) {
     grpc::ClientContext context;
-    return ReadStream(
-        (*loopback)->stub->Segment(&context, requests.at(&scene)));
+    const auto start = std::chrono::steady_clock::now();
+    return ReadStream((*loopback)->stub->Segment(&context, requests.at(&scene)),
+                      timing == StreamTiming::kFirstObject ? &state : nullptr,
+                      start);
   });
 }
 
-// One SegmentIncremental call per scene with the server's defaults;
-// max_objects 1: the time to the first object; 0: the whole scene.
+// One SegmentIncremental call per scene with the server's defaults, timed
+// as `timing` says.
 void BenchmarkGrpcIncremental(benchmark::State& state, const SceneList& scenes,
-                              const std::string& set_name, int max_objects) {
+                              const std::string& set_name,
+                              StreamTiming timing) {
+  const int max_objects = timing == StreamTiming::kAll ? 0 : 1;
   absl::StatusOr<Loopback*> loopback = StartLoopback();
   if (!loopback.ok()) {
     state.SkipWithError(loopback.status().ToString().c_str());
@@ -217,8 +265,10 @@ void BenchmarkGrpcIncremental(benchmark::State& state, const SceneList& scenes,
   }
   SweepScenes(state, scenes, set_name, [&](const BenchScene& scene) {
     grpc::ClientContext context;
+    const auto start = std::chrono::steady_clock::now();
     return ReadStream(
-        (*loopback)->stub->SegmentIncremental(&context, requests.at(&scene)));
+        (*loopback)->stub->SegmentIncremental(&context, requests.at(&scene)),
+        timing == StreamTiming::kFirstObject ? &state : nullptr, start);
   });
 }
 
@@ -310,31 +360,32 @@ void RegisterGrpcBenchmarks(const SceneList* scenes,
        {std::pair<const char*, v1::SegmentationMethod>{
             "cos", v1::SEGMENTATION_METHOD_COS},
         {"ebs", v1::SEGMENTATION_METHOD_EBS}}) {
-    for (const int max_objects : {1, 0}) {
-      benchmark::RegisterBenchmark(
-          absl::StrCat("BM_SegmentGrpc/", name,
-                       max_objects == 1 ? "/first" : "/all", suffix)
+    for (const StreamTiming timing : kStreamTimings) {
+      benchmark::internal::Benchmark* b = benchmark::RegisterBenchmark(
+          absl::StrCat("BM_SegmentGrpc/", name, "/", StreamTimingName(timing),
+                       suffix)
               .c_str(),
-          [scenes, set_name, method = method,
-           max_objects](benchmark::State& state) {
-            BenchmarkGrpcSegment(state, *scenes, set_name, method, max_objects);
-          })
-          ->Iterations(SweepIterations(sweep, static_cast<int>(scenes->size()),
-                                       2 * kGrpcDetectMs))
+          [scenes, set_name, method = method, timing](benchmark::State& state) {
+            BenchmarkGrpcSegment(state, *scenes, set_name, method, timing);
+          });
+      b->Iterations(SweepIterations(sweep, static_cast<int>(scenes->size()),
+                                    2 * kGrpcDetectMs))
           ->Unit(benchmark::kMillisecond);
+      if (timing == StreamTiming::kFirstObject) b->UseManualTime();
     }
   }
-  for (const int max_objects : {1, 0}) {
-    benchmark::RegisterBenchmark(
-        absl::StrCat("BM_SegmentIncrementalGrpc/",
-                     max_objects == 1 ? "first" : "all", suffix)
+  for (const StreamTiming timing : kStreamTimings) {
+    benchmark::internal::Benchmark* b = benchmark::RegisterBenchmark(
+        absl::StrCat("BM_SegmentIncrementalGrpc/", StreamTimingName(timing),
+                     suffix)
             .c_str(),
-        [scenes, set_name, max_objects](benchmark::State& state) {
-          BenchmarkGrpcIncremental(state, *scenes, set_name, max_objects);
-        })
-        ->Iterations(SweepIterations(sweep, static_cast<int>(scenes->size()),
-                                     2 * kGrpcDetectMs))
+        [scenes, set_name, timing](benchmark::State& state) {
+          BenchmarkGrpcIncremental(state, *scenes, set_name, timing);
+        });
+    b->Iterations(SweepIterations(sweep, static_cast<int>(scenes->size()),
+                                  2 * kGrpcDetectMs))
         ->Unit(benchmark::kMillisecond);
+    if (timing == StreamTiming::kFirstObject) b->UseManualTime();
   }
   benchmark::RegisterBenchmark(
       absl::StrCat("BM_ObjectMessages/cos", suffix).c_str(),
