@@ -12,6 +12,7 @@
 #include "core/pipeline/detect.h"
 #include "core/pipeline/incremental.h"
 #include "core/pipeline/models.h"
+#include "core/pipeline/object_geometry.h"
 #include "core/pipeline/segment.h"
 #include "tools/bench/bench_inputs.h"
 #include "tools/bench/stages.h"
@@ -53,10 +54,26 @@ void AddPoint(const AttentionPoint& p, Digest& d) {
   d.Value(p.saliency);
 }
 
+void AddBox(const OrientedBox& box, Digest& d) {
+  d.Value(box.center);
+  d.Value(box.orientation.coeffs());
+  d.Value(box.size);
+}
+
 void AddObject(const SegmentedObject& o, Digest& d) {
   AddPoint(o.seed, d);
   d.Mat(o.mask);
   d.Value(o.score);
+  d.Value(o.geometry.has_value());
+  if (o.geometry.has_value()) {
+    const ObjectGeometry& g = *o.geometry;
+    AddBox(g.box, d);
+    d.Value(g.support_origin);
+    d.Value(g.support_orientation.coeffs());
+    AddBox(g.box_in_support, d);
+    d.Value(g.height_above_support);
+    d.Value(g.footprint_area_m2);
+  }
 }
 
 struct DigestFlags {
