@@ -2,18 +2,23 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <opencv2/imgproc.hpp>
 
 #include "absl/strings/str_cat.h"
 #include "core/base/guarded.h"
+#include "core/frame/hull_candidates.h"
 
 namespace fovea {
 namespace {
 
-// The value at `percent` of the sorted values (nearest rank).
-float Percentile(const std::vector<float>& sorted, float percent) {
-  const double rank = percent / 100.0 * (sorted.size() - 1);
-  return sorted[static_cast<size_t>(std::lround(rank))];
+// The value at `percent` of the values in sorted order (nearest rank);
+// reorders `values` (a selection, not a sort).
+float Percentile(std::vector<float>& values, float percent) {
+  const double rank = percent / 100.0 * (values.size() - 1);
+  const auto at = values.begin() + static_cast<ptrdiff_t>(std::lround(rank));
+  std::nth_element(values.begin(), at, values.end());
+  return *at;
 }
 
 absl::StatusOr<ObjectGeometry> FitUnguarded(
@@ -39,23 +44,24 @@ absl::StatusOr<ObjectGeometry> FitUnguarded(
   std::vector<float> heights;
   heights.reserve(finite.size());
   for (const Eigen::Vector3f& p : finite) heights.push_back(plane.Height(p));
-  std::vector<float> sorted = heights;
-  std::sort(sorted.begin(), sorted.end());
-  const float low = Percentile(sorted, options.trim_percent);
-  const float high = Percentile(sorted, 100.0f - options.trim_percent);
-  std::vector<cv::Point2f> footprint;
+  std::vector<float> selected = heights;
+  const float low = Percentile(selected, options.trim_percent);
+  const float high = Percentile(selected, 100.0f - options.trim_percent);
+  std::vector<Eigen::Vector2f> footprint;
   footprint.reserve(finite.size());
   for (size_t i = 0; i < finite.size(); ++i) {
     if (heights[i] < low || heights[i] > high) continue;
-    const Eigen::Vector2f q = plane.ToPlane(finite[i]);
-    footprint.emplace_back(q.x(), q.y());
+    footprint.push_back(plane.ToPlane(finite[i]));
   }
   if (footprint.size() < 3) {
     return absl::FailedPreconditionError(
         "object box: fewer than 3 points left after trimming");
   }
   // The minimum-area rectangle's two side directions; x along the longer.
-  const cv::RotatedRect rect = cv::minAreaRect(footprint);
+  // It depends on the footprint's hull only: the points that can be hull
+  // vertices give the same rectangle (cv::minAreaRect's hull sorts its
+  // points, so their order does not matter).
+  const cv::RotatedRect rect = cv::minAreaRect(HullCandidates(footprint));
   cv::Point2f corner[4];
   rect.points(corner);
   Eigen::Vector2f side_a(corner[1].x - corner[0].x, corner[1].y - corner[0].y);
