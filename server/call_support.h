@@ -146,7 +146,7 @@ bool SubmitGated(WorkQueue& work, const std::shared_ptr<JobGate>& gate,
 // slices are released once parsed. gRPC allocated the body (non-const) and
 // destroys it only when the call is done, so it may be cleared here.
 template <typename Request>
-std::pair<std::unique_ptr<const Request>, absl::Status> Parse(
+std::pair<std::unique_ptr<Request>, absl::Status> Parse(
     const grpc::ByteBuffer* body) {
   auto request = std::make_unique<Request>();
   absl::Status parsed = ParseRequest(*body, request.get());

@@ -1,6 +1,7 @@
 #ifndef FOVEA_SERVER_CONVERT_H_
 #define FOVEA_SERVER_CONVERT_H_
 
+#include <cstdint>
 #include <opencv2/core.hpp>
 #include <string>
 
@@ -33,13 +34,18 @@ enum class DepthEncoding {
   k16UC1,  // uint16 in units of `depth_scale` metres, 0 for no data
 };
 
+// A depth in metres as a 16-bit depth value in units of `metres_per_unit`
+// (> 0): rounded to the nearest unit; NaN, 0, negative or beyond 16 bits
+// is 0, no data.
+uint16_t ToDepthUnits(float metres, double metres_per_unit);
+
 // A decoded frame as raw wire images: colour "rgb8" (step = width * 3),
 // depth as `depth_encoding` (step = width * bytes per pixel). For 16UC1,
 // depth is rounded to units of `depth_scale` (metres per unit, > 0);
 // values that do not fit in 16 bits, and NaN, become 0 (no data). The
 // inverse of DecodeFrame for raw frames, used by the warm-up and tests.
 v1::Frame ToProtoFrame(const RgbdFrame& frame, DepthEncoding depth_encoding,
-                       double depth_scale = 0.001);
+                       double depth_scale = kDefaultDepthScale);
 
 // Detect options (convert_detect_options.cc).
 

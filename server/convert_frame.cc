@@ -22,6 +22,12 @@ RawImage ToRawImage(const v1::Image& image) {
 
 }  // namespace
 
+uint16_t ToDepthUnits(float metres, double metres_per_unit) {
+  const double units = std::round(metres / metres_per_unit);
+  // NaN fails both comparisons; a rounded value above 0 is at least 1.
+  return units > 0.0 && units <= 65535.0 ? static_cast<uint16_t>(units) : 0;
+}
+
 RawFrame ToRawFrame(const v1::Frame& frame) {
   RawFrame raw;
   raw.color = ToRawImage(frame.color());
@@ -73,11 +79,7 @@ v1::Frame ToProtoFrame(const RgbdFrame& frame, DepthEncoding depth_encoding,
     for (int v = 0; v < frame.depth.rows; ++v) {
       const float* row = frame.depth.ptr<float>(v);
       for (int u = 0; u < frame.depth.cols; ++u) {
-        const double units = std::round(row[u] / depth_scale);
-        const uint16_t value =
-            (std::isfinite(units) && units > 0.0 && units <= 65535.0)
-                ? static_cast<uint16_t>(units)
-                : 0;
+        const uint16_t value = ToDepthUnits(row[u], depth_scale);
         // Little-endian, as the wire says.
         *dst++ = static_cast<char>(value & 0xff);
         *dst++ = static_cast<char>(value >> 8);

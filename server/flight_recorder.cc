@@ -23,6 +23,7 @@
 #include "core/frame/image_codec.h"
 #include "core/frame/image_header.h"
 #include "fovea/v1/frame.pb.h"
+#include "server/convert.h"
 #include "server/log.h"
 #include "server/metrics.h"
 
@@ -34,8 +35,6 @@ namespace fs = std::filesystem;
 // Metres per unit of the 16-bit depth PNG a 32FC1 frame is stored as:
 // 0.1 mm, up to 6.5 m.
 constexpr double kFloatDepthScale = 1e-4;
-// Metres per unit when a request leaves depth_scale 0 (frame.proto).
-constexpr double kDefaultDepthScale = 1e-3;
 // The writer thread's nice value: the lowest priority there is.
 constexpr int kWriterNice = 19;
 
@@ -132,10 +131,7 @@ absl::StatusOr<double> DepthFile(const v1::Frame& frame, Files& out) {
         const float* in = metres.ptr<float>(v);
         uint16_t* o = units.ptr<uint16_t>(v);
         for (int u = 0; u < metres.cols; ++u) {
-          const double value = std::round(in[u] / kFloatDepthScale);
-          // NaN, 0, negative or beyond the 16 bits: no data.
-          o[u] = value >= 1.0 && value <= 65535.0 ? static_cast<uint16_t>(value)
-                                                  : uint16_t{0};
+          o[u] = ToDepthUnits(in[u], kFloatDepthScale);
         }
       }
       units_scale = kFloatDepthScale;
@@ -151,17 +147,17 @@ absl::StatusOr<double> DepthFile(const v1::Frame& frame, Files& out) {
   return units_scale;
 }
 
-// Everything a record holds, in memory.
-Files MakeFiles(const RecordedCall& call, int64_t sequence) {
+// Everything a record holds, in memory. The frame's pixels go into the
+// image files and out of the request (which is the recorder's).
+Files MakeFiles(RecordedCall& call, int64_t sequence) {
   Files out;
-  std::unique_ptr<google::protobuf::Message> request(call.request->New());
-  request->CopyFrom(*call.request);
+  google::protobuf::Message* request = call.request.get();
   const google::protobuf::FieldDescriptor* field =
       request->GetDescriptor()->FindFieldByName("frame");
   if (field != nullptr &&
       field->type() == google::protobuf::FieldDescriptor::TYPE_MESSAGE) {
     auto* frame = static_cast<v1::Frame*>(
-        request->GetReflection()->MutableMessage(request.get(), field));
+        request->GetReflection()->MutableMessage(request, field));
     absl::Status colour = ColourFile(frame->color(), out);
     absl::StatusOr<double> scale =
         colour.ok() ? DepthFile(*frame, out) : absl::StatusOr<double>(colour);

@@ -63,8 +63,10 @@ absl::Status Validate(const RecorderConfig& config);
 struct RecordedCall {
   std::string method;  // "Detect", "Segment", "SegmentIncremental"
   // The request (a DetectRequest, SegmentRequest or
-  // SegmentIncrementalRequest) and the messages sent, in order.
-  std::unique_ptr<const google::protobuf::Message> request;
+  // SegmentIncrementalRequest) and the messages sent, in order. The
+  // recorder owns the request: it moves the frame's pixels out of it into
+  // the record's image files instead of copying them.
+  std::unique_ptr<google::protobuf::Message> request;
   std::vector<std::unique_ptr<const google::protobuf::Message>> responses;
   std::string code;         // the gRPC status code's name, "OK", ...
   double seconds = 0.0;     // the call's time on the server

@@ -42,7 +42,7 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
  public:
   DetectReactor(const ServiceConfig& config, WorkQueue& work,
                 grpc::CallbackServerContext* context,
-                std::unique_ptr<const v1::DetectRequest> request,
+                std::unique_ptr<v1::DetectRequest> request,
                 const absl::Status& parsed, v1::DetectResponse* response)
       : config_(config),
         context_(context),
@@ -165,8 +165,9 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
   const ServiceConfig& config_;  // the service's; outlives every call
   // gRPC's, valid until OnDone.
   grpc::CallbackServerContext* const context_;
-  // Moved to the recorder in OnDone, when recorded.
-  std::unique_ptr<const v1::DetectRequest> request_;
+  // Read only here; moved to the recorder in OnDone, when recorded (which
+  // takes the pixels out of it as it writes them to files).
+  std::unique_ptr<v1::DetectRequest> request_;
   v1::DetectResponse* const response_;  // gRPC's, valid until OnDone
   CallRecord call_;
   const Clock::time_point start_ = Clock::now();
@@ -200,8 +201,7 @@ class StreamReactor final
   StreamReactor(std::string_view method, Convert convert, Handle handle,
                 const ServiceConfig& config, WorkQueue& work,
                 grpc::CallbackServerContext* context,
-                std::unique_ptr<const Request> request,
-                const absl::Status& parsed)
+                std::unique_ptr<Request> request, const absl::Status& parsed)
       : method_(method),
         handle_(handle),
         config_(config),
@@ -447,8 +447,9 @@ class StreamReactor final
   const Handle handle_;
   const ServiceConfig& config_;
   grpc::CallbackServerContext* const context_;  // gRPC's, valid until OnDone
-  // Moved to the recorder in OnDone, when recorded.
-  std::unique_ptr<const Request> request_;
+  // Read only here; moved to the recorder in OnDone, when recorded (which
+  // takes the pixels out of it as it writes them to files).
+  std::unique_ptr<Request> request_;
   CallRecord call_;
   const Clock::time_point start_;
   Options options_;

@@ -28,8 +28,6 @@
 namespace fovea {
 namespace {
 
-// Metres per unit of 16-bit depth when the frame's depth_scale is 0.
-constexpr double kDefaultDepthScale = 0.001;
 // Largest FrameLimits.max_width / max_height accepted: keeps every byte
 // count of a 4-byte-per-pixel row and image inside an int for cv::Mat.
 constexpr uint32_t kLargestLimit = 1u << 15;

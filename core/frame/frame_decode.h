@@ -27,6 +27,9 @@ struct RawImage {
   std::string_view compressed;
 };
 
+// Metres per unit of 16-bit depth when a frame's depth_scale is 0.
+inline constexpr double kDefaultDepthScale = 0.001;
+
 struct RawFrame {
   RawImage color;
   RawImage depth;
