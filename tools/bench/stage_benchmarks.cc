@@ -19,7 +19,6 @@
 #include "core/pipeline/detect.h"
 #include "core/pipeline/incremental.h"
 #include "core/pipeline/models.h"
-#include "core/pipeline/object_geometry.h"
 #include "core/pipeline/saliency_registry.h"
 #include "core/pipeline/segment.h"
 #include "core/saliency/ph.h"
@@ -29,6 +28,7 @@
 #include "core/segmentation/ebs.h"
 #include "core/segmentation/planar_patches.h"
 #include "core/segmentation/surface_model.h"
+#include "tools/bench/object_geometry_benchmark.h"
 
 namespace fovea::bench {
 namespace {
@@ -51,7 +51,6 @@ constexpr double kEbsEdgeProbabilityMs = 12.0;
 constexpr double kEbsContourMs = 4.0;
 constexpr double kDetectMs = 30.0;
 constexpr double kSegmentMs = 60.0;
-constexpr double kObjectGeometryMs = 1.0;
 constexpr double kPeerEuclideanMs = 40.0;
 constexpr double kPeerLccpMs = 40.0;
 
@@ -328,64 +327,6 @@ void RegisterSegmentCases(const SceneList* scenes, const std::string& set,
   }
 }
 
-// The box of each object of a frame on its support (FitSupportAlignedBox,
-// as every Segment and SegmentIncremental object gets one): COS's objects
-// with the default options, their points and the support cut once per
-// scene before the timing.
-struct SceneObjects {
-  SupportPlane plane;
-  std::vector<std::vector<Eigen::Vector3f>> points;
-};
-
-absl::StatusOr<SceneObjects> CutObjects(const BenchScene& scene) {
-  const absl::StatusOr<LoadedModels>& models = BenchModels();
-  if (!models.ok()) return models.status();
-  SceneObjects objects;
-  SegmentSinks sinks;
-  sinks.support = [&objects](const SupportPlane& plane) {
-    objects.plane = plane;
-    return absl::OkStatus();
-  };
-  sinks.object = [&objects, &scene](SegmentedObject object) {
-    objects.points.push_back(MaskPoints(scene.cloud, object.mask, object.box));
-    return absl::OkStatus();
-  };
-  FOVEA_RETURN_IF_ERROR(
-      RunSegment(scene.frame, SegmentOptions{}, models->View(), sinks)
-          .status());
-  return objects;
-}
-
-void RegisterObjectGeometryCase(const SceneList* scenes, const std::string& set,
-                                const std::string& suffix,
-                                const SweepOptions& sweep) {
-  benchmark::RegisterBenchmark(
-      ("BM_ObjectGeometry" + suffix).c_str(),
-      [scenes, set](benchmark::State& state) {
-        std::unordered_map<const BenchScene*, SceneObjects> cut;
-        for (const auto& scene : *scenes) {
-          absl::StatusOr<SceneObjects> objects = CutObjects(*scene);
-          if (!objects.ok()) {
-            state.SkipWithError(objects.status().ToString().c_str());
-            return;
-          }
-          cut.emplace(scene.get(), *std::move(objects));
-        }
-        SweepScenes(state, *scenes, set, [&](const BenchScene& scene) {
-          const SceneObjects& objects = cut.at(&scene);
-          for (const auto& points : objects.points) {
-            absl::StatusOr<ObjectGeometry> box =
-                FitSupportAlignedBox(points, objects.plane);
-            benchmark::DoNotOptimize(box);
-          }
-          return absl::OkStatus();
-        });
-      })
-      ->Iterations(SweepIterations(sweep, static_cast<int>(scenes->size()),
-                                   kObjectGeometryMs))
-      ->Unit(benchmark::kMillisecond);
-}
-
 // The whole-scene PCL peers of core/baseline/scene_segmenters.h, from the
 // organized cloud with normals (what our own segmentation starts from too):
 // support plane by organized multi-plane segmentation, then Euclidean
@@ -607,7 +548,7 @@ void RegisterStageBenchmarks(const SceneList* scenes,
   RegisterSurfaceModelCases(scenes, set_name, suffix, sweep);
   RegisterDetectCases(scenes, set_name, suffix, sweep);
   RegisterSegmentCases(scenes, set_name, suffix, sweep);
-  RegisterObjectGeometryCase(scenes, set_name, suffix, sweep);
+  RegisterObjectGeometryBenchmark(scenes, set_name, suffix, sweep);
   RegisterPeerCases(scenes, set_name, suffix, sweep);
   RegisterAttentionCases(scenes, set_name, suffix, sweep);
 }

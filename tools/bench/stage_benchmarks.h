@@ -47,10 +47,11 @@ void SweepScenes(benchmark::State& state, const SceneList& scenes,
 // Registers every in-process case (decode, cloud, normals, support plane,
 // frame preparation, each saliency operator, surface edges, planar patches,
 // surface models, EBS edge probability and contour, MSR, Detect, Segment,
-// the whole-scene PCL peers BM_PeerEuclidean and BM_PeerLccp) on `scenes`,
-// named "BM_<Stage><suffix>" or "BM_Detect/<ops><suffix>"; `suffix` is ""
-// for the synthetic set and "/osd" for the OSD set. `scenes` must outlive
-// the benchmark run. Nothing is registered for an empty set.
+// the object boxes (object_geometry_benchmark.h), the whole-scene PCL peers
+// BM_PeerEuclidean and BM_PeerLccp) on `scenes`, named "BM_<Stage><suffix>" or
+// "BM_Detect/<ops><suffix>"; `suffix` is "" for the synthetic set and "/osd"
+// for the OSD set. `scenes` must outlive the benchmark run. Nothing is
+// registered for an empty set.
 void RegisterStageBenchmarks(const SceneList* scenes,
                              const std::string& set_name,
                              const std::string& suffix,
