@@ -214,25 +214,42 @@ void AnnulusHit(float z, float r_in, float r_out, float sign, const Vector3f& o,
 // (radius r - w at z = h) whose lowest point is the floor,
 // z_floor = -h + max(w, floor): with depth D = h - z_floor its radius is
 // ((r - w)^2 + D^2) / (2 D), so the inside curves smoothly down to the
-// floor as a real bowl's does.
+// floor as a real bowl's does. With a flat floor of radius rf > 0 the
+// inside is the sphere through the rim's inner circle and the floor's edge
+// (centre on the axis at z_c, from r_rim^2 + (h - z_c)^2 =
+// rf^2 + (z_floor - z_c)^2), cut at the floor, plus the floor disc.
 std::optional<RayHit> IntersectBowl(float r, float h, float w, float floor,
-                                    const Vector3f& o, const Vector3f& d,
-                                    float t_min, float t_max) {
+                                    float rf, const Vector3f& o,
+                                    const Vector3f& d, float t_min,
+                                    float t_max) {
   std::optional<RayHit> best;
   const float r_rim = r - w;
   const float z_foot = -h;
   const float z_floor = -h + std::max(w, floor);
   const float depth = h - z_floor;
-  const float r_in = (r_rim * r_rim + depth * depth) / (2.0f * depth);
   SphereHits(
       Vector3f(0.0f, 0.0f, h), r, 1.0f, o, d, t_min, t_max,
       [&](const Vector3f& p) {
         return p.z() <= h + kBoundSlack && p.z() >= z_foot - kBoundSlack;
       },
       &best);
-  SphereHits(
-      Vector3f(0.0f, 0.0f, z_floor + r_in), r_in, -1.0f, o, d, t_min, t_max,
-      [&](const Vector3f& p) { return p.z() <= h + kBoundSlack; }, &best);
+  if (rf > 0.0f) {
+    const float z_c =
+        (r_rim * r_rim + h * h - rf * rf - z_floor * z_floor) / (2.0f * depth);
+    const float r_in = std::sqrt(rf * rf + (z_floor - z_c) * (z_floor - z_c));
+    SphereHits(
+        Vector3f(0.0f, 0.0f, z_c), r_in, -1.0f, o, d, t_min, t_max,
+        [&](const Vector3f& p) {
+          return p.z() <= h + kBoundSlack && p.z() >= z_floor - kBoundSlack;
+        },
+        &best);
+    AnnulusHit(z_floor, 0.0f, rf, 1.0f, o, d, t_min, t_max, &best);
+  } else {
+    const float r_in = (r_rim * r_rim + depth * depth) / (2.0f * depth);
+    SphereHits(
+        Vector3f(0.0f, 0.0f, z_floor + r_in), r_in, -1.0f, o, d, t_min, t_max,
+        [&](const Vector3f& p) { return p.z() <= h + kBoundSlack; }, &best);
+  }
   AnnulusHit(h, r_rim, r, 1.0f, o, d, t_min, t_max, &best);  // the rim
   const float foot =
       std::sqrt(std::max(0.0f, r * r - (h - z_foot) * (h - z_foot)));
@@ -269,7 +286,8 @@ std::optional<RayHit> IntersectLocal(const Primitive& primitive,
       return IntersectCone(primitive.radius, h.z(), o, d, t_min, t_max);
     case Shape::kBowl:
       return IntersectBowl(primitive.radius, h.z(), primitive.thickness,
-                           primitive.floor_height, o, d, t_min, t_max);
+                           primitive.floor_height, primitive.floor_radius, o, d,
+                           t_min, t_max);
     case Shape::kCup:
       return IntersectCup(primitive.radius, h.z(), primitive.thickness, o, d,
                           t_min, t_max);
@@ -350,13 +368,17 @@ RaycastImage RaycastScene(const SceneSpec& spec) {
   const Eigen::Matrix3f cam_to_world = spec.camera_pose.linear();
   const Vector3f eye = spec.camera_pose.translation();
 
-  // Objects first, then the background parts: hit index k + 1 is
-  // prepared[k].
+  // Objects first, then the background parts, then the object parts: hit
+  // index k + 1 is prepared[k].
   std::vector<const Primitive*> primitives;
-  primitives.reserve(spec.objects.size() + spec.background.size());
+  primitives.reserve(spec.objects.size() + spec.background.size() +
+                     spec.object_parts.size());
   for (const Primitive& primitive : spec.objects)
     primitives.push_back(&primitive);
   for (const BackgroundPart& part : spec.background) {
+    primitives.push_back(&part.primitive);
+  }
+  for (const ObjectPart& part : spec.object_parts) {
     primitives.push_back(&part.primitive);
   }
   std::vector<PreparedPrimitive> prepared;

@@ -36,11 +36,12 @@ std::optional<RayHit> IntersectTable(const Eigen::Vector2f& table_half_size,
                                      float t_min, float t_max);
 
 // One ray per pixel centre through spec.intrinsics from spec.camera_pose,
-// nearest hit wins (table, objects and background parts).
+// nearest hit wins (table, objects, background parts and object parts).
 struct RaycastImage {
   cv::Mat depth;  // CV_32FC1, camera z, metres; NaN where nothing is hit
   // CV_32SC1: -1 nothing, 0 table, k + 1 spec.objects[k],
-  // objects.size() + 1 + j spec.background[j].
+  // objects.size() + 1 + j spec.background[j],
+  // objects.size() + background.size() + 1 + i spec.object_parts[i].
   cv::Mat hit;
   cv::Mat normal;  // CV_32FC3, world-frame unit normal facing the camera
 };

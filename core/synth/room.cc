@@ -200,22 +200,6 @@ bool BlocksView(const Rect& r, const Vector2f& eye, const Rect& table) {
   return false;
 }
 
-Intrinsics RoomIntrinsics(RoomSensor sensor, int width, int height) {
-  Intrinsics k;
-  const double w = width, h = height;
-  if (sensor == RoomSensor::kKinectV1) {
-    k.fx = k.fy = 525.0 * w / 640.0;
-    k.cx = (w - 1.0) / 2.0;
-    k.cy = (h - 1.0) / 2.0;
-    return k;
-  }
-  const bool wide = w / h > 1.55;  // 16:9 rather than 4:3
-  k.fx = k.fy = wide ? 920.0 * w / 1280.0 : 613.0 * w / 640.0;
-  k.cx = w / 2.0 + 2.5 * w / 640.0;
-  k.cy = h / 2.0 + 8.0 * h / 480.0;
-  return k;
-}
-
 // Distance from the table centre to its edge along the unit direction.
 float EdgeDistance(const Vector2f& half, const Vector2f& dir) {
   const float ax =
@@ -275,6 +259,22 @@ NoiseOptions RoomNoise(RoomSensor sensor) {
                                          : ActiveStereoNoise();
 }
 
+Intrinsics SensorIntrinsics(RoomSensor sensor, int width, int height) {
+  Intrinsics k;
+  const double w = width, h = height;
+  if (sensor == RoomSensor::kKinectV1) {
+    k.fx = k.fy = 525.0 * w / 640.0;
+    k.cx = (w - 1.0) / 2.0;
+    k.cy = (h - 1.0) / 2.0;
+    return k;
+  }
+  const bool wide = w / h > 1.55;  // 16:9 rather than 4:3
+  k.fx = k.fy = wide ? 920.0 * w / 1280.0 : 613.0 * w / 640.0;
+  k.cx = w / 2.0 + 2.5 * w / 640.0;
+  k.cy = h / 2.0 + 8.0 * h / 480.0;
+  return k;
+}
+
 SceneSpec RandomRoomSpec(uint64_t seed, const RoomOptions& options) {
   FOVEA_CHECK(Validate(options).ok());
   Random rng(seed);
@@ -282,7 +282,7 @@ SceneSpec RandomRoomSpec(uint64_t seed, const RoomOptions& options) {
   spec.width = options.width;
   spec.height = options.height;
   spec.intrinsics =
-      RoomIntrinsics(options.sensor, options.width, options.height);
+      SensorIntrinsics(options.sensor, options.width, options.height);
 
   // The support table.
   const Vector2f half(rng.Uniform(kTableHalfXMin, kTableHalfXMax),

@@ -64,6 +64,11 @@ SceneSpec RandomRoomSpec(uint64_t seed, const RoomOptions& options);
 // The noise model of options.sensor.
 NoiseOptions RoomNoise(RoomSensor sensor);
 
+// The pinhole intrinsics of `sensor` at width x height pixels, as
+// RoomSensor describes them (the Kinect's principal point at the image
+// centre, the active stereo's a few pixels right of and below it).
+Intrinsics SensorIntrinsics(RoomSensor sensor, int width, int height);
+
 // RandomRoomSpec rendered with RoomNoise, noise seeded by `seed`.
 SynthScene GenerateRoom(uint64_t seed, const RoomOptions& options);
 

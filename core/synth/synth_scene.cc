@@ -14,6 +14,7 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
+#include "core/base/status_macros.h"
 #include "core/frame/osd_pcd.h"
 #include "core/synth/random.h"
 #include "core/synth/raycast.h"
@@ -197,6 +198,68 @@ float NoisyDepth(float z, float focal_px, const NoiseOptions& noise,
   return fb / disparity;
 }
 
+// OK, or INVALID_ARGUMENT naming `field` (the primitive's place in the
+// SceneSpec): see Validate(const SceneSpec&).
+absl::Status ValidatePrimitive(const Primitive& p, const std::string& field) {
+  if (!IsRotation(p.pose.linear())) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".pose must be a rigid transform"));
+  }
+  if (!IsUnitRgb(p.rgb)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".rgb must be in [0, 1]"));
+  }
+  const bool needs_radius = p.shape != Shape::kBox;
+  const bool needs_half_z = p.shape != Shape::kSphere;
+  if (needs_radius && !(p.radius > 0.0f)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".radius must be > 0"));
+  }
+  if (p.shape == Shape::kBox && !(p.half_extents.minCoeff() > 0.0f)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".half_extents must be > 0"));
+  }
+  if (needs_half_z && !(p.half_extents.z() > 0.0f)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".half_extents.z must be > 0"));
+  }
+  const bool hollow = p.shape == Shape::kBowl || p.shape == Shape::kCup;
+  if (hollow && !(p.thickness > 0.0f && p.thickness < p.radius &&
+                  p.thickness < 2.0f * p.half_extents.z())) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        field, ".thickness must be > 0 and below the radius and height"));
+  }
+  if (p.shape == Shape::kBowl && !(2.0f * p.half_extents.z() < p.radius)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field,
+                     ": a bowl's depth (2 half_extents.z) must be "
+                     "below its radius"));
+  }
+  if (p.shape == Shape::kBowl &&
+      !(p.floor_height >= 0.0f && p.floor_height < 2.0f * p.half_extents.z())) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".floor_height must be in [0, the bowl's depth)"));
+  }
+  if (p.shape == Shape::kBowl && !(p.floor_radius >= 0.0f)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".floor_radius must be >= 0"));
+  }
+  if (p.shape == Shape::kBowl && p.floor_radius > 0.0f) {
+    const float h = p.half_extents.z();
+    const float rim = p.radius - p.thickness;
+    const float depth = 2.0f * h - std::max(p.thickness, p.floor_height);
+    const float foot = std::sqrt(p.radius * p.radius - 4.0f * h * h);
+    if (!(p.floor_radius * p.floor_radius <= rim * rim - depth * depth) ||
+        !(p.floor_radius < foot)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          field,
+          ".floor_radius must be at most sqrt((radius - thickness)^2 - "
+          "depth^2) and below the foot's radius"));
+    }
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace
 
 absl::Status Validate(const SceneSpec& spec) {
@@ -221,48 +284,19 @@ absl::Status Validate(const SceneSpec& spec) {
         "SceneSpec.camera_pose must be a rigid transform");
   }
   for (size_t k = 0; k < spec.objects.size(); ++k) {
-    const Primitive& p = spec.objects[k];
-    const std::string field = absl::StrCat("SceneSpec.objects[", k, "]");
-    if (!IsRotation(p.pose.linear())) {
-      return absl::InvalidArgumentError(
-          absl::StrCat(field, ".pose must be a rigid transform"));
-    }
-    if (!IsUnitRgb(p.rgb)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat(field, ".rgb must be in [0, 1]"));
-    }
-    const bool needs_radius = p.shape != Shape::kBox;
-    const bool needs_half_z = p.shape != Shape::kSphere;
-    if (needs_radius && !(p.radius > 0.0f)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat(field, ".radius must be > 0"));
-    }
-    if (p.shape == Shape::kBox && !(p.half_extents.minCoeff() > 0.0f)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat(field, ".half_extents must be > 0"));
-    }
-    if (needs_half_z && !(p.half_extents.z() > 0.0f)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat(field, ".half_extents.z must be > 0"));
-    }
-    const bool hollow = p.shape == Shape::kBowl || p.shape == Shape::kCup;
-    if (hollow && !(p.thickness > 0.0f && p.thickness < p.radius &&
-                    p.thickness < 2.0f * p.half_extents.z())) {
+    FOVEA_RETURN_IF_ERROR(ValidatePrimitive(
+        spec.objects[k], absl::StrCat("SceneSpec.objects[", k, "]")));
+  }
+  for (size_t i = 0; i < spec.object_parts.size(); ++i) {
+    const ObjectPart& part = spec.object_parts[i];
+    const std::string field = absl::StrCat("SceneSpec.object_parts[", i, "]");
+    if (part.object < 0 ||
+        part.object >= static_cast<int>(spec.objects.size())) {
       return absl::InvalidArgumentError(absl::StrCat(
-          field, ".thickness must be > 0 and below the radius and height"));
+          field, ".object must index SceneSpec.objects, got ", part.object));
     }
-    if (p.shape == Shape::kBowl && !(2.0f * p.half_extents.z() < p.radius)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat(field,
-                       ": a bowl's depth (2 half_extents.z) must be "
-                       "below its radius"));
-    }
-    if (p.shape == Shape::kBowl &&
-        !(p.floor_height >= 0.0f &&
-          p.floor_height < 2.0f * p.half_extents.z())) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          field, ".floor_height must be in [0, the bowl's depth)"));
-    }
+    FOVEA_RETURN_IF_ERROR(
+        ValidatePrimitive(part.primitive, absl::StrCat(field, ".primitive")));
   }
   return absl::OkStatus();
 }
@@ -341,22 +375,31 @@ SynthScene RenderScene(const SceneSpec& spec, const NoiseOptions& noise,
                                   rng)
           : cv::Mat();
 
-  // Albedo, texture, label and darkness of each hit index (0 table, k + 1
-  // object, then the background parts).
+  // Albedo, texture, label, object (or -1) and darkness of each hit index
+  // (0 table, k + 1 object, then the background parts, then the object
+  // parts).
   std::vector<Eigen::Vector3f> albedo = {spec.table_rgb};
   std::vector<Texture> texture = {spec.table_texture};
   std::vector<int> label = {kTableLabel};
+  std::vector<int> object_of_hit = {-1};
   for (size_t k = 0; k < spec.objects.size(); ++k) {
     albedo.push_back(spec.objects[k].rgb);
     texture.push_back(spec.objects[k].texture);
     label.push_back(ObjectLabel(static_cast<int>(k)));
+    object_of_hit.push_back(static_cast<int>(k));
   }
   for (const BackgroundPart& part : spec.background) {
     albedo.push_back(part.primitive.rgb);
     texture.push_back(part.primitive.texture);
     label.push_back(part.label);
+    object_of_hit.push_back(-1);
   }
-  const int object_hits = static_cast<int>(spec.objects.size());
+  for (const ObjectPart& part : spec.object_parts) {
+    albedo.push_back(part.primitive.rgb);
+    texture.push_back(part.primitive.texture);
+    label.push_back(ObjectLabel(part.object));
+    object_of_hit.push_back(part.object);
+  }
   const Eigen::Matrix3f cam_to_world = spec.camera_pose.linear();
   const Eigen::Vector3f eye = spec.camera_pose.translation();
   const float fx = static_cast<float>(spec.intrinsics.fx);
@@ -414,7 +457,7 @@ SynthScene RenderScene(const SceneSpec& spec, const NoiseOptions& noise,
         }
         if (!std::isnan(depth_row[u])) {
           label_row[u] = label[hit];
-          if (hit > 0 && hit <= object_hits) ++visible[hit - 1];
+          if (object_of_hit[hit] >= 0) ++visible[object_of_hit[hit]];
         }
       }
       for (int c = 0; c < 3; ++c) {

@@ -49,7 +49,10 @@ struct Primitive {
   //             the sphere through the rim's inner circle (radius -
   //             thickness) whose lowest point, the floor, is
   //             max(thickness, floor_height) above the foot; needs
-  //             2 half_extents.z() < radius;
+  //             2 half_extents.z() < radius; with `floor_radius` > 0
+  //             the floor is a flat disc of that radius and the inside is
+  //             the sphere through the rim's inner circle and the disc's
+  //             edge (a real bowl's flat inner bottom);
   //   cup:      a cylindrical shell `thickness` thick with a bottom as
   //             thick, open at the top: axis local z, outer radius
   //             `radius`, half height half_extents.z().
@@ -61,6 +64,12 @@ struct Primitive {
   // foot ring and bottom, 1-2 cm); below `thickness` the floor is
   // `thickness` up.
   float floor_height = 0.0f;
+  // Bowl: radius of its flat inner floor, metres; 0 (the default) curves
+  // the inside down to a single lowest point. At most
+  // sqrt((radius - thickness)^2 - depth^2), depth the rim's height above the
+  // floor (so the inside widens all the way up), and below the foot's
+  // radius sqrt(radius^2 - (2 half_extents.z())^2). Other shapes ignore it.
+  float floor_radius = 0.0f;
   Eigen::Vector3f rgb = {0.8f, 0.2f, 0.2f};  // albedo, [0, 1]
   Texture texture = Texture::kFlat;
 };
@@ -81,12 +90,23 @@ struct BackgroundPart {
   int label = kFurnitureLabel;  // one of the labels above, 1..9
 };
 
+// A further primitive of an object made of several (a mug's handle, an
+// open box's walls): rendered with the label of spec.objects[object], its
+// pixels counted in that object's ObjectTruth::visible_pixels.
+struct ObjectPart {
+  Primitive primitive;
+  int object = 0;  // index into SceneSpec::objects
+};
+
 struct SceneSpec {
   // Table top: a rectangle of the plane z = 0 centred at the origin.
   Eigen::Vector2f table_half_size = {0.6f, 0.4f};  // metres
   Eigen::Vector3f table_rgb = {0.55f, 0.45f, 0.35f};
   Texture table_texture = Texture::kFlat;
   std::vector<Primitive> objects;
+  // The further parts of objects made of several primitives (empty: every
+  // object is its one primitive).
+  std::vector<ObjectPart> object_parts;
   // The room: floor, walls, furniture, other tables and what stands on
   // them (empty for a bare table-top scene).
   std::vector<BackgroundPart> background;
@@ -99,7 +119,7 @@ struct SceneSpec {
 
 // OK, or INVALID_ARGUMENT naming the field: sizes and focal lengths must be
 // positive, radii and half extents positive, albedos in [0, 1], poses
-// rotations.
+// rotations; object parts name an object of `objects`.
 absl::Status Validate(const SceneSpec& spec);
 
 struct NoiseOptions {
@@ -153,10 +173,11 @@ NoiseOptions ActiveStereoNoise();
 
 // Ground truth of one object as rendered.
 struct ObjectTruth {
-  int label = 0;  // OSD-style label 10 * (index + 2), object id index + 2
-  Primitive primitive;
-  // Pixels carrying `label` in the rendered frame: seen by the camera and
-  // with depth (pixels whose depth the noise model dropped have label 0).
+  int label = 0;        // OSD-style label 10 * (index + 2), object id index + 2
+  Primitive primitive;  // spec.objects[index]; its parts are not repeated
+  // Pixels carrying `label` in the rendered frame, over all the object's
+  // parts: seen by the camera and with depth (pixels whose depth the noise
+  // model dropped have label 0).
   int visible_pixels = 0;
 };
 
@@ -177,7 +198,8 @@ struct SynthScene {
 //                      world-frame light), RGB; pixels seeing nothing show a
 //                      flat grey background;
 //   frame.labels:      0 where depth is NaN, 1 table, 10 * (k + 2) for
-//                      spec.objects[k], each background part's label;
+//                      spec.objects[k] and the object_parts of object k,
+//                      each background part's label;
 //   frame.name:        "synth-<seed>"; frame.frame.intrinsics =
 //                      spec.intrinsics.
 // With noise.enabled the depth gets, in this order, edge dropouts (computed
