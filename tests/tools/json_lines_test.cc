@@ -61,10 +61,11 @@ TEST(JsonLinesTest, DetectWritesNonFiniteNumbersAsNull) {
   EXPECT_EQ(json["detect_ms_median"], 12.3457);
   EXPECT_THAT(
       KeysOf(json),
-      ElementsAreArray({"scenes", "hit_ratio", "distance_to_center",
-                        "distance_to_center_thesis", "hit_ratio_at",
-                        "scenes_10plus", "hit_ratio_10plus", "repeated_points",
-                        "off_object_points", "detect_ms_median"}));
+      ElementsAreArray({"scenes", "hit_ratio", "hit_ratio_all_points",
+                        "distance_to_center", "distance_to_center_thesis",
+                        "hit_ratio_at", "scenes_10plus", "hit_ratio_10plus",
+                        "repeated_points", "off_object_points",
+                        "detect_ms_median"}));
 }
 
 TEST(JsonLinesTest, MethodKeepsItsKeysAndRoundingAndNullsNonFinite) {

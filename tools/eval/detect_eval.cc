@@ -118,6 +118,7 @@ DetectEvalSummary Summarize(const std::vector<SceneResult>& scenes,
     if (!kind.empty() && r.kind != kind) continue;
     s.scenes.push_back(r);
     s.hit_ratio += r.score.hit_ratio;
+    s.hit_ratio_all_points += r.hit_ratio_all_points;
     s.repeated_points += r.score.repeated_points;
     s.off_object_points += r.score.off_object_points;
     s.distance_to_center += r.score.distance_to_center;
@@ -130,6 +131,7 @@ DetectEvalSummary Summarize(const std::vector<SceneResult>& scenes,
   const double n = static_cast<double>(s.scenes.size());
   if (n > 0) {
     s.hit_ratio /= n;
+    s.hit_ratio_all_points /= n;
     s.repeated_points /= n;
     s.off_object_points /= n;
     s.distance_to_center /= n;
@@ -181,8 +183,14 @@ absl::StatusOr<DetectEvalSummary> EvaluateDetectOn(
     SceneResult r;
     r.name = scene.name;
     r.kind = SceneKind(scene.name);
+    // The thesis's HR: the first max(K, 10) points, however many Detect
+    // returned; and, beside it, HR over every point returned.
     r.score = ScoreAttentionPoints(result->points, scene.labels, cloud.xyz,
-                                   options.detect.max_points);
+                                   kHitRatioAtMax);
+    r.hit_ratio_all_points =
+        ScoreAttentionPoints(result->points, scene.labels, cloud.xyz,
+                             static_cast<int>(result->points.size()))
+            .hit_ratio;
     r.points = static_cast<int>(result->points.size());
     r.detect_ms = ms;
     if (options.verbose) {

@@ -15,15 +15,22 @@ namespace fovea::eval {
 
 struct SceneResult {
   std::string name;
-  std::string kind;  // SceneKind(name)
-  DetectionScore score;
+  std::string kind;                   // SceneKind(name)
+  DetectionScore score;               // HR over the first max(K, 10) points
+  double hit_ratio_all_points = 0.0;  // HR over every point returned
   int points = 0;
   double detect_ms = 0.0;
 };
 
 struct DetectEvalSummary {
   std::vector<SceneResult> scenes;  // scenes with at least one object
-  double hit_ratio = 0.0;           // mean over scenes
+  // Mean over scenes of the thesis's HR: distinct objects hit among the
+  // first max(K, 10) points / K (section 2.6.1), however many points
+  // Detect returned; and of HR over every point returned (an extraction
+  // that returns a point per region hits more the more it returns: read
+  // it with off_object_points).
+  double hit_ratio = 0.0;
+  double hit_ratio_all_points = 0.0;
   double distance_to_center = 0.0;  // mean over scenes
   double distance_to_center_thesis = 0.0;
   std::array<double, kHitRatioAtMax> hit_ratio_at{};

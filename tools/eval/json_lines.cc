@@ -58,6 +58,7 @@ std::string DetectSummaryJson(const DetectEvalSummary& summary,
   Json json;
   json["scenes"] = summary.scenes.size();
   json["hit_ratio"] = Detect(summary.hit_ratio);
+  json["hit_ratio_all_points"] = Detect(summary.hit_ratio_all_points);
   json["distance_to_center"] = Detect(summary.distance_to_center);
   json["distance_to_center_thesis"] = Detect(summary.distance_to_center_thesis);
   json["hit_ratio_at"] = std::move(at);

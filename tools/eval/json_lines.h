@@ -21,7 +21,8 @@ namespace fovea::eval {
 //   - a string (a method, group or scene name) is escaped; bytes that are
 //     not UTF-8 become U+FFFD.
 
-// `detect`: scenes, hit_ratio, distance_to_center,
+// `detect`: scenes, hit_ratio (the first max(K, 10) points),
+// hit_ratio_all_points, distance_to_center,
 // distance_to_center_thesis, hit_ratio_at (HR(N) for N = 1..10),
 // scenes_10plus, hit_ratio_10plus (of `many`: the scenes of 10 or more
 // objects), repeated_points, off_object_points, detect_ms_median. Numbers

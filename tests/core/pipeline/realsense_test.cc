@@ -5,8 +5,6 @@
 // covers them or what is off the table, and the marked objects are inside
 // masks.
 
-#include "tests/core/testing/realsense.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -20,6 +18,7 @@
 #include "core/pipeline/incremental.h"
 #include "core/pipeline/models.h"
 #include "core/pipeline/segment.h"
+#include "tools/eval/realsense_frames.h"
 
 namespace fovea {
 namespace {
@@ -49,7 +48,7 @@ bool Covered(const FrameRun& run, cv::Point p) {
 
 // Checks the support and the table / off-table pixels; returns how many
 // of the frame's marked objects are inside a mask.
-int CheckFrame(const testing::RealSenseFrame& f, const FrameRun& run,
+int CheckFrame(const eval::RealSenseFrame& f, const FrameRun& run,
                bool objects = true) {
   SCOPED_TRACE(f.name);
   const Intrinsics& k = f.frame.intrinsics;
@@ -83,18 +82,18 @@ int CheckFrame(const testing::RealSenseFrame& f, const FrameRun& run,
 class RealSenseTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    const std::string dir = testing::RealSenseDir();
+    const std::string dir = eval::RealSenseDir();
     if (dir.empty()) GTEST_SKIP() << "FOVEA_REALSENSE_DIR is not set";
-    frames_ = testing::LoadRealSenseFrames(dir);
+    frames_ = eval::LoadRealSenseFrames(dir);
     ASSERT_EQ(frames_.size(), 4u);
     ASSERT_NE(&Models(), nullptr);
   }
-  std::vector<testing::RealSenseFrame> frames_;
+  std::vector<eval::RealSenseFrame> frames_;
 };
 
 TEST_F(RealSenseTest, IncrementalSegmentationFindsTheTableAndOnlyItsObjects) {
   int objects = 0, covered = 0;
-  for (const testing::RealSenseFrame& f : frames_) {
+  for (const eval::RealSenseFrame& f : frames_) {
     FrameRun run;
     SegmentSinks sinks;
     sinks.support = [&](const SupportPlane& plane) {
@@ -119,7 +118,7 @@ TEST_F(RealSenseTest, IncrementalSegmentationFindsTheTableAndOnlyItsObjects) {
 }
 
 TEST_F(RealSenseTest, DetectsTheTableAsTheSupportWhateverElseIsInView) {
-  for (const testing::RealSenseFrame& f : frames_) {
+  for (const eval::RealSenseFrame& f : frames_) {
     absl::StatusOr<DetectResult> detect = RunDetect(f.frame, DetectOptions{});
     ASSERT_TRUE(detect.ok()) << f.name << ": " << detect.status();
     FrameRun run{detect->plane, {}};

@@ -1,8 +1,9 @@
-#ifndef FOVEA_TESTS_CORE_TESTING_REALSENSE_H_
-#define FOVEA_TESTS_CORE_TESTING_REALSENSE_H_
+#ifndef FOVEA_TOOLS_EVAL_REALSENSE_FRAMES_H_
+#define FOVEA_TOOLS_EVAL_REALSENSE_FRAMES_H_
 
 // The four raw RealSense-like frames of shared/data/realsense: where the
-// tests that need them find them, and their marked pixels.
+// tests and `fovea-eval scorecard` find them, and their marked pixels.
+// Header-only, so that tests use it without linking the eval tool.
 
 #include <cstdlib>
 #include <filesystem>
@@ -18,12 +19,16 @@
 
 #include "core/frame/rgbd_frame.h"
 
-namespace fovea::testing {
+namespace fovea::eval {
 
-// $FOVEA_REALSENSE_DIR when it holds points.json, else "" (tests skip).
-inline std::string RealSenseDir() {
-  const char* root = std::getenv("FOVEA_REALSENSE_DIR");
-  if (root == nullptr) return "";
+// `root` ($FOVEA_REALSENSE_DIR when empty) when it holds points.json, else
+// "" (tests skip).
+inline std::string RealSenseDir(std::string root = "") {
+  if (root.empty()) {
+    const char* env = std::getenv("FOVEA_REALSENSE_DIR");
+    if (env == nullptr) return "";
+    root = env;
+  }
   if (!std::filesystem::exists(std::filesystem::path(root) / "points.json")) {
     return "";
   }
@@ -102,6 +107,6 @@ inline std::vector<RealSenseFrame> LoadRealSenseFrames(const std::string& dir) {
   return frames;
 }
 
-}  // namespace fovea::testing
+}  // namespace fovea::eval
 
-#endif  // FOVEA_TESTS_CORE_TESTING_REALSENSE_H_
+#endif  // FOVEA_TOOLS_EVAL_REALSENSE_FRAMES_H_
