@@ -7,6 +7,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <opencv2/imgproc.hpp>
 #include <random>
@@ -45,17 +46,17 @@ void OrientTowardsCamera(Eigen::Vector3f& normal, float& d) {
 }
 
 // Whether a plane's normal may belong to a support: perpendicular to
-// gravity when it is known, else facing the camera's up (-y).
+// gravity when it is known. Without gravity any plane may: the camera may be
+// rolled or upside down (a wrist camera, a ceiling mount), and the side of a
+// surface it sees is its top (normals are oriented towards the camera);
+// which surfaces are level is decided among the candidates (EstimateUp).
 bool OrientationAllowed(const Eigen::Vector3f& normal,
                         const SupportPlaneOptions& options,
                         const SupportHints& hints) {
-  if (hints.gravity.has_value()) {
-    const Eigen::Vector3f up = -hints.gravity->normalized();
-    return normal.dot(up) >=
-           std::cos(options.gravity_tolerance_deg * kDegToRad) - 1e-6f;
-  }
-  return -normal.y() >=
-         std::cos(options.max_tilt_from_camera_up_deg * kDegToRad) - 1e-6f;
+  if (!hints.gravity.has_value()) return true;
+  const Eigen::Vector3f up = -hints.gravity->normalized();
+  return normal.dot(up) >=
+         std::cos(options.gravity_tolerance_deg * kDegToRad) - 1e-6f;
 }
 
 int CountSupport(const Plane& plane, const Grid& grid,
@@ -221,6 +222,36 @@ Eigen::Vector3f EstimateUp(const std::vector<Candidate>& candidates) {
   return up;
 }
 
+// A candidate's score with its tilt and level term taken against `up`
+// instead (the other terms do not depend on it).
+void SetTilt(const Eigen::Vector3f& up, const SupportPlaneOptions& options,
+             std::vector<Candidate>& candidates) {
+  for (Candidate& c : candidates) {
+    const float old_cos = std::cos(c.score.tilt_deg * kDegToRad);
+    const float new_cos = std::clamp(c.plane.normal.dot(up), -1.0f, 1.0f);
+    c.score.total += options.level_weight *
+                     (std::max(new_cos, 0.0f) - std::max(old_cos, 0.0f));
+    c.score.tilt_deg = std::acos(new_cos) / kDegToRad;
+  }
+}
+
+// The normal of the candidate that scores best when its own normal is up
+// (its level term full).
+Eigen::Vector3f BestLevelNormal(const std::vector<Candidate>& candidates,
+                                const SupportPlaneOptions& options) {
+  float best = -std::numeric_limits<float>::infinity();
+  Eigen::Vector3f up = -Eigen::Vector3f::UnitY();
+  for (const Candidate& c : candidates) {
+    const float level = std::max(std::cos(c.score.tilt_deg * kDegToRad), 0.0f);
+    const float own = c.score.total + options.level_weight * (1.0f - level);
+    if (own > best) {
+      best = own;
+      up = c.plane.normal;
+    }
+  }
+  return up;
+}
+
 absl::Status ValidateUnit(const Eigen::Vector3f& v, std::string_view field) {
   if (!v.allFinite()) {
     return absl::InvalidArgumentError(
@@ -285,11 +316,6 @@ absl::Status Validate(const SupportPlaneOptions& o) {
   if (o.grid_columns < 16)
     return invalid("grid_columns", ">= 16", o.grid_columns);
   if (o.max_planes < 1) return invalid("max_planes", ">= 1", o.max_planes);
-  if (!(o.max_tilt_from_camera_up_deg > 0.0f &&
-        o.max_tilt_from_camera_up_deg <= 180.0f)) {
-    return invalid("max_tilt_from_camera_up_deg", "in (0, 180]",
-                   o.max_tilt_from_camera_up_deg);
-  }
   if (!(o.gravity_tolerance_deg > 0.0f && o.gravity_tolerance_deg <= 90.0f)) {
     return invalid("gravity_tolerance_deg", "in (0, 90]",
                    o.gravity_tolerance_deg);
@@ -362,13 +388,27 @@ absl::StatusOr<SupportSearch> SearchSupport(const OrganizedCloud& cloud,
         grid, plane, options, min_cos, /*refit=*/!hints.plane.has_value());
     for (Candidate& c : parts) candidates.push_back(std::move(c));
   }
-  // Surfaces facing another way than the floor and the tables (walls seen
-  // from above) are not supports.
-  Eigen::Vector3f up;
+  if (candidates.empty()) {
+    return absl::NotFoundError(
+        hints.plane.has_value()
+            ? "support plane: the given plane has no surface in view of at "
+              "least support_plane.min_candidate_area_m2"
+            : absl::StrCat("support plane: no surface of at least ",
+                           options.min_candidate_area_m2, " m^2 in view (",
+                           planes.size(), " planes found)"));
+  }
   if (hints.gravity.has_value()) {
-    up = -hints.gravity->normalized();
+    support_internal::ScoreCandidates(grid, -hints.gravity->normalized(),
+                                      options, candidates);
   } else {
-    up = EstimateUp(candidates);
+    // Which way is up is what the candidates say: first scored against the
+    // normal most of their area shares, then "up" is the normal of the one
+    // that scores best as a level surface of its own (what stands on it
+    // decides, so a wall filling the view does not), and surfaces facing
+    // another way than it (walls seen from above) are not supports.
+    support_internal::ScoreCandidates(grid, EstimateUp(candidates), options,
+                                      candidates);
+    const Eigen::Vector3f up = BestLevelNormal(candidates, options);
     if (!hints.plane.has_value()) {
       const float min_up =
           std::cos(options.max_tilt_from_estimated_up_deg * kDegToRad);
@@ -378,17 +418,8 @@ absl::StatusOr<SupportSearch> SearchSupport(const OrganizedCloud& cloud,
                                       }),
                        candidates.end());
     }
+    SetTilt(up, options, candidates);
   }
-  if (candidates.empty()) {
-    return absl::NotFoundError(
-        hints.plane.has_value()
-            ? "support plane: the given plane has no surface in view of at "
-              "least support_plane.min_candidate_area_m2"
-            : absl::StrCat("support plane: no surface facing up of at least ",
-                           options.min_candidate_area_m2, " m^2 in view (",
-                           planes.size(), " planes found)"));
-  }
-  support_internal::ScoreCandidates(grid, up, options, candidates);
   std::stable_sort(candidates.begin(), candidates.end(),
                    [](const Candidate& a, const Candidate& b) {
                      return a.score.total > b.score.total;

@@ -100,16 +100,15 @@ struct SupportPlaneOptions {
   // Planes are found one after the other (each one's inliers removed before
   // the next), at most this many.
   int max_planes = 6;
-  // Without gravity, candidate planes must face the camera's "up": the
-  // angle between the plane normal and the camera's -y axis (up in the
-  // image) is at most this, degrees. 90 disables the test.
-  float max_tilt_from_camera_up_deg = 75.0f;
   // With gravity, the plane normal must be within this of "up" (-gravity),
   // degrees.
   float gravity_tolerance_deg = 15.0f;
-  // Without gravity, candidates more than this from the estimated up
-  // direction (the normal shared by most candidate area) are not
-  // candidates, degrees: walls are perpendicular to floors and tables.
+  // Without gravity nothing is assumed about which way is up in the image
+  // (the camera may be rolled or upside down): every plane in view is a
+  // candidate, its up side the side the camera sees, and candidates more
+  // than this from the estimated up direction (the normal shared by most
+  // candidate area) are not candidates, degrees: walls are perpendicular
+  // to floors and tables.
   float max_tilt_from_estimated_up_deg = 35.0f;
   // A plane needs this share of the grid's valid points to be found at all.
   float min_inlier_fraction = 0.02f;

@@ -61,14 +61,21 @@ TEST(SupportPlaneTest, TheBoxTopProjectsInsideTheHullAndFarAwayDoesNot) {
   EXPECT_FALSE(plane->ProjectsInsideHull(far));
 }
 
-TEST(SupportPlaneTest, AWallFacingTheCameraIsNotATable) {
-  // The only plane faces the camera head-on: its normal is at 90 degrees
-  // from the camera's up direction.
+TEST(SupportPlaneTest, APlaneSeenHeadOnIsATableWithoutGravityAndAWallWithIt) {
+  // The only plane faces the camera head-on. Without gravity nothing says
+  // which way is up: a camera looking straight down at a table sees this,
+  // so it is the support, its normal towards the camera. With gravity
+  // along the image's y axis it is a wall, and there is no support.
   RgbdFrame frame = testing::PlaneFrame({0.0f, 0.0f, -1.0f}, 1.2f);
   absl::StatusOr<OrganizedCloud> cloud = BuildOrganizedCloud(frame, {});
   ASSERT_TRUE(cloud.ok());
   absl::StatusOr<SupportPlane> plane = FindSupportPlane(*cloud, {});
-  EXPECT_EQ(plane.status().code(), absl::StatusCode::kNotFound);
+  ASSERT_TRUE(plane.ok()) << plane.status();
+  EXPECT_GT(-plane->normal.z(), 0.99f);
+  SupportHints hints;
+  hints.gravity = Eigen::Vector3f(0.0f, 1.0f, 0.0f);
+  EXPECT_EQ(FindSupportPlane(*cloud, {}, hints).status().code(),
+            absl::StatusCode::kNotFound);
 }
 
 TEST(SupportPlaneTest, NoDepthIsNotFound) {
