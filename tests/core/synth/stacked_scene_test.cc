@@ -22,7 +22,7 @@ namespace {
 
 using Eigen::Vector3f;
 
-constexpr int kSeeds = 20;
+constexpr int kSeeds = 10;
 
 NoiseOptions NoNoise() {
   NoiseOptions noise;
@@ -202,7 +202,11 @@ TEST(StackedPileTest, EveryPileHoldsEightToSixteenVisibleObjectsThreeStacked) {
 }
 
 TEST(StackedPileTest, EveryObjectKeepsThirtyPercentOfItsPixelsAlone) {
-  for (const StackedPile& pile : Piles()) {
+  // A render per object: the first six piles (about 70 objects) keep the
+  // test to a second or two, and a few times that under the sanitizers.
+  constexpr size_t kCheckedPiles = 6;
+  for (size_t i = 0; i < kCheckedPiles && i < Piles().size(); ++i) {
+    const StackedPile& pile = Piles()[i];
     SceneSpec bare = pile.spec;
     bare.background.clear();
     const SynthScene all = RenderScene(bare, NoNoise(), 1);
