@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/frame/frame_transform.h"
 #include "core/frame/organized_cloud.h"
 #include "core/frame/support_plane.h"
 #include "core/synth/synth_scene.h"
@@ -93,6 +94,26 @@ TEST(SupportSearchTest, TheTableObjectsStandOnBeatsTheLargerFloor) {
             static_cast<int>(search->candidates.size()));
   EXPECT_TRUE(search->candidates.back().score.under_another);
   EXPECT_FALSE(search->chosen.given);
+}
+
+TEST(SupportSearchTest, ARolledCameraFindsTheSameTableWithoutGravity) {
+  // The table scene seen by the same camera turned a quarter, a half and
+  // three quarters about its optical axis (a wrist camera turned sideways,
+  // a camera mounted upside down): the support is the same table, its
+  // normal rotated with the camera ((x, y, z) -> (-y, x, z) per turn).
+  const synth::SynthScene scene = Render(TableOnFloor(ThreeBoxes()));
+  for (int turns = 1; turns <= 3; ++turns) {
+    const RgbdFrame rolled = RotateFrame(scene.frame.frame, turns);
+    OrganizedCloud cloud = BackProject(rolled);
+    EstimateNormals({}, cloud);
+    absl::StatusOr<SupportPlane> plane = FindSupportPlane(cloud, {});
+    ASSERT_TRUE(plane.ok()) << turns << ": " << plane.status();
+    Eigen::Vector3f n = scene.table_normal_camera;
+    for (int t = 0; t < turns; ++t) n = Eigen::Vector3f(-n.y(), n.x(), n.z());
+    EXPECT_GT(plane->normal.dot(n), std::cos(0.05f)) << turns;
+    EXPECT_LT(std::abs(plane->d - scene.table_d_camera), 0.01f) << turns;
+    EXPECT_GE(plane->score.objects, 3) << turns;
+  }
 }
 
 TEST(SupportSearchTest, AnEmptyTableNearerThanTheFloorIsStillTheSupport) {
