@@ -26,6 +26,16 @@
 #include "core/frame/pcd_reader.h"
 
 namespace fovea {
+
+cv::Mat ObjectIdImage(const cv::Mat& labels) {
+  cv::Mat ids(labels.size(), CV_32SC1);
+  for (int v = 0; v < labels.rows; ++v) {
+    const int* in = labels.ptr<int>(v);
+    int* out = ids.ptr<int>(v);
+    for (int u = 0; u < labels.cols; ++u) out[u] = ObjectId(in[u]);
+  }
+  return ids;
+}
 namespace {
 
 // Colour of a pixel whose colour is unknown: the file has no rgb/rgba

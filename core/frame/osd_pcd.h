@@ -25,6 +25,10 @@ struct LabelledFrame {
 inline int ObjectId(int label) { return label >= 20 ? label / 10 : 0; }
 inline bool IsTableLabel(int label) { return label >= 1 && label <= 9; }
 
+// ObjectId of every pixel of `labels` (CV_32SC1): CV_32SC1, 0 where no
+// object.
+cv::Mat ObjectIdImage(const cv::Mat& labels);
+
 // Loads an OSD PCD (fields label x y z rgba; any PCD with x y z and rgb or
 // rgba also works, labels then 0). An organized cloud (height > 1) keeps
 // its layout; an unorganized one (height 1) is re-organized by projecting

@@ -137,11 +137,15 @@ std::vector<Candidate> SplitIntoSurfaces(const Grid& grid, const Plane& plane,
                                          const SupportPlaneOptions& options,
                                          float min_cos, bool refit);
 
-// Fills every candidate's score (SupportPlaneOptions), `up` being gravity's
-// opposite or its estimate.
-void ScoreCandidates(const Grid& grid, const Eigen::Vector3f& up,
-                     const SupportPlaneOptions& options,
+// Fills every candidate's score (SupportPlaneOptions) but its tilt and
+// level term, which depend on which way is up: AddLevelTerm adds them.
+void ScoreCandidates(const Grid& grid, const SupportPlaneOptions& options,
                      std::vector<Candidate>& candidates);
+
+// Sets every candidate's tilt against `up` (gravity's opposite, or the
+// normal the candidates chose) and adds its level term to its total.
+void AddLevelTerm(const Eigen::Vector3f& up, const SupportPlaneOptions& options,
+                  std::vector<Candidate>& candidates);
 
 // The support region of `chosen`: its part of its plane joined by the
 // plane's other parts that are inside its hull or only hidden from it by

@@ -38,8 +38,6 @@ constexpr float kDuplicateDistance = 0.02f;  // metres
 constexpr int kMaxRefinements = 6;
 // Fewest grid points a plane needs, whatever the fraction.
 constexpr int kMinPlanePoints = 30;
-// Candidates within this angle share one "up" when it is estimated.
-constexpr float kSameUpAngleDeg = 10.0f;
 
 void OrientTowardsCamera(Eigen::Vector3f& normal, float& d) {
   support_internal::OrientTowardsCamera(normal, d);
@@ -49,7 +47,8 @@ void OrientTowardsCamera(Eigen::Vector3f& normal, float& d) {
 // gravity when it is known. Without gravity any plane may: the camera may be
 // rolled or upside down (a wrist camera, a ceiling mount), and the side of a
 // surface it sees is its top (normals are oriented towards the camera);
-// which surfaces are level is decided among the candidates (EstimateUp).
+// which surfaces are level is decided among the candidates
+// (BestLevelNormal).
 bool OrientationAllowed(const Eigen::Vector3f& normal,
                         const SupportPlaneOptions& options,
                         const SupportHints& hints) {
@@ -199,53 +198,14 @@ std::vector<Plane> FindPlanes(const Grid& grid,
   return planes;
 }
 
-// The normal most candidate area agrees with (within kSameUpAngleDeg),
-// area-weighted: floors and tables are parallel, walls are not.
-Eigen::Vector3f EstimateUp(const std::vector<Candidate>& candidates) {
-  const float same = std::cos(kSameUpAngleDeg * kDegToRad);
-  float best_weight = -1.0f;
-  Eigen::Vector3f up = -Eigen::Vector3f::UnitY();
-  for (const Candidate& c : candidates) {
-    Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-    float weight = 0.0f;
-    for (const Candidate& o : candidates) {
-      if (c.plane.normal.dot(o.plane.normal) >= same) {
-        weight += o.area_m2;
-        sum += o.area_m2 * o.plane.normal;
-      }
-    }
-    if (weight > best_weight && sum.norm() > 0.0f) {
-      best_weight = weight;
-      up = sum.normalized();
-    }
-  }
-  return up;
-}
-
-// A candidate's score with its tilt and level term taken against `up`
-// instead (the other terms do not depend on it).
-void SetTilt(const Eigen::Vector3f& up, const SupportPlaneOptions& options,
-             std::vector<Candidate>& candidates) {
-  for (Candidate& c : candidates) {
-    const float old_cos = std::cos(c.score.tilt_deg * kDegToRad);
-    const float new_cos = std::clamp(c.plane.normal.dot(up), -1.0f, 1.0f);
-    c.score.total += options.level_weight *
-                     (std::max(new_cos, 0.0f) - std::max(old_cos, 0.0f));
-    c.score.tilt_deg = std::acos(new_cos) / kDegToRad;
-  }
-}
-
-// The normal of the candidate that scores best when its own normal is up
-// (its level term full).
-Eigen::Vector3f BestLevelNormal(const std::vector<Candidate>& candidates,
-                                const SupportPlaneOptions& options) {
+// The normal of the candidate with the best total before its level term
+// (which every candidate would get in full as a level surface of its own).
+Eigen::Vector3f BestLevelNormal(const std::vector<Candidate>& candidates) {
   float best = -std::numeric_limits<float>::infinity();
   Eigen::Vector3f up = -Eigen::Vector3f::UnitY();
   for (const Candidate& c : candidates) {
-    const float level = std::max(std::cos(c.score.tilt_deg * kDegToRad), 0.0f);
-    const float own = c.score.total + options.level_weight * (1.0f - level);
-    if (own > best) {
-      best = own;
+    if (c.score.total > best) {
+      best = c.score.total;
       up = c.plane.normal;
     }
   }
@@ -397,18 +357,16 @@ absl::StatusOr<SupportSearch> SearchSupport(const OrganizedCloud& cloud,
                            options.min_candidate_area_m2, " m^2 in view (",
                            planes.size(), " planes found)"));
   }
+  support_internal::ScoreCandidates(grid, options, candidates);
+  Eigen::Vector3f up;
   if (hints.gravity.has_value()) {
-    support_internal::ScoreCandidates(grid, -hints.gravity->normalized(),
-                                      options, candidates);
+    up = -hints.gravity->normalized();
   } else {
-    // Which way is up is what the candidates say: first scored against the
-    // normal most of their area shares, then "up" is the normal of the one
+    // Which way is up is what the candidates say: the normal of the one
     // that scores best as a level surface of its own (what stands on it
     // decides, so a wall filling the view does not), and surfaces facing
     // another way than it (walls seen from above) are not supports.
-    support_internal::ScoreCandidates(grid, EstimateUp(candidates), options,
-                                      candidates);
-    const Eigen::Vector3f up = BestLevelNormal(candidates, options);
+    up = BestLevelNormal(candidates);
     if (!hints.plane.has_value()) {
       const float min_up =
           std::cos(options.max_tilt_from_estimated_up_deg * kDegToRad);
@@ -418,8 +376,8 @@ absl::StatusOr<SupportSearch> SearchSupport(const OrganizedCloud& cloud,
                                       }),
                        candidates.end());
     }
-    SetTilt(up, options, candidates);
   }
+  support_internal::AddLevelTerm(up, options, candidates);
   std::stable_sort(candidates.begin(), candidates.end(),
                    [](const Candidate& a, const Candidate& b) {
                      return a.score.total > b.score.total;

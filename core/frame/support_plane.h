@@ -106,8 +106,9 @@ struct SupportPlaneOptions {
   // Without gravity nothing is assumed about which way is up in the image
   // (the camera may be rolled or upside down): every plane in view is a
   // candidate, its up side the side the camera sees, and candidates more
-  // than this from the estimated up direction (the normal shared by most
-  // candidate area) are not candidates, degrees: walls are perpendicular
+  // than this from the estimated up direction (the normal of the
+  // candidate that scores best as a level surface of its own) are not
+  // candidates, degrees: walls are perpendicular
   // to floors and tables.
   float max_tilt_from_estimated_up_deg = 35.0f;
   // A plane needs this share of the grid's valid points to be found at all.

@@ -209,8 +209,7 @@ std::vector<Candidate> SplitIntoSurfaces(const Grid& grid, const Plane& plane,
   return candidates;
 }
 
-void ScoreCandidates(const Grid& grid, const Eigen::Vector3f& up,
-                     const SupportPlaneOptions& options,
+void ScoreCandidates(const Grid& grid, const SupportPlaneOptions& options,
                      std::vector<Candidate>& candidates) {
   const float parallel = std::cos(kParallelAngleDeg * kDegToRad);
   for (Candidate& c : candidates) {
@@ -219,8 +218,6 @@ void ScoreCandidates(const Grid& grid, const Eigen::Vector3f& up,
     s.objects = CountStandingObjects(grid, c, options, &weighted_objects);
     s.area_m2 = c.area_m2;
     s.distance_m = c.centroid.norm();
-    const float cos_tilt = std::clamp(c.plane.normal.dot(up), -1.0f, 1.0f);
-    s.tilt_deg = std::acos(cos_tilt) / kDegToRad;
     s.under_another = false;
     for (const Candidate& o : candidates) {
       if (&o == &c || o.plane.normal.dot(c.plane.normal) < parallel) continue;
@@ -243,9 +240,17 @@ void ScoreCandidates(const Grid& grid, const Eigen::Vector3f& up,
         options.view_weight * std::exp(-off_axis * off_axis) +
         options.area_weight *
             std::min(s.area_m2 / options.reference_area_m2, 1.0f) +
-        options.near_weight * std::exp(-s.distance_m / options.near_scale_m) +
-        options.level_weight * std::max(cos_tilt, 0.0f) -
+        options.near_weight * std::exp(-s.distance_m / options.near_scale_m) -
         (s.under_another ? options.under_weight : 0.0f);
+  }
+}
+
+void AddLevelTerm(const Eigen::Vector3f& up, const SupportPlaneOptions& options,
+                  std::vector<Candidate>& candidates) {
+  for (Candidate& c : candidates) {
+    const float cos_tilt = std::clamp(c.plane.normal.dot(up), -1.0f, 1.0f);
+    c.score.tilt_deg = std::acos(cos_tilt) / kDegToRad;
+    c.score.total += options.level_weight * std::max(cos_tilt, 0.0f);
   }
 }
 

@@ -530,34 +530,6 @@ bool Admissible(const Candidate& c, const std::vector<Placed>& placed,
   return true;
 }
 
-// Pixels of each object in a reduced ray cast of `spec`: half of a
-// 640-pixel-wide frame, so at most kVisibilityCastWidth columns whatever
-// the frame's resolution (the room around the table is left out: it never
-// stands between the camera and the table's objects).
-std::vector<int> HalfResolutionPixelCounts(SceneSpec spec) {
-  const double scale =
-      std::min(0.5, static_cast<double>(kVisibilityCastWidth) / spec.width);
-  spec.width = std::max(1, static_cast<int>(spec.width * scale));
-  spec.height = std::max(1, static_cast<int>(spec.height * scale));
-  spec.background.clear();
-  Intrinsics& k = spec.intrinsics;
-  k.fx *= scale;
-  k.fy *= scale;
-  k.cx = (k.cx + 0.5) * scale - 0.5;
-  k.cy = (k.cy + 0.5) * scale - 0.5;
-  const RaycastImage ray = RaycastScene(spec);
-  std::vector<int> counts(spec.objects.size(), 0);
-  for (int v = 0; v < ray.hit.rows; ++v) {
-    const int* row = ray.hit.ptr<int>(v);
-    for (int u = 0; u < ray.hit.cols; ++u) {
-      if (row[u] > 0 && row[u] <= static_cast<int>(counts.size())) {
-        ++counts[row[u] - 1];
-      }
-    }
-  }
-  return counts;
-}
-
 // Whether, with `c` added, every object keeps at least min_visible_fraction
 // of its pixels seen alone (`alone`, extended with c's on success).
 bool KeepsEveryObjectVisible(const Candidate& c,
@@ -566,11 +538,13 @@ bool KeepsEveryObjectVisible(const Candidate& c,
                              std::vector<int>* alone) {
   SceneSpec trial = spec;
   trial.objects = {c.placed.primitive};
-  const int candidate_alone = HalfResolutionPixelCounts(trial)[0];
+  const int candidate_alone =
+      ReducedObjectPixelCounts(trial, kVisibilityCastWidth)[0];
   trial.objects.clear();
   for (const Placed& p : placed) trial.objects.push_back(p.primitive);
   trial.objects.push_back(c.placed.primitive);
-  const std::vector<int> counts = HalfResolutionPixelCounts(trial);
+  const std::vector<int> counts =
+      ReducedObjectPixelCounts(trial, kVisibilityCastWidth);
   for (size_t i = 0; i < counts.size(); ++i) {
     const int full = i < alone->size() ? (*alone)[i] : candidate_alone;
     if (counts[i] < kMinVisiblePixelsHalfRes ||

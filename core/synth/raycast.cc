@@ -448,4 +448,35 @@ RaycastImage RaycastScene(const SceneSpec& spec) {
   return out;
 }
 
+std::vector<int> ReducedObjectPixelCounts(SceneSpec spec, int max_width) {
+  const double scale =
+      std::min(0.5, static_cast<double>(max_width) / spec.width);
+  spec.width = std::max(1, static_cast<int>(spec.width * scale));
+  spec.height = std::max(1, static_cast<int>(spec.height * scale));
+  spec.background.clear();
+  Intrinsics& k = spec.intrinsics;
+  k.fx *= scale;
+  k.fy *= scale;
+  k.cx = (k.cx + 0.5) * scale - 0.5;
+  k.cy = (k.cy + 0.5) * scale - 0.5;
+  std::vector<int> object_of_hit = {-1};
+  for (size_t i = 0; i < spec.objects.size(); ++i) {
+    object_of_hit.push_back(static_cast<int>(i));
+  }
+  for (const ObjectPart& part : spec.object_parts) {
+    object_of_hit.push_back(part.object);
+  }
+  const RaycastImage ray = RaycastScene(spec);
+  std::vector<int> counts(spec.objects.size(), 0);
+  for (int v = 0; v < ray.hit.rows; ++v) {
+    const int* row = ray.hit.ptr<int>(v);
+    for (int u = 0; u < ray.hit.cols; ++u) {
+      if (row[u] > 0 && object_of_hit[row[u]] >= 0) {
+        ++counts[object_of_hit[row[u]]];
+      }
+    }
+  }
+  return counts;
+}
+
 }  // namespace fovea::synth

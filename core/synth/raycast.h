@@ -47,6 +47,13 @@ struct RaycastImage {
 };
 RaycastImage RaycastScene(const SceneSpec& spec);
 
+// Pixels of each object (its parts included) in a reduced ray cast of
+// `spec` without its background: half of a 640-pixel-wide frame, at most
+// `max_width` columns whatever the frame's resolution (the room around the
+// table never stands between the camera and the table's objects). What
+// the scene generators check visibility with while placing objects.
+std::vector<int> ReducedObjectPixelCounts(SceneSpec spec, int max_width);
+
 }  // namespace fovea::synth
 
 #endif  // FOVEA_CORE_SYNTH_RAYCAST_H_

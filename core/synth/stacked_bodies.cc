@@ -85,17 +85,6 @@ Vector3f Pick(const float (&palette)[N][3], const Vector3f& table_rgb,
 
 Vector3f Rgb(const float (&c)[3]) { return {c[0], c[1], c[2]}; }
 
-Primitive Box(const Vector3f& centre, const Vector3f& half, const Vector3f& rgb,
-              Texture texture = Texture::kFlat) {
-  Primitive p;
-  p.shape = Shape::kBox;
-  p.pose.translation() = centre;
-  p.half_extents = half;
-  p.rgb = rgb;
-  p.texture = texture;
-  return p;
-}
-
 Footprint Rect(const Vector2f& centre, const Vector2f& half, float z_min,
                float z_max) {
   Footprint f;
@@ -139,7 +128,7 @@ std::optional<PileBody> MakeBook(float room, const Vector3f& table_rgb,
   const float board = rng.Uniform(0.0015f, 0.003f);
   PileBody body;
   body.primitives.push_back(
-      Box(Vector3f(0, 0, half.z()), half, cover, Texture::kPaint));
+      BoxPrimitive(Vector3f(0, 0, half.z()), half, cover, Texture::kPaint));
   // Pages on the +x, +y and -y sides (the spine is at -x), between the
   // covers, a hair proud of the cover box.
   const Vector3f pages = Rgb(kPages) * rng.Uniform(0.92f, 1.0f);
@@ -147,15 +136,15 @@ std::optional<PileBody> MakeBook(float room, const Vector3f& table_rgb,
   const float sx = half.x() + kPagesProud - kPagesStrip / 2;
   const float sy = half.y() + kPagesProud - kPagesStrip / 2;
   const float spine = 2.0f * board;
-  body.primitives.push_back(Box(
+  body.primitives.push_back(BoxPrimitive(
       Vector3f(sx, 0, half.z()),
       Vector3f(kPagesStrip / 2, half.y() + kPagesProud, page_half_z), pages));
   for (const float s : {-1.0f, 1.0f}) {
     body.primitives.push_back(
-        Box(Vector3f(spine / 2 + kPagesProud / 2, s * sy, half.z()),
-            Vector3f(half.x() - spine / 2 + kPagesProud / 2, kPagesStrip / 2,
-                     page_half_z),
-            pages));
+        BoxPrimitive(Vector3f(spine / 2 + kPagesProud / 2, s * sy, half.z()),
+                     Vector3f(half.x() - spine / 2 + kPagesProud / 2,
+                              kPagesStrip / 2, page_half_z),
+                     pages));
   }
   const Vector3f outer(half.x() + kPagesProud, half.y() + kPagesProud,
                        half.z());
@@ -173,11 +162,11 @@ std::optional<PileBody> MakeBox(float room, bool stacked,
   const Vector3f half(*hx, *hy, rng.Uniform(0.02f, stacked ? 0.045f : 0.06f));
   const bool cardboard = rng.Bernoulli(0.4);
   PileBody body;
-  body.primitives.push_back(Box(Vector3f(0, 0, half.z()), half,
-                                cardboard
-                                    ? Rgb(kCardboard) * rng.Uniform(0.9f, 1.05f)
-                                    : Pick(kPrintedBoxes, table_rgb, rng),
-                                cardboard ? Texture::kPaint : Texture::kFlat));
+  body.primitives.push_back(
+      BoxPrimitive(Vector3f(0, 0, half.z()), half,
+                   cardboard ? Rgb(kCardboard) * rng.Uniform(0.9f, 1.05f)
+                             : Pick(kPrintedBoxes, table_rgb, rng),
+                   cardboard ? Texture::kPaint : Texture::kFlat));
   SetBoxVolumes(half, body);
   return body;
 }
@@ -188,7 +177,8 @@ std::optional<PileBody> MakeTablet(float room, Random& rng) {
   const Vector3f half(*hx, *hx * rng.Uniform(0.65f, 0.72f),
                       rng.Uniform(0.005f, 0.008f));
   PileBody body;
-  body.primitives.push_back(Box(Vector3f(0, 0, half.z()), half, Rgb(kSlate)));
+  body.primitives.push_back(
+      BoxPrimitive(Vector3f(0, 0, half.z()), half, Rgb(kSlate)));
   SetBoxVolumes(half, body);
   return body;
 }
@@ -252,14 +242,14 @@ std::optional<PileBody> MakeMug(float room, const Vector3f& table_rgb,
   const float arm_x0 = *r - kHandleIntoWall;
   const float arm_x1 = *r + reach - kHandleBar;
   for (const float z : {z_low, z_high}) {
-    body.primitives.push_back(
-        Box(Vector3f((arm_x0 + arm_x1) / 2, 0, z),
-            Vector3f((arm_x1 - arm_x0) / 2, kHandleHalfWidth, kHandleArm / 2),
-            rgb));
+    body.primitives.push_back(BoxPrimitive(
+        Vector3f((arm_x0 + arm_x1) / 2, 0, z),
+        Vector3f((arm_x1 - arm_x0) / 2, kHandleHalfWidth, kHandleArm / 2),
+        rgb));
   }
   const float bar_z0 = z_low - kHandleArm / 2;
   const float bar_z1 = z_high + kHandleArm / 2;
-  body.primitives.push_back(Box(
+  body.primitives.push_back(BoxPrimitive(
       Vector3f(*r + reach - kHandleBar / 2, 0, (bar_z0 + bar_z1) / 2),
       Vector3f(kHandleBar / 2, kHandleHalfWidth, (bar_z1 - bar_z0) / 2), rgb));
   body.hull = Disc(*r + reach, 0.0f, 2.0f * hz);
@@ -315,24 +305,24 @@ PileBody MakeOpenBox(const Vector3f& table_rgb, Random& rng) {
                                       : Texture::kWood;
   const Vector2f inner = half - Vector2f::Constant(wall);
   PileBody body;
-  body.primitives.push_back(Box(Vector3f(0, 0, bottom / 2),
-                                Vector3f(inner.x(), inner.y(), bottom / 2), rgb,
-                                texture));
+  body.primitives.push_back(
+      BoxPrimitive(Vector3f(0, 0, bottom / 2),
+                   Vector3f(inner.x(), inner.y(), bottom / 2), rgb, texture));
   body.solids.push_back(Rect(Vector2f::Zero(), inner, 0.0f, bottom));
   for (const float s : {-1.0f, 1.0f}) {  // front and back, full length
     const Vector2f c(0, s * (half.y() - wall / 2));
     const Vector2f h(half.x(), wall / 2);
-    body.primitives.push_back(Box(Vector3f(c.x(), c.y(), height / 2),
-                                  Vector3f(h.x(), h.y(), height / 2), rgb,
-                                  texture));
+    body.primitives.push_back(BoxPrimitive(Vector3f(c.x(), c.y(), height / 2),
+                                           Vector3f(h.x(), h.y(), height / 2),
+                                           rgb, texture));
     body.solids.push_back(Rect(c, h, 0.0f, height));
   }
   for (const float s : {-1.0f, 1.0f}) {  // the sides, between them
     const Vector2f c(s * (half.x() - wall / 2), 0);
     const Vector2f h(wall / 2, inner.y());
-    body.primitives.push_back(Box(Vector3f(c.x(), c.y(), height / 2),
-                                  Vector3f(h.x(), h.y(), height / 2), rgb,
-                                  texture));
+    body.primitives.push_back(BoxPrimitive(Vector3f(c.x(), c.y(), height / 2),
+                                           Vector3f(h.x(), h.y(), height / 2),
+                                           rgb, texture));
     body.solids.push_back(Rect(c, h, 0.0f, height));
   }
   body.hull = Rect(Vector2f::Zero(), half, 0.0f, height);
@@ -382,6 +372,17 @@ Footprint PoseFootprint(Footprint f, const Vector2f& xy, float base_z,
 }
 
 }  // namespace
+
+Primitive BoxPrimitive(const Vector3f& centre, const Vector3f& half,
+                       const Vector3f& rgb, Texture texture) {
+  Primitive p;
+  p.shape = Shape::kBox;
+  p.pose.translation() = centre;
+  p.half_extents = half;
+  p.rgb = rgb;
+  p.texture = texture;
+  return p;
+}
 
 std::optional<PileBody> MakePileBody(StackedKind kind, float room,
                                      const Vector3f& table_rgb, Random& rng) {

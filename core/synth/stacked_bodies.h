@@ -50,6 +50,12 @@ std::optional<PileBody> MakePileBody(StackedKind kind, float room,
 // tablets and open boxes those and mugs; plates cups and mugs; bowls cups.
 bool CanRestOn(StackedKind kind, StackedKind support);
 
+// An axis-aligned box primitive centred at `centre` with half sizes
+// `half`, metres.
+Primitive BoxPrimitive(const Eigen::Vector3f& centre,
+                       const Eigen::Vector3f& half, const Eigen::Vector3f& rgb,
+                       Texture texture = Texture::kFlat);
+
 // `body` turned by `yaw` (radians, about +z), its origin moved to (xy,
 // base_z): primitives, solids, hull and top alike.
 PileBody PosePileBody(const PileBody& body, const Eigen::Vector2f& xy,

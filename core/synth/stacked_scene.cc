@@ -202,31 +202,23 @@ SceneSpec Stage(RoomSensor sensor, Random& rng, Vector2f* pile_centre) {
   const Vector2f& half = spec.table_half_size;
   const float thickness = rng.Uniform(kTableThicknessMin, kTableThicknessMax);
   const float floor_z = -rng.Uniform(kTableHeightMin, kTableHeightMax);
-  auto box = [](const Vector3f& centre, const Vector3f& half_extents,
-                const Vector3f& rgb, Texture texture) {
-    Primitive p;
-    p.shape = Shape::kBox;
-    p.pose.translation() = centre;
-    p.half_extents = half_extents;
-    p.rgb = rgb;
-    p.texture = texture;
-    return p;
-  };
-  spec.background.push_back({box(Vector3f(0, 0, -kTopRecess - thickness / 2),
-                                 Vector3f(half.x(), half.y(), thickness / 2),
-                                 spec.table_rgb * 0.9f, Texture::kWood),
-                             kSupportTableLabel});
+  spec.background.push_back(
+      {BoxPrimitive(Vector3f(0, 0, -kTopRecess - thickness / 2),
+                    Vector3f(half.x(), half.y(), thickness / 2),
+                    spec.table_rgb * 0.9f, Texture::kWood),
+       kSupportTableLabel});
   const float grey = rng.Uniform(0.45f, 0.65f);
   spec.background.push_back(
-      {box(Vector3f(0, 0, floor_z - 0.01f),
-           Vector3f(kRoomHalfSize, kRoomHalfSize, 0.01f),
-           Vector3f(grey, grey, grey * 1.03f), Texture::kPaint),
+      {BoxPrimitive(Vector3f(0, 0, floor_z - 0.01f),
+                    Vector3f(kRoomHalfSize, kRoomHalfSize, 0.01f),
+                    Vector3f(grey, grey, grey * 1.03f), Texture::kPaint),
        kFloorLabel});
   const float wall_y =
       half.y() + rng.Uniform(0.0f, kWallGapMax) + kWallHalfThickness;
   const float wall = rng.Uniform(0.7f, 0.9f);
   spec.background.push_back(
-      {box(Vector3f(0, wall_y, floor_z + kWallHalfHeight),
+      {BoxPrimitive(
+           Vector3f(0, wall_y, floor_z + kWallHalfHeight),
            Vector3f(kRoomHalfSize, kWallHalfThickness, kWallHalfHeight),
            Vector3f(wall, wall * 0.98f, wall * 0.93f), Texture::kPaint),
        kWallLabel});
@@ -246,39 +238,6 @@ void SetObjects(const std::vector<Placed>& placed, SceneSpec& spec) {
   }
 }
 
-// Pixels of each object (all its parts) on a half-resolution ray cast of
-// `spec` without its background.
-std::vector<int> HalfResolutionPixelCounts(SceneSpec spec) {
-  const double scale =
-      std::min(0.5, static_cast<double>(kVisibilityCastWidth) / spec.width);
-  spec.width = std::max(1, static_cast<int>(spec.width * scale));
-  spec.height = std::max(1, static_cast<int>(spec.height * scale));
-  spec.background.clear();
-  Intrinsics& k = spec.intrinsics;
-  k.fx *= scale;
-  k.fy *= scale;
-  k.cx = (k.cx + 0.5) * scale - 0.5;
-  k.cy = (k.cy + 0.5) * scale - 0.5;
-  std::vector<int> object_of_hit = {-1};
-  for (size_t i = 0; i < spec.objects.size(); ++i) {
-    object_of_hit.push_back(static_cast<int>(i));
-  }
-  for (const ObjectPart& part : spec.object_parts) {
-    object_of_hit.push_back(part.object);
-  }
-  const RaycastImage ray = RaycastScene(spec);
-  std::vector<int> counts(spec.objects.size(), 0);
-  for (int v = 0; v < ray.hit.rows; ++v) {
-    const int* row = ray.hit.ptr<int>(v);
-    for (int u = 0; u < ray.hit.cols; ++u) {
-      if (row[u] > 0 && object_of_hit[row[u]] >= 0) {
-        ++counts[object_of_hit[row[u]]];
-      }
-    }
-  }
-  return counts;
-}
-
 // Whether, with `candidate` added, every object keeps its share of the
 // pixels it covers alone (`alone`, extended with the candidate's on
 // success).
@@ -287,11 +246,13 @@ bool KeepsEveryObjectVisible(const Placed& candidate,
                              const SceneSpec& spec, std::vector<int>& alone) {
   SceneSpec trial = spec;
   SetObjects({candidate}, trial);
-  const int candidate_alone = HalfResolutionPixelCounts(trial)[0];
+  const int candidate_alone =
+      ReducedObjectPixelCounts(trial, kVisibilityCastWidth)[0];
   std::vector<Placed> all = placed;
   all.push_back(candidate);
   SetObjects(all, trial);
-  const std::vector<int> counts = HalfResolutionPixelCounts(trial);
+  const std::vector<int> counts =
+      ReducedObjectPixelCounts(trial, kVisibilityCastWidth);
   for (size_t i = 0; i < counts.size(); ++i) {
     const int full = i < alone.size() ? alone[i] : candidate_alone;
     if (counts[i] < kMinVisiblePixelsHalfRes ||

@@ -18,6 +18,7 @@
 #include "core/baseline/scene_segmenters.h"
 #include "core/frame/organized_cloud.h"
 #include "tools/eval/scene_kind.h"
+#include "tools/eval/scene_runner.h"
 #include "tools/eval/stats.h"
 
 namespace fovea::eval {
@@ -122,9 +123,7 @@ void WriteScenePng(const std::string& dir, const LabelledFrame& scene,
   cv::cvtColor(scene.frame.color, bgr, cv::COLOR_RGB2BGR);
   cv::Mat overlay = bgr.clone();
   for (size_t i = 0; i < run.masks.size(); ++i) {
-    overlay.setTo(
-        cv::Scalar((i * 67) % 256, (80 + i * 151) % 256, (160 + i * 97) % 256),
-        run.masks[i].mask);
+    overlay.setTo(MaskColor(i), run.masks[i].mask);
   }
   cv::addWeighted(overlay, 0.55, bgr, 0.45, 0.0, overlay);
   for (size_t i = 0; i < run.masks.size(); ++i) {

@@ -22,26 +22,13 @@ namespace {
 
 constexpr double kOverlayAlpha = 0.55;
 
-// The object ids of the labels (0 none).
-cv::Mat ObjectIds(const cv::Mat& labels) {
-  cv::Mat ids(labels.size(), CV_32SC1);
-  for (int v = 0; v < labels.rows; ++v) {
-    const int* in = labels.ptr<int>(v);
-    int* out = ids.ptr<int>(v);
-    for (int u = 0; u < labels.cols; ++u) out[u] = ObjectId(in[u]);
-  }
-  return ids;
-}
-
 void WritePng(const std::string& dir, const LabelledFrame& scene,
               SceneMethod method, const SceneRun& run) {
   cv::Mat bgr;
   cv::cvtColor(scene.frame.color, bgr, cv::COLOR_RGB2BGR);
   cv::Mat overlay = bgr.clone();
   for (size_t i = 0; i < run.masks.size(); ++i) {
-    overlay.setTo(
-        cv::Scalar((i * 67) % 256, (80 + i * 151) % 256, (160 + i * 97) % 256),
-        run.masks[i].mask);
+    overlay.setTo(MaskColor(i), run.masks[i].mask);
   }
   cv::addWeighted(overlay, kOverlayAlpha, bgr, 1.0 - kOverlayAlpha, 0.0,
                   overlay);
@@ -50,7 +37,7 @@ void WritePng(const std::string& dir, const LabelledFrame& scene,
                 cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1);
   }
   cv::Mat objects;
-  ObjectIds(scene.labels).convertTo(objects, CV_8U, 20);
+  ObjectIdImage(scene.labels).convertTo(objects, CV_8U, 20);
   cv::Mat edges;
   cv::Canny(objects, edges, 1, 1);
   cv::Mat truth = bgr.clone();
@@ -163,7 +150,7 @@ absl::StatusOr<MethodResults> EvaluateMethods(
       const int min_pixels =
           std::max(1, static_cast<int>(kEvalMinObjectPixels *
                                        scene.labels.total() / (640.0 * 480.0)));
-      const cv::Mat ids = ObjectIds(scene.labels);
+      const cv::Mat ids = ObjectIdImage(scene.labels);
       for (const SceneMethod method : options.methods) {
         SceneRunOptions run_options;
         run_options.method = method;

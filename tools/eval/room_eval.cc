@@ -24,16 +24,6 @@ constexpr double kFoundF = 0.5;
 constexpr double kOverlayAlpha = 0.55;
 
 // Ground-truth object ids (0 none) of the frame.
-cv::Mat ObjectIds(const cv::Mat& labels) {
-  cv::Mat ids(labels.size(), CV_32SC1);
-  for (int v = 0; v < labels.rows; ++v) {
-    const int* in = labels.ptr<int>(v);
-    int* out = ids.ptr<int>(v);
-    for (int u = 0; u < labels.cols; ++u) out[u] = ObjectId(in[u]);
-  }
-  return ids;
-}
-
 bool SupportCorrect(const synth::SynthScene& truth,
                     const std::optional<SupportPlane>& plane) {
   if (!plane.has_value() || plane->inliers.empty()) return false;
@@ -72,9 +62,7 @@ void WritePng(const std::string& dir, const synth::SynthScene& truth,
     overlay.setTo(cv::Scalar(0, 200, 0), run.support->inliers);
   }
   for (size_t i = 0; i < run.masks.size(); ++i) {
-    overlay.setTo(
-        cv::Scalar((i * 67) % 256, (80 + i * 151) % 256, (160 + i * 97) % 256),
-        run.masks[i].mask);
+    overlay.setTo(MaskColor(i), run.masks[i].mask);
   }
   cv::addWeighted(overlay, kOverlayAlpha, bgr, 1.0 - kOverlayAlpha, 0.0,
                   overlay);
@@ -83,7 +71,7 @@ void WritePng(const std::string& dir, const synth::SynthScene& truth,
                 cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1);
   }
   cv::Mat objects;
-  ObjectIds(truth.frame.labels).convertTo(objects, CV_8U, 20);
+  ObjectIdImage(truth.frame.labels).convertTo(objects, CV_8U, 20);
   cv::Mat edges;
   cv::Canny(objects, edges, 1, 1);
   cv::Mat gt = bgr.clone();
@@ -110,7 +98,7 @@ RoomResult Score(const synth::SynthScene& truth, const SceneRun& run,
   const int min_pixels =
       std::max(1, static_cast<int>(std::lround(
                       kMinObjectPixels640 * labels.total() / (640.0 * 480.0))));
-  const cv::Mat ids = ObjectIds(labels);
+  const cv::Mat ids = ObjectIdImage(labels);
   r.uois = ScoreUois(ids, run.segments, min_pixels);
   r.whole_scene_f = WholeSceneF(labels, run.segments, min_pixels);
   r.masks = static_cast<int>(run.masks.size());

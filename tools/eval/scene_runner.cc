@@ -107,6 +107,10 @@ absl::StatusOr<SceneRun> RunOnScene(const LabelledFrame& scene,
     run.support = plane;
     return absl::OkStatus();
   };
+  sinks.points = [&](const std::vector<AttentionPoint>& points) {
+    run.points = points;
+    return absl::OkStatus();
+  };
   sinks.object = [&](SegmentedObject object) {
     if (first) run.first_ms = MsSince(start);
     first = false;

@@ -34,12 +34,22 @@ struct SceneRunOptions {
 
 struct SceneRun {
   std::vector<SeededMask> masks;  // in the order they came, frame's size
-  cv::Mat segments;               // CV_32SC1: mask index, -1 none
+  // COS / EBS / INC: the attention points Detect gave the run (its seeds,
+  // or INC's order), most salient first, in the frame's pixels.
+  std::vector<AttentionPoint> points;
+  cv::Mat segments;  // CV_32SC1: mask index, -1 none
   // The support the scene was prepared on (the peers: none).
   std::optional<SupportPlane> support;
   double first_ms = 0.0;  // to the first object (the whole run if none)
   double total_ms = 0.0;  // the whole run
 };
+
+// The colour (BGR) overlays tint the i-th mask with.
+inline cv::Scalar MaskColor(size_t i) {
+  return cv::Scalar(static_cast<double>((i * 67) % 256),
+                    static_cast<double>((80 + i * 151) % 256),
+                    static_cast<double>((160 + i * 97) % 256));
+}
 
 // Runs `options.method` on the frame to the end (every seed, the whole
 // scene). Where masks overlap (COS and EBS may), the earlier keeps the

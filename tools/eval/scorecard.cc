@@ -50,15 +50,14 @@ struct SceneRecord : SegmentFigures {
   double total_ms = 0.0;
 };
 
+// ObjectIdImage without the objects of fewer than `min_pixels` pixels.
 cv::Mat ObjectIds(const cv::Mat& labels, int min_pixels) {
-  cv::Mat ids(labels.size(), CV_32SC1);
+  cv::Mat ids = ObjectIdImage(labels);
   std::map<int, int> count;
-  for (int v = 0; v < labels.rows; ++v) {
-    const int* in = labels.ptr<int>(v);
-    int* out = ids.ptr<int>(v);
-    for (int u = 0; u < labels.cols; ++u) {
-      out[u] = ObjectId(in[u]);
-      if (out[u] > 0) ++count[out[u]];
+  for (int v = 0; v < ids.rows; ++v) {
+    const int* id = ids.ptr<int>(v);
+    for (int u = 0; u < ids.cols; ++u) {
+      if (id[u] > 0) ++count[id[u]];
     }
   }
   for (const auto& [id, n] : count) {
@@ -80,9 +79,7 @@ void WriteOverlay(const std::string& dir, const std::string& name,
   cv::cvtColor(frame.color, bgr, cv::COLOR_RGB2BGR);
   cv::Mat overlay = bgr.clone();
   for (size_t i = 0; i < masks.size(); ++i) {
-    overlay.setTo(
-        cv::Scalar((i * 67) % 256, (80 + i * 151) % 256, (160 + i * 97) % 256),
-        masks[i].mask);
+    overlay.setTo(MaskColor(i), masks[i].mask);
   }
   cv::addWeighted(overlay, kOverlayAlpha, bgr, 1.0 - kOverlayAlpha, 0.0,
                   overlay);
@@ -98,7 +95,7 @@ void WriteOverlay(const std::string& dir, const std::string& name,
   cv::Mat right = bgr.clone();
   if (!labels.empty()) {
     cv::Mat objects;
-    ObjectIds(labels, 1).convertTo(objects, CV_8U, 20);
+    ObjectIdImage(labels).convertTo(objects, CV_8U, 20);
     cv::Mat edges;
     cv::Canny(objects, edges, 1, 1);
     right.setTo(cv::Scalar(0, 255, 0), edges);
@@ -123,13 +120,14 @@ absl::StatusOr<SceneRun> RunOrEmpty(const LabelledFrame& scene,
   return run;
 }
 
-// Detect as the server runs it by default: HR over max(K, 10) points.
-void ScoreAttention(const LabelledFrame& scene, SceneRecord& r) {
-  absl::StatusOr<DetectResult> detect = RunDetect(scene.frame, DetectOptions{});
-  if (!detect.ok()) return;  // no support: HR 0, no points
+// The run's attention points (Detect with the server's default options,
+// which the segmentation runs with): HR over max(K, 10) points. No support:
+// no points, HR 0.
+void ScoreAttention(const LabelledFrame& scene,
+                    const std::vector<AttentionPoint>& points, SceneRecord& r) {
   const OrganizedCloud cloud = BackProject(scene.frame);
-  const DetectionScore score = ScoreAttentionPoints(
-      detect->points, scene.labels, cloud.xyz, kHitRatioAtMax);
+  const DetectionScore score =
+      ScoreAttentionPoints(points, scene.labels, cloud.xyz, kHitRatioAtMax);
   r.hit_ratio = score.hit_ratio;
   r.off_object_points = score.off_object_points;
 }
@@ -155,7 +153,7 @@ absl::Status ScoreLabelledScene(const SetContext& ctx, const std::string& set,
     FOVEA_ASSIGN_OR_RETURN(SceneRun run, RunOrEmpty(scene, run_options, r));
     r.total_ms = run.total_ms;
     static_cast<SegmentFigures&>(r) = ScoreSegments(scene.labels, run.segments);
-    ScoreAttention(scene, r);
+    ScoreAttention(scene, run.points, r);
     if (ctx.options->verbose) {
       std::fprintf(stderr,
                    "%-10s %-4s %-10s %-22s objects %2d found %2d masks/obj "
