@@ -109,6 +109,26 @@ int LoadScenesOrExit(const char* command,
   return 0;
 }
 
+// With --samples_csv, the samples as CSV (the features by `names`, then
+// label and scene); false after a message when the file cannot be written.
+bool WriteSamplesCsv(const std::vector<std::string>& names,
+                     const std::vector<SvmSample>& samples) {
+  const std::string csv = absl::GetFlag(FLAGS_samples_csv);
+  if (csv.empty()) return true;
+  std::string text;
+  for (const std::string& name : names) text += name + ",";
+  text += "label,scene\n";
+  for (const SvmSample& s : samples) {
+    for (const double x : s.x) text += absl::StrFormat("%.5g,", x);
+    text += absl::StrFormat("%d,%d\n", s.label, s.group);
+  }
+  if (!WriteFile(csv, text)) {
+    std::fprintf(stderr, "fovea-train: cannot write %s\n", csv.c_str());
+    return false;
+  }
+  return true;
+}
+
 int TrainCos() {
   const std::string out = absl::GetFlag(FLAGS_out);
   absl::StatusOr<std::vector<LabelledFrame>> scenes;
@@ -128,19 +148,7 @@ int TrainCos() {
   std::printf("cos: %zu samples from %zu scenes\n", samples.size(),
               scenes->size());
   PrintClassMeans(samples);
-  if (const std::string csv = absl::GetFlag(FLAGS_samples_csv); !csv.empty()) {
-    std::string text;
-    for (const std::string& name : CosFeatureNames()) text += name + ",";
-    text += "label,scene\n";
-    for (const SvmSample& s : samples) {
-      for (const double x : s.x) text += absl::StrFormat("%.5g,", x);
-      text += absl::StrFormat("%d,%d\n", s.label, s.group);
-    }
-    if (!WriteFile(csv, text)) {
-      std::fprintf(stderr, "fovea-train: cannot write %s\n", csv.c_str());
-      return kRunError;
-    }
-  }
+  if (!WriteSamplesCsv(CosFeatureNames(), samples)) return kRunError;
   LinearSvmTrainingOptions svm;
   svm.c = absl::GetFlag(FLAGS_c);
   const int folds = absl::GetFlag(FLAGS_folds);
@@ -270,6 +278,7 @@ int TrainInc() {
   for (const SvmSample& s : samples) positives += s.label == 1 ? 1 : 0;
   std::printf("inc: %zu relation samples from %zu scenes (%d same object)\n",
               samples.size(), scenes->size(), positives);
+  if (!WriteSamplesCsv(RelationFeatureNames(), samples)) return kRunError;
   const int folds = absl::GetFlag(FLAGS_folds);
   // The thesis's search (10-fold, C and gamma on a log2 grid) redone by
   // scene folds on a coarser grid; without --grid, the defaults (the
