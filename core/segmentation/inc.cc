@@ -71,6 +71,19 @@ absl::Status Validate(const IncOptions& options) {
     return absl::InvalidArgumentError(
         absl::StrCat("surface_models.", s.message()));
   }
+  const IncOptions::ConvexJoin& convex = options.convex_join;
+  if (!(convex.min_touching >= 0.0 && convex.min_touching <= 1.0) ||
+      !(convex.min_convexity >= 0.0 && convex.min_convexity <= 1.0) ||
+      !(convex.max_sharp_concave >= 0.0 && convex.max_sharp_concave <= 1.0)) {
+    return absl::InvalidArgumentError(
+        "convex_join: min_touching, min_convexity and max_sharp_concave must "
+        "be in [0, 1]");
+  }
+  if (!(convex.joined_probability > 0.5 && convex.joined_probability <= 1.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("convex_join.joined_probability must be in (0.5, 1], got ",
+                     convex.joined_probability));
+  }
   if (options.max_growth_steps < 1) {
     return absl::InvalidArgumentError(absl::StrCat(
         "max_growth_steps must be positive, got ", options.max_growth_steps));
@@ -193,7 +206,15 @@ double IncSegmenter::SameProbability(int a, int b) {
   const uint64_t key = PairKey(a, b);
   const auto found = probability_.find(key);
   if (found != probability_.end()) return found->second;
-  const double p = svm_.Probability(scene_.relations->Relate(a, b));
+  const std::vector<double> relation = scene_.relations->Relate(a, b);
+  const IncOptions::ConvexJoin& convex = options_.convex_join;
+  const bool convex_join =
+      convex.enabled &&
+      relation[kBorder3dFractionFeature] >= convex.min_touching &&
+      relation[kBorderConvexityFeature] >= convex.min_convexity &&
+      relation[kBorderSharpConcaveFeature] <= convex.max_sharp_concave;
+  const double svm = svm_.Probability(relation);
+  const double p = convex_join ? std::max(svm, convex.joined_probability) : svm;
   probability_.emplace(key, p);
   return p;
 }

@@ -53,6 +53,14 @@ absl::Status Validate(const RelationOptions& options);
 // The relation features' names, in order.
 const std::vector<std::string>& RelationFeatureNames();
 
+// Indices of the border features a geometric rule reads (IncOptions::
+// convex_join): the share of the border where the surfaces touch in 3D,
+// the mean convexity mapped to [0, 1] (0.5 flat, above convex) and the
+// share of sharp concave folds.
+inline constexpr int kBorder3dFractionFeature = 10;
+inline constexpr int kBorderConvexityFeature = 12;
+inline constexpr int kBorderSharpConcaveFeature = 13;
+
 // Per-frame statistics of the surfaces of `labels` (CV_32SC1, -1 = none;
 // surfaces 0 .. count-1): colour histograms, texture energies and, for
 // every 4-adjacent pair, the statistics along their shared border.
