@@ -29,13 +29,11 @@
 #include "tools/eval/realsense_frames.h"
 #include "tools/eval/scene_kind.h"
 #include "tools/eval/stats.h"
+#include "tools/eval/training_scenes.h"
 
 namespace fovea::eval {
 namespace {
 
-// The seeds the shipped INC model's synthetic piles start at
-// (models/README.md); evaluation piles start at 1.
-constexpr uint64_t kTrainingPileSeed = 1000001;
 // A segment found an object when their F reaches this.
 constexpr double kFoundF = 0.5;
 constexpr double kOverlayAlpha = 0.55;
@@ -225,11 +223,12 @@ absl::Status RunOsdSets(const SetContext& ctx) {
     }
   }
   if (uses_inc) {
-    for (int k = 0; k < o.training_piles; ++k) {
-      const synth::SynthScene pile = synth::GeneratePile(kTrainingPileSeed + k);
+    const std::vector<LabelledFrame> synthetic =
+        SyntheticTrainingScenes(o.training_piles, o.training_stacked);
+    for (size_t k = 0; k < synthetic.size(); ++k) {
       FOVEA_ASSIGN_OR_RETURN(
           std::vector<SvmSample> s,
-          CollectIncSamples(pile.frame, static_cast<int>(scenes.size()) + k,
+          CollectIncSamples(synthetic[k], static_cast<int>(scenes.size() + k),
                             inc_defaults.detect, inc_defaults.inc));
       pile_inc.insert(pile_inc.end(), s.begin(), s.end());
     }

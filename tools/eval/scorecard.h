@@ -40,12 +40,15 @@ struct ScorecardOptions {
   // Sets to run, by name as above ("stacked" and "rooms" cover both
   // sensors); empty: all.
   std::vector<std::string> sets;
-  int piles = 40;            // scenes of `piles`
-  int stacked = 30;          // scenes of `stacked`, per sensor
-  int rooms = 30;            // rooms per sensor
-  int training_piles = 100;  // synthetic piles added to each fold's training
-  std::string out_dir;       // <set>/<scene>_<method>.png overlays
-  bool verbose = false;      // one line per scene on stderr
+  int piles = 40;    // scenes of `piles`
+  int stacked = 30;  // scenes of `stacked`, per sensor
+  int rooms = 30;    // rooms per sensor
+  // Synthetic scenes added to each fold's INC training, as the shipped
+  // model's (SyntheticTrainingScenes): piles, and stacked piles per sensor.
+  int training_piles = 100;
+  int training_stacked = 0;
+  std::string out_dir;   // <set>/<scene>_<method>.png overlays
+  bool verbose = false;  // one line per scene on stderr
 };
 
 // The figures of one set, method and kind (kind "all": the whole set).

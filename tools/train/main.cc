@@ -3,7 +3,7 @@
 //   fovea-train cos --data DIR --out models/cos_svm.txt [--folds 5] [--c 1]
 //   fovea-train ebs --data DIR --out models/ebs_edges.txt [--folds 5]
 //   fovea-train inc --data DIR --out models/inc_relations.txt [--grid]
-//                   [--piles N [--pile_seed S]]
+//                   [--piles N] [--stacked N]
 //
 // Prints the k-fold cross-validated accuracy (folds by scene) and writes
 // the model trained on every scene, with that accuracy in its provenance.
@@ -26,6 +26,7 @@
 #include "core/segmentation/svm_training.h"
 #include "core/synth/synth_scene.h"
 #include "tools/eval/detect_eval.h"
+#include "tools/eval/training_scenes.h"
 
 ABSL_FLAG(std::string, data, "",
           "OSD-format folder: *.pcd files, or a folder with learn/ inside. "
@@ -40,10 +41,10 @@ ABSL_FLAG(bool, grid, false,
           "2, 8) instead of using the defaults.");
 ABSL_FLAG(int, piles, 0,
           "inc: also train on this many synthetic piles (core/synth "
-          "GeneratePile), seeds from --pile_seed.");
-ABSL_FLAG(uint64_t, pile_seed, 1000001,
-          "inc: the first training pile's seed; far from fovea-eval's "
-          "--seed 1 so that its piles stay held out.");
+          "GeneratePile), seeds from 1000001 (evaluations use seeds from 1).");
+ABSL_FLAG(int, stacked, 0,
+          "inc: also train on this many synthetic stacked piles per sensor "
+          "(core/synth GenerateStackedPile, Kinect v1 and active stereo).");
 ABSL_FLAG(double, c, fovea::LinearSvmTrainingOptions().c,
           "cos: the SVM's soft-margin penalty C.");
 
@@ -258,9 +259,13 @@ int TrainInc() {
     std::fprintf(stderr, "fovea-train: --piles must not be negative\n");
     return kUsageError;
   }
-  for (int k = 0; k < piles; ++k) {
-    scenes->push_back(
-        synth::GeneratePile(absl::GetFlag(FLAGS_pile_seed) + k).frame);
+  const int stacked = absl::GetFlag(FLAGS_stacked);
+  if (stacked < 0) {
+    std::fprintf(stderr, "fovea-train: --stacked must not be negative\n");
+    return kUsageError;
+  }
+  for (LabelledFrame& scene : eval::SyntheticTrainingScenes(piles, stacked)) {
+    scenes->push_back(std::move(scene));
   }
   const IncrementalOptions options;
   std::vector<SvmSample> samples;
@@ -325,13 +330,12 @@ int TrainInc() {
       model->Serialize(), "inc");  // round trip: what the server will load
   std::string text = trained.Serialize();
   const std::string provenance = absl::StrFormat(
-      "fovea-train inc, %d scenes and %d synthetic piles (seeds from %u), "
-      "%zu samples, C %g gamma %g; %d-fold "
+      "fovea-train inc, %d scenes, %d synthetic piles and %d stacked piles "
+      "per sensor (seeds from %u), %zu samples, C %g gamma %g; %d-fold "
       "cross-validated accuracy %.3f (balanced %.3f)",
-      learn_scenes, piles,
-      static_cast<unsigned>(absl::GetFlag(FLAGS_pile_seed)), samples.size(),
-      best.c, best.gamma, best_cv.folds, best_cv.accuracy,
-      best_cv.balanced_accuracy);
+      learn_scenes, piles, stacked,
+      static_cast<unsigned>(eval::kTrainingSceneSeed), samples.size(), best.c,
+      best.gamma, best_cv.folds, best_cv.accuracy, best_cv.balanced_accuracy);
   const size_t at = text.find("\nprovenance ");
   const size_t end = text.find('\n', at + 1);
   text.replace(at + 12, end - at - 12, provenance);
