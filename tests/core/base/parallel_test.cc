@@ -114,10 +114,12 @@ TEST(ParallelForTest, AWaitingThreadNeverRunsAnotherRequestsWork) {
     a_thread = std::this_thread::get_id();
     ParallelScope scope(&pool, 2);
     std::atomic<bool> second_started{false};
-    ParallelFor(2, [&](int i) {
+    // Roles by thread, not by item: either item may be the one A's own
+    // thread takes (the pool's worker may take item 0 first).
+    ParallelFor(2, [&](int) {
       const auto until =
           std::chrono::steady_clock::now() + std::chrono::seconds(10);
-      if (i == 0) {
+      if (std::this_thread::get_id() == a_thread) {
         // Until the other item runs on the other thread; then A's thread
         // has nothing of its own to do and waits.
         while (!second_started.load() &&
