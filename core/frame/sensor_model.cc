@@ -74,8 +74,10 @@ SensorModel SensorModelFor(SensorKind kind, const Intrinsics& intrinsics) {
       model.min_range_m = kStereoMinRange;
       break;
     case SensorKind::kGeneric: {
-      // The focal length a 640-pixel-wide frame of this camera would have.
-      const double width = 2.0 * (intrinsics.cx + 0.5);
+      // The focal length a 640-pixel-wide frame of this camera would have,
+      // the width being the longer side (a camera rolled a quarter turn
+      // sends its 640 pixels as rows).
+      const double width = 2.0 * (std::max(intrinsics.cx, intrinsics.cy) + 0.5);
       const double fx640 = width > 0.0 && intrinsics.fx > 0.0
                                ? intrinsics.fx * 640.0 / width
                                : 0.0;

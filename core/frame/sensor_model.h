@@ -54,8 +54,10 @@ struct SensorModel {
 };
 
 // The model of `kind` for a frame with these intrinsics (pixels of the
-// frame as sent). kGeneric chooses from the focal length a 640-pixel-wide
-// frame of the camera would have (fx * 640 / (2 cx + 1)): 500-590 px is
+// frame as sent). kGeneric chooses from the focal length a frame of the
+// camera 640 pixels on its longer side would have
+// (fx * 640 / (2 max(cx, cy) + 1), so that a camera rolled a quarter turn
+// is still itself): 500-590 px is
 // the structured-light PrimeSense family (Kinect v1, Xtion, Astra) and gets
 // the Kinect v1 model; any other camera gets the active-stereo model, the
 // noisier one, with a 3 m range.

@@ -47,6 +47,14 @@ TEST(SensorModelTest, GenericPicksTheModelFromTheFocalLength) {
               SensorModelFor(SensorKind::kKinectV1, k).sigma_per_z2)
         << k.fx;
   }
+  // The same cameras rolled a quarter turn (a wrist camera turned
+  // sideways: 480 columns, 640 rows, the principal point swapped).
+  for (const Intrinsics& k : {Intrinsics{525.0, 525.0, 239.5, 319.5},
+                              Intrinsics{570.3, 570.3, 239.5, 319.5}}) {
+    EXPECT_EQ(SensorModelFor(SensorKind::kGeneric, k).sigma_per_z2,
+              SensorModelFor(SensorKind::kKinectV1, k).sigma_per_z2)
+        << k.fx;
+  }
   // A RealSense colour camera at 640x480 and at 1280x720, a depth stream
   // (385 px at 640): the active-stereo model, 3 m range.
   for (const Intrinsics& k : {Intrinsics{612.9, 613.2, 322.5, 248.2},
