@@ -10,6 +10,7 @@
 #include "core/base/guarded.h"
 #include "core/base/parallel.h"
 #include "core/base/status_macros.h"
+#include "core/pipeline/sensor_adaptation.h"
 
 namespace fovea {
 namespace {
@@ -52,7 +53,9 @@ absl::StatusOr<SegmentSummary> RunUnguarded(const RgbdFrame& frame,
 
   std::vector<AttentionPoint> points;
   cv::Mat saliency;
-  const IncOptions& inc_options = options.inc;
+  // The surface models' noise is the scene's sensor's.
+  IncOptions inc_options = options.inc;
+  AdaptToSensor(scene.sensor, inc_options.surface_models);
   // The surfaces do not depend on the saliency map: with two threads they
   // are built while Detect runs.
   std::optional<absl::StatusOr<CosScene>> surfaces;
