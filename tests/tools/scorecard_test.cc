@@ -35,6 +35,7 @@ TEST(ScoreSegmentsTest, OneMaskPerObjectIsOneMaskPerObject) {
   const SegmentFigures f = ScoreSegments(labels, segments);
   EXPECT_EQ(f.objects, 2);
   EXPECT_EQ(f.found, 2);
+  EXPECT_TRUE(f.missed.empty());
   EXPECT_EQ(f.object_masks, 2);
   EXPECT_EQ(f.objects_with_masks, 2);
   EXPECT_EQ(f.false_objects, 0);
@@ -65,6 +66,7 @@ TEST(ScoreSegmentsTest, AMaskOnTheTableIsAFalseObjectAndAMissedObjectIsLost) {
   const SegmentFigures f = ScoreSegments(labels, segments);
   EXPECT_EQ(f.false_objects, 1);
   EXPECT_EQ(f.found, 1);
+  EXPECT_EQ(f.missed, std::vector<int>{2});  // object 2 (label 20)
   EXPECT_EQ(f.object_masks, 1);
   // A mask taking two whole objects matches neither one to one.
   cv::Mat both = NoSegments(labels);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -135,10 +136,12 @@ struct SetContext {
   std::vector<SceneRecord>* records;
 };
 
-absl::Status ScoreLabelledScene(const SetContext& ctx, const std::string& set,
-                                const std::string& kind,
-                                const LabelledFrame& scene,
-                                const SegmentModels& models) {
+// `describe`, when given, names an object (by ObjectId) for --verbose's
+// list of the objects no segment found.
+absl::Status ScoreLabelledScene(
+    const SetContext& ctx, const std::string& set, const std::string& kind,
+    const LabelledFrame& scene, const SegmentModels& models,
+    const std::function<std::string(int)>& describe = {}) {
   for (const SceneMethod method : ctx.options->methods) {
     SceneRecord r;
     r.set = set;
@@ -163,6 +166,13 @@ absl::Status ScoreLabelledScene(const SetContext& ctx, const std::string& set,
                        : 0.0,
                    r.false_objects, r.uois.overlap_f, r.uois.boundary_f,
                    r.hit_ratio, r.no_support ? " NO SUPPORT" : "");
+      if (describe) {
+        for (const int id : r.missed) {
+          std::fprintf(stderr, "%-10s %-4s %-10s %-22s   missed: %s\n",
+                       set.c_str(), r.method.c_str(), kind.c_str(),
+                       scene.name.c_str(), describe(id).c_str());
+        }
+      }
     }
     if (!ctx.options->out_dir.empty()) {
       WriteOverlay(absl::StrCat(ctx.options->out_dir, "/", set),
@@ -302,11 +312,22 @@ absl::Status RunSyntheticSets(const SetContext& ctx) {
   if (Wants(o, "stacked")) {
     for (const synth::RoomSensor sensor : sensors) {
       for (int k = 0; k < o.stacked; ++k) {
-        const synth::SynthScene scene =
-            synth::GenerateStackedPile(1 + k, sensor).scene;
+        const synth::StackedPile pile =
+            synth::GenerateStackedPile(1 + k, sensor);
+        // Object k has label 10 (k + 2), ObjectId k + 2.
+        const auto describe = [&pile](int id) {
+          const int k = id - 2;
+          if (k < 0 || k >= static_cast<int>(pile.kinds.size())) {
+            return absl::StrCat("object ", id);
+          }
+          const int on = pile.rests_on[k];
+          return std::string(synth::StackedKindName(pile.kinds[k])) + " on " +
+                 (on < 0 ? std::string("the table")
+                         : std::string(synth::StackedKindName(pile.kinds[on])));
+        };
         FOVEA_RETURN_IF_ERROR(ScoreLabelledScene(
             ctx, "stacked", std::string(synth::RoomSensorName(sensor)),
-            scene.frame, models));
+            pile.scene.frame, models, describe));
       }
     }
   }
@@ -473,13 +494,19 @@ SegmentFigures ScoreSegments(const cv::Mat& labels, const cv::Mat& segments) {
     ++r.objects_with_masks;
   }
   for (const auto& [object, size] : object_size) {
+    bool found = false;
     for (const auto& [segment, ssize] : segment_size) {
       const auto it = overlap.find({segment, object});
       if (it == overlap.end()) continue;
       if (2.0 * it->second / (size + ssize) >= kFoundF) {
-        ++r.found;
+        found = true;
         break;
       }
+    }
+    if (found) {
+      ++r.found;
+    } else {
+      r.missed.push_back(object);
     }
   }
   return r;

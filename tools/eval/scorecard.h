@@ -93,6 +93,8 @@ struct SegmentFigures {
   int object_masks = 0, objects_with_masks = 0;
   // Segments whose labelled pixels lie mostly on no object.
   int false_objects = 0;
+  // The objects no segment matches with F >= 0.5 (ObjectId), ascending.
+  std::vector<int> missed;
 };
 // `segments`: CV_32SC1 of the labels' size, -1 none, else a segment id.
 SegmentFigures ScoreSegments(const cv::Mat& labels, const cv::Mat& segments);
