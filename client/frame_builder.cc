@@ -8,94 +8,27 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "core/base/status_macros.h"
+#include "core/frame/image_header.h"
 
 namespace fovea::client {
 namespace {
 
-constexpr absl::string_view kPngSignature = "\x89PNG\r\n\x1a\n";
-// Signature, IHDR length and type, width, height, bit depth, colour type.
-constexpr size_t kPngHeaderBytes = 8 + 4 + 4 + 4 + 4 + 1 + 1;
-
-uint32_t BigEndian32(const unsigned char* p) {
-  return (uint32_t{p[0]} << 24) | (uint32_t{p[1]} << 16) |
-         (uint32_t{p[2]} << 8) | uint32_t{p[3]};
-}
-
-uint32_t BigEndian16(const unsigned char* p) {
-  return (uint32_t{p[0]} << 8) | uint32_t{p[1]};
-}
-
-absl::StatusOr<CompressedInfo> ProbePng(absl::string_view bytes) {
-  if (bytes.size() < kPngHeaderBytes) {
-    return absl::InvalidArgumentError("PNG file truncated before its header");
-  }
-  const auto* p = reinterpret_cast<const unsigned char*>(bytes.data());
-  if (std::memcmp(p + 12, "IHDR", 4) != 0) {
-    return absl::InvalidArgumentError("PNG file does not start with IHDR");
-  }
-  CompressedInfo info;
-  info.format = "png";
-  info.width = BigEndian32(p + 16);
-  info.height = BigEndian32(p + 20);
-  info.bit_depth = p[24];
-  switch (p[25]) {  // PNG colour type
+// A PNG colour type's channels (palette indices decode to RGB).
+absl::StatusOr<int> PngChannels(int colour_type) {
+  switch (colour_type) {
     case 0:
-      info.channels = 1;
-      break;
+      return 1;
     case 2:
-    case 3:  // palette: indices to RGB
-      info.channels = 3;
-      break;
+    case 3:
+      return 3;
     case 4:
-      info.channels = 2;
-      break;
+      return 2;
     case 6:
-      info.channels = 4;
-      break;
+      return 4;
     default:
-      return absl::InvalidArgumentError(
-          absl::StrCat("PNG colour type ", int{p[25]}, " is invalid"));
+      return absl::InvalidArgumentError(absl::StrCat(
+          "compressed: PNG colour type ", colour_type, " is invalid"));
   }
-  return info;
-}
-
-// Is `marker` a start-of-frame marker (SOF0-SOF15 without DHT, JPG, DAC)?
-bool IsStartOfFrame(unsigned char marker) {
-  return marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 &&
-         marker != 0xCC;
-}
-
-absl::StatusOr<CompressedInfo> ProbeJpeg(absl::string_view bytes) {
-  const auto* p = reinterpret_cast<const unsigned char*>(bytes.data());
-  size_t i = 2;  // after SOI
-  while (i + 4 <= bytes.size()) {
-    if (p[i] != 0xFF) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("JPEG marker expected at byte ", i));
-    }
-    const unsigned char marker = p[i + 1];
-    if (marker == 0xFF) {  // fill byte
-      ++i;
-      continue;
-    }
-    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD9)) {
-      i += 2;  // standalone marker, no length
-      continue;
-    }
-    const uint32_t length = BigEndian16(p + i + 2);
-    if (IsStartOfFrame(marker)) {
-      if (i + 2 + 8 > bytes.size() || length < 8) break;
-      CompressedInfo info;
-      info.format = "jpeg";
-      info.bit_depth = p[i + 4];
-      info.height = BigEndian16(p + i + 5);
-      info.width = BigEndian16(p + i + 7);
-      info.channels = p[i + 9];
-      return info;
-    }
-    i += 2 + length;
-  }
-  return absl::InvalidArgumentError("JPEG file has no frame header (SOF)");
 }
 
 }  // namespace
@@ -158,13 +91,27 @@ absl::StatusOr<fovea::v1::Image> MakeRawImage(const void* data,
 }
 
 absl::StatusOr<CompressedInfo> ProbeCompressedImage(absl::string_view bytes) {
-  if (bytes.substr(0, kPngSignature.size()) == kPngSignature) {
-    return ProbePng(bytes);
+  const std::string_view file(bytes.data(), bytes.size());
+  CompressedInfo info;
+  if (IsPngFile(file)) {
+    FOVEA_ASSIGN_OR_RETURN(ImageFileHeader header,
+                           ReadPngFileHeader(file, "compressed"));
+    FOVEA_ASSIGN_OR_RETURN(info.channels, PngChannels(header.channels));
+    info.format = "png";
+    info.width = header.width;
+    info.height = header.height;
+    info.bit_depth = header.bit_depth;
+    return info;
   }
-  if (bytes.size() >= 3 && static_cast<unsigned char>(bytes[0]) == 0xFF &&
-      static_cast<unsigned char>(bytes[1]) == 0xD8 &&
-      static_cast<unsigned char>(bytes[2]) == 0xFF) {
-    return ProbeJpeg(bytes);
+  if (IsJpegFile(file)) {
+    FOVEA_ASSIGN_OR_RETURN(ImageFileHeader header,
+                           ReadJpegFileHeader(file, "compressed"));
+    info.format = "jpeg";
+    info.width = header.width;
+    info.height = header.height;
+    info.bit_depth = header.bit_depth;
+    info.channels = header.channels;
+    return info;
   }
   return absl::InvalidArgumentError(
       absl::StrCat("compressed: ", bytes.size(),

@@ -5,16 +5,13 @@
 
 #include <chrono>
 
+#include "core/base/stage_clock.h"
+
 namespace fovea::server {
 
 // The clock of every duration the server measures (calls, stages, queue
-// waits): monotonic, unaffected by changes to the wall clock.
-using Clock = std::chrono::steady_clock;
-
-// Seconds from `start` to now.
-inline double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
+// waits): core's (fovea::SteadyClock, fovea::SecondsSince).
+using Clock = SteadyClock;
 
 // True once `deadline` (a call's raw deadline, any gpr clock) has passed.
 // Compared as gpr_timespec: a deadline past the year 2262 (grpc-timeout

@@ -18,8 +18,11 @@
 #include <system_error>
 #include <utility>
 
+#include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/time/clock.h"
+#include "absl/time/time.h"
 #include "core/frame/image_codec.h"
 #include "core/frame/image_header.h"
 #include "fovea/v1/frame.pb.h"
@@ -299,6 +302,20 @@ bool FlightRecorder::ShouldRecord() {
   // share, evenly spread.
   const uint64_t i = calls_seen_.fetch_add(1, std::memory_order_relaxed) + 1;
   return std::floor(i * config_.sample) > std::floor((i - 1) * config_.sample);
+}
+
+RecordedCall EndedCall(
+    std::string method, std::unique_ptr<google::protobuf::Message> request,
+    std::vector<std::unique_ptr<const google::protobuf::Message>> responses,
+    absl::StatusCode code, double seconds) {
+  RecordedCall call;
+  call.method = std::move(method);
+  call.request = std::move(request);
+  call.responses = std::move(responses);
+  call.code = absl::StatusCodeToString(code);
+  call.seconds = seconds;
+  call.unix_micros = absl::ToUnixMicros(absl::Now());
+  return call;
 }
 
 void FlightRecorder::Submit(RecordedCall call) {

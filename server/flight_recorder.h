@@ -73,6 +73,13 @@ struct RecordedCall {
   int64_t unix_micros = 0;  // when it ended
 };
 
+// A call that ends now with `code`, `seconds` after it started: its
+// record, with the code's name and the time stamp filled in.
+RecordedCall EndedCall(
+    std::string method, std::unique_ptr<google::protobuf::Message> request,
+    std::vector<std::unique_ptr<const google::protobuf::Message>> responses,
+    absl::StatusCode code, double seconds);
+
 class FlightRecorder {
  public:
   // Creates the folder, takes stock of the records in it (deleting

@@ -27,9 +27,6 @@ bool LogEnabled(LogLevel level);
 // Writes `message` (without a trailing newline) when `level` is enabled.
 void Log(LogLevel level, std::string_view message);
 
-inline void LogDebug(std::string_view message) {
-  Log(LogLevel::kDebug, message);
-}
 inline void LogInfo(std::string_view message) { Log(LogLevel::kInfo, message); }
 inline void LogWarn(std::string_view message) { Log(LogLevel::kWarn, message); }
 inline void LogError(std::string_view message) {

@@ -6,7 +6,6 @@
 #include <prometheus/gauge.h>
 #include <prometheus/histogram.h>
 #include <prometheus/registry.h>
-#include <prometheus/text_serializer.h>
 
 #include <array>
 #include <exception>
@@ -357,11 +356,6 @@ void SetRecorderBytes(int64_t bytes) {
 void IncrementInflight() { Metrics::Get().inflight().Increment(); }
 
 void DecrementInflight() { Metrics::Get().inflight().Decrement(); }
-
-std::string MetricsText() {
-  return prometheus::TextSerializer().Serialize(
-      Metrics::Get().registry()->Collect());
-}
 
 // Handler threads of /metrics.
 constexpr int kMetricsThreads = 16;

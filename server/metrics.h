@@ -96,9 +96,6 @@ void RecordDescriptors(int open, int limit, int64_t refused_total);
 void RecordRecorderOutcome(std::string_view outcome);
 void SetRecorderBytes(int64_t bytes);
 
-// The registry in Prometheus' text format, as /metrics serves it.
-std::string MetricsText();
-
 // The HTTP endpoint serving /metrics. Stops serving when destroyed.
 class MetricsEndpoint {
  public:

@@ -94,18 +94,15 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
     if (record_) {
       // The call is over: its request and answer go to the recorder (the
       // response is gRPC's, deleted after this; it was sent already).
-      RecordedCall recorded;
-      recorded.method = "Detect";
-      recorded.request = std::move(request_);
+      std::vector<std::unique_ptr<const google::protobuf::Message>> sent;
       if (end_code_ == absl::StatusCode::kOk) {
         auto response = std::make_unique<v1::DetectResponse>();
         response->Swap(response_);
-        recorded.responses.push_back(std::move(response));
+        sent.push_back(std::move(response));
       }
-      recorded.code = absl::StatusCodeToString(end_code_);
-      recorded.seconds = SecondsSince(start_);
-      recorded.unix_micros = absl::ToUnixMicros(absl::Now());
-      config_.recorder->Submit(std::move(recorded));
+      config_.recorder->Submit(EndedCall("Detect", std::move(request_),
+                                         std::move(sent), end_code_,
+                                         SecondsSince(start_)));
     }
     TsanHappensBefore(&config_);  // before the service's destruction
     delete this;
@@ -279,17 +276,14 @@ class StreamReactor final
   void OnDone() override {
     TsanHappensAfter(this);
     if (record_) {
-      RecordedCall recorded;
-      recorded.method = std::string(method_);
-      recorded.request = std::move(request_);
+      std::vector<std::unique_ptr<const google::protobuf::Message>> sent;
       {
         std::lock_guard<std::mutex> lock(mutex_);
-        recorded.responses = std::move(recorded_);
+        sent = std::move(recorded_);
       }
-      recorded.code = absl::StatusCodeToString(end_code_);
-      recorded.seconds = SecondsSince(start_);
-      recorded.unix_micros = absl::ToUnixMicros(absl::Now());
-      config_.recorder->Submit(std::move(recorded));
+      config_.recorder->Submit(EndedCall(std::string(method_),
+                                         std::move(request_), std::move(sent),
+                                         end_code_, SecondsSince(start_)));
     }
     TsanHappensBefore(&config_);  // before the service's destruction
     delete this;

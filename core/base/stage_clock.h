@@ -8,6 +8,15 @@
 
 namespace fovea {
 
+// The clock of every duration Fovea measures (stages, calls, queue waits):
+// monotonic, unaffected by changes to the wall clock.
+using SteadyClock = std::chrono::steady_clock;
+
+// Seconds from `start` to now.
+inline double SecondsSince(SteadyClock::time_point start) {
+  return std::chrono::duration<double>(SteadyClock::now() - start).count();
+}
+
 // How long one stage of a request took, wall clock.
 struct StageTiming {
   std::string stage;  // "cloud", "normals", "saliency.sym3d", "inc.relations"
@@ -19,18 +28,17 @@ struct StageTiming {
 class StageClock {
  public:
   explicit StageClock(std::vector<StageTiming>& timings)
-      : timings_(timings), start_(Clock::now()) {}
+      : timings_(timings), start_(SteadyClock::now()) {}
   void Lap(std::string stage) {
-    const Clock::time_point now = Clock::now();
+    const SteadyClock::time_point now = SteadyClock::now();
     timings_.push_back({std::move(stage),
                         std::chrono::duration<double>(now - start_).count()});
     start_ = now;
   }
 
  private:
-  using Clock = std::chrono::steady_clock;
   std::vector<StageTiming>& timings_;
-  Clock::time_point start_;
+  SteadyClock::time_point start_;
 };
 
 }  // namespace fovea

@@ -9,20 +9,15 @@
 #include "absl/strings/str_cat.h"
 #include "core/base/guarded.h"
 #include "core/base/parallel.h"
+#include "core/base/stage_clock.h"
 #include "core/base/status_macros.h"
 #include "core/pipeline/sensor_adaptation.h"
 
 namespace fovea {
 namespace {
 
-using SteadyClock = std::chrono::steady_clock;
-
 // Focal length the attention sigma is given at, pixels.
 constexpr double kReferenceFocalPx = 525.0;
-
-double SecondsSince(SteadyClock::time_point start) {
-  return std::chrono::duration<double>(SteadyClock::now() - start).count();
-}
 
 absl::StatusOr<SegmentSummary> RunUnguarded(const RgbdFrame& frame,
                                             const IncrementalOptions& options,

@@ -15,19 +15,12 @@
 #include "absl/strings/str_join.h"
 #include "core/base/guarded.h"
 #include "core/base/parallel.h"
+#include "core/base/stage_clock.h"
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
 
 namespace fovea {
-namespace {
-
-using SteadyClock = std::chrono::steady_clock;
-
-double SecondsSince(SteadyClock::time_point start) {
-  return std::chrono::duration<double>(SteadyClock::now() - start).count();
-}
-
-}  // namespace
+namespace {}  // namespace
 
 namespace {
 

@@ -21,6 +21,7 @@
 #include "core/base/check.h"
 #include "core/synth/footprint.h"
 #include "core/synth/random.h"
+#include "core/synth/random_bodies.h"
 #include "core/synth/raycast.h"
 #include "core/synth/synth_scene.h"
 
@@ -33,20 +34,6 @@ using Eigen::Vector3f;
 constexpr float kPi = 3.14159265358979f;
 constexpr int kMaxObjects = 20;
 
-// Object sizes in metres: household objects 3-15 cm across.
-constexpr float kBoxHalfMin = 0.015f;
-constexpr float kBoxHalfMax = 0.07f;
-constexpr float kBoxHalfHeightMax = 0.06f;
-constexpr float kCylinderRadiusMin = 0.018f;
-constexpr float kCylinderRadiusMax = 0.045f;
-constexpr float kCylinderHalfHeightMin = 0.025f;
-constexpr float kCylinderHalfHeightMax = 0.075f;
-constexpr float kSphereRadiusMin = 0.025f;
-constexpr float kSphereRadiusMax = 0.055f;
-constexpr float kConeRadiusMin = 0.025f;
-constexpr float kConeRadiusMax = 0.055f;
-constexpr float kConeHalfHeightMin = 0.035f;
-constexpr float kConeHalfHeightMax = 0.07f;
 // Objects stacked on a box: at most this tall (half height, metres);
 // stacked cylinders at least this thick (radius, metres).
 constexpr float kStackedHalfHeightMax = 0.05f;
@@ -55,9 +42,6 @@ constexpr float kStackedYawMax = 0.35f;         // radians, relative to support
 constexpr float kStackedBoxProbability = 0.6f;  // else an upright cylinder
 constexpr float kMinSupportHalfSize = 0.025f;   // metres
 
-// Shape mix (box, cylinder, sphere, cone) and cylinder poses.
-constexpr float kShapeWeights[4] = {0.35f, 0.3f, 0.15f, 0.2f};
-constexpr float kLyingCylinderProbability = 0.3f;
 // Leaning boxes: tilt, radians.
 constexpr float kMinLean = 0.21f;  // 12 degrees
 constexpr float kMaxLean = 0.52f;  // 30 degrees
@@ -79,47 +63,6 @@ constexpr int kAttemptsPerObject = 40;
 // which is at most this wide.
 constexpr int kMinVisiblePixelsHalfRes = 40;
 constexpr int kVisibilityCastWidth = 320;
-
-// Object colours: HSV ranges; dark objects have value below kDarkValueMax.
-constexpr float kSaturationMin = 0.35f;
-constexpr float kSaturationMax = 0.9f;
-constexpr float kValueMin = 0.45f;
-constexpr float kValueMax = 0.95f;
-constexpr float kDarkValueMin = 0.03f;
-constexpr float kDarkValueMax = 0.09f;
-constexpr float kMinColorDistanceToTable = 0.25f;  // RGB, [0, 1] units
-// Non-dark objects stay well above NoiseOptions::dark_albedo (0.12), so that
-// only dark_object_probability makes objects lose depth.
-constexpr float kMinLuminance = 0.2f;
-
-// A shape with its size and colour, before it is posed.
-struct Body {
-  Shape shape = Shape::kBox;
-  Vector3f half_extents = Vector3f::Constant(0.05f);  // box; z for cyl/cone
-  float radius = 0.05f;
-  bool lying = false;         // cylinder on its side
-  float lean = 0.0f;          // box tilted about its local y axis, radians
-  float thickness = 0.005f;   // bowl and cup walls
-  float floor_height = 0.0f;  // a bowl's inner floor above its foot
-  Vector3f rgb = Vector3f::Constant(0.5f);
-
-  float Height() const {
-    switch (shape) {
-      case Shape::kBox:
-        return 2.0f * (half_extents.x() * std::sin(lean) +
-                       half_extents.z() * std::cos(lean));
-      case Shape::kCone:
-      case Shape::kBowl:
-      case Shape::kCup:
-        return 2.0f * half_extents.z();
-      case Shape::kCylinder:
-        return lying ? 2.0f * radius : 2.0f * half_extents.z();
-      case Shape::kSphere:
-        return 2.0f * radius;
-    }
-    return 0.0f;
-  }
-};
 
 struct Placed {
   Primitive primitive;
@@ -171,171 +114,6 @@ Placed Pose(const Body& body, const Vector2f& xy, float base_z, float yaw) {
   }
   out.on_table = base_z == 0.0f;
   return out;
-}
-
-Vector3f HsvToRgb(float h, float s, float v) {
-  const float c = v * s;
-  const float hp = h * 6.0f;
-  const float x = c * (1.0f - std::abs(std::fmod(hp, 2.0f) - 1.0f));
-  Vector3f rgb;
-  switch (static_cast<int>(hp) % 6) {
-    case 0:
-      rgb = {c, x, 0};
-      break;
-    case 1:
-      rgb = {x, c, 0};
-      break;
-    case 2:
-      rgb = {0, c, x};
-      break;
-    case 3:
-      rgb = {0, x, c};
-      break;
-    case 4:
-      rgb = {x, 0, c};
-      break;
-    default:
-      rgb = {c, 0, x};
-      break;
-  }
-  return rgb + Vector3f::Constant(v - c);
-}
-
-Vector3f RandomAlbedo(const Vector3f& table_rgb, float dark_probability,
-                      Random& rng) {
-  if (rng.Bernoulli(dark_probability)) {
-    return HsvToRgb(static_cast<float>(rng.Uniform()), rng.Uniform(0.0f, 0.5f),
-                    rng.Uniform(kDarkValueMin, kDarkValueMax));
-  }
-  Vector3f rgb;
-  do {
-    rgb = HsvToRgb(static_cast<float>(rng.Uniform()),
-                   rng.Uniform(kSaturationMin, kSaturationMax),
-                   rng.Uniform(kValueMin, kValueMax));
-  } while ((rgb - table_rgb).norm() < kMinColorDistanceToTable ||
-           rgb.dot(Vector3f(0.299f, 0.587f, 0.114f)) < kMinLuminance);
-  return rgb;
-}
-
-Shape RandomShape(Random& rng) {
-  float r = static_cast<float>(rng.Uniform());
-  for (int i = 0; i < 3; ++i) {
-    if (r < kShapeWeights[i]) return static_cast<Shape>(i);
-    r -= kShapeWeights[i];
-  }
-  return Shape::kCone;
-}
-
-// The household mix: what a kitchen or office table holds.
-enum class HouseholdKind {
-  kBox,
-  kBook,
-  kCylinder,
-  kBowl,
-  kCup,
-  kSphere,
-  kCone
-};
-constexpr float kHouseholdWeights[7] = {0.25f, 0.12f, 0.2f, 0.13f,
-                                        0.15f, 0.05f, 0.1f};
-
-// Household bodies, metres: books lie flat; bowls are 10-18 cm across and
-// 45-70 % as deep as their radius; cups 6-9 cm across, 8-12 cm tall.
-Body RandomHouseholdBody(const Vector3f& rgb, Random& rng) {
-  float r = static_cast<float>(rng.Uniform());
-  int kind = 0;
-  for (; kind < 6 && r >= kHouseholdWeights[kind]; ++kind) {
-    r -= kHouseholdWeights[kind];
-  }
-  Body body;
-  body.rgb = rgb;
-  switch (static_cast<HouseholdKind>(kind)) {
-    case HouseholdKind::kBook:
-      body.shape = Shape::kBox;
-      body.half_extents = {rng.Uniform(0.06f, 0.11f), rng.Uniform(0.04f, 0.08f),
-                           rng.Uniform(0.008f, 0.02f)};
-      return body;
-    case HouseholdKind::kBowl:
-      body.shape = Shape::kBowl;
-      // A cereal or salad bowl: 4-9 cm deep, its floor on a foot ring.
-      body.radius = rng.Uniform(0.05f, 0.09f);
-      body.half_extents = {body.radius, body.radius,
-                           body.radius * rng.Uniform(0.6f, 0.9f) / 2.0f};
-      body.thickness = rng.Uniform(0.004f, 0.008f);
-      body.floor_height = rng.Uniform(0.01f, 0.018f);
-      return body;
-    case HouseholdKind::kCup:
-      body.shape = Shape::kCup;
-      body.radius = rng.Uniform(0.03f, 0.045f);
-      body.half_extents = {body.radius, body.radius, rng.Uniform(0.04f, 0.06f)};
-      body.thickness = rng.Uniform(0.003f, 0.005f);
-      return body;
-    default:
-      break;
-  }
-  // Boxes, cylinders, spheres and cones as RandomBody draws them.
-  static constexpr Shape kRest[] = {Shape::kBox, Shape::kBox, Shape::kCylinder,
-                                    Shape::kBox, Shape::kBox, Shape::kSphere,
-                                    Shape::kCone};
-  body.shape = kRest[kind];
-  switch (body.shape) {
-    case Shape::kBox:
-      body.half_extents = {rng.Uniform(kBoxHalfMin, kBoxHalfMax),
-                           rng.Uniform(kBoxHalfMin, kBoxHalfMax),
-                           rng.Uniform(kBoxHalfMin, kBoxHalfHeightMax)};
-      break;
-    case Shape::kCylinder:
-      body.radius = rng.Uniform(kCylinderRadiusMin, kCylinderRadiusMax);
-      body.half_extents = {
-          body.radius, body.radius,
-          rng.Uniform(kCylinderHalfHeightMin, kCylinderHalfHeightMax)};
-      body.lying = rng.Bernoulli(kLyingCylinderProbability);
-      break;
-    case Shape::kSphere:
-      body.radius = rng.Uniform(kSphereRadiusMin, kSphereRadiusMax);
-      body.half_extents = Vector3f::Constant(body.radius);
-      break;
-    default:
-      body.shape = Shape::kCone;
-      body.radius = rng.Uniform(kConeRadiusMin, kConeRadiusMax);
-      body.half_extents = {body.radius, body.radius,
-                           rng.Uniform(kConeHalfHeightMin, kConeHalfHeightMax)};
-      break;
-  }
-  return body;
-}
-
-Body RandomBody(const Vector3f& rgb, Random& rng) {
-  Body body;
-  body.shape = RandomShape(rng);
-  body.rgb = rgb;
-  switch (body.shape) {
-    case Shape::kBox:
-      body.half_extents = {rng.Uniform(kBoxHalfMin, kBoxHalfMax),
-                           rng.Uniform(kBoxHalfMin, kBoxHalfMax),
-                           rng.Uniform(kBoxHalfMin, kBoxHalfHeightMax)};
-      break;
-    case Shape::kCylinder:
-      body.radius = rng.Uniform(kCylinderRadiusMin, kCylinderRadiusMax);
-      body.half_extents = {
-          body.radius, body.radius,
-          rng.Uniform(kCylinderHalfHeightMin, kCylinderHalfHeightMax)};
-      body.lying = rng.Bernoulli(kLyingCylinderProbability);
-      break;
-    case Shape::kSphere:
-      body.radius = rng.Uniform(kSphereRadiusMin, kSphereRadiusMax);
-      body.half_extents = Vector3f::Constant(body.radius);
-      break;
-    case Shape::kCone:
-      body.radius = rng.Uniform(kConeRadiusMin, kConeRadiusMax);
-      body.half_extents = {body.radius, body.radius,
-                           rng.Uniform(kConeHalfHeightMin, kConeHalfHeightMax)};
-      break;
-    case Shape::kBowl:
-    case Shape::kCup:
-      break;  // only in the household mix
-  }
-  return body;
 }
 
 // A proposed object, with the clearance it must keep from every other

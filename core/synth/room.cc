@@ -22,6 +22,7 @@
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/synth/random.h"
+#include "core/synth/random_bodies.h"
 
 namespace fovea::synth {
 namespace {
@@ -98,31 +99,9 @@ Vector3f MutedRgb(Random& rng, float lo, float hi) {
 
 // A saturated colour for things standing on other tables and the floor.
 Vector3f BrightRgb(Random& rng) {
-  const float h = rng.Uniform(0.0f, 1.0f) * 6.0f;
+  const float h = rng.Uniform(0.0f, 1.0f);
   const float s = rng.Uniform(0.4f, 0.9f), v = rng.Uniform(0.45f, 0.95f);
-  const float c = v * s, x = c * (1.0f - std::abs(std::fmod(h, 2.0f) - 1.0f));
-  Vector3f rgb;
-  switch (static_cast<int>(h) % 6) {
-    case 0:
-      rgb = {c, x, 0};
-      break;
-    case 1:
-      rgb = {x, c, 0};
-      break;
-    case 2:
-      rgb = {0, c, x};
-      break;
-    case 3:
-      rgb = {0, x, c};
-      break;
-    case 4:
-      rgb = {x, 0, c};
-      break;
-    default:
-      rgb = {c, 0, x};
-      break;
-  }
-  return rgb + Vector3f::Constant(v - c);
+  return HsvToRgb(h, s, v);
 }
 
 // A table's top (label `top_label`) and four legs standing on the floor at

@@ -17,6 +17,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "core/base/parallel.h"
+#include "core/base/stage_clock.h"
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/baseline/scene_segmenters.h"
@@ -32,11 +33,7 @@
 namespace fovea::bench {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
+using Clock = SteadyClock;
 
 // One request's stage times, seconds, in the order they ran, same-named
 // stages summed (every "segment.object" of a run is one figure).
