@@ -13,6 +13,7 @@
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "core/pipeline/models.h"
+#include "tools/eval/commands.h"
 #include "tools/eval/scorecard.h"
 
 ABSL_DECLARE_FLAG(std::string, data);
@@ -48,8 +49,6 @@ ABSL_FLAG(std::string, write_markdown, "",
 namespace fovea::eval {
 namespace {
 
-constexpr int kUsageError = 64;
-constexpr int kRunError = 1;
 constexpr int kFell = 3;
 
 std::string FromEnv(const std::string& flag, const char* name) {
