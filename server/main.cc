@@ -3,14 +3,17 @@
 #include <pthread.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
+#include "absl/flags/reflection.h"
 #include "absl/flags/usage.h"
 #include "absl/flags/usage_config.h"
 #include "absl/strings/match.h"
@@ -136,32 +139,17 @@ int main(int argc, char** argv) {
   using fovea::server::LogError;
   using fovea::server::LogInfo;
   // Before the command line, so that it wins.
+  // Every flag defined in this file, each settable from the environment:
+  // a new flag is its ABSL_FLAG alone.
+  std::vector<std::string> server_flags;
+  for (const auto& [name, flag] : absl::GetAllFlags()) {
+    if (usage.contains_help_flags(flag->Filename())) {
+      server_flags.emplace_back(name);
+    }
+  }
+  std::sort(server_flags.begin(), server_flags.end());
   const absl::Status from_env = fovea::server::ApplyFlagsFromEnv(
-      {"listen",
-       "metrics_listen",
-       "concurrency",
-       "threads_per_request",
-       "queue",
-       "max_message_bytes",
-       "max_width",
-       "max_height",
-       "grace_period_s",
-       "drain_delay_s",
-       "reflection",
-       "max_connection_age_s",
-       "max_connection_age_grace_s",
-       "stream_stall_timeout_s",
-       "memory_quota_mb",
-       "handshake_timeout_s",
-       "tls_cert",
-       "tls_key",
-       "tls_client_ca",
-       "models_dir",
-       "log_level",
-       "record_dir",
-       "record_max_mb",
-       "record_sample"},
-      [](const char* name) { return std::getenv(name); });
+      server_flags, [](const char* name) { return std::getenv(name); });
   if (!from_env.ok()) {
     LogError(from_env.ToString());
     return 2;

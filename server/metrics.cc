@@ -1,5 +1,6 @@
 #include "server/metrics.h"
 
+#include <google/protobuf/descriptor.h>
 #include <prometheus/counter.h>
 #include <prometheus/exposer.h>
 #include <prometheus/family.h>
@@ -10,6 +11,8 @@
 #include <array>
 #include <exception>
 #include <mutex>
+#include <string>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
@@ -19,16 +22,40 @@ namespace fovea::server {
 namespace {
 
 struct MethodInfo {
-  std::string_view name;
-  std::string_view type;  // go-grpc-prometheus' grpc_type
+  std::string name;
+  std::string type;  // go-grpc-prometheus' grpc_type
 };
 
-constexpr std::array<MethodInfo, 4> kMethods = {{
-    {"Detect", "unary"},
-    {"Segment", "server_stream"},
-    {"SegmentIncremental", "server_stream"},
-    {"GetCapabilities", "unary"},
-}};
+}  // namespace
+
+const google::protobuf::ServiceDescriptor& PerceptionDescriptor() {
+  static const google::protobuf::ServiceDescriptor* const service =
+      google::protobuf::DescriptorPool::generated_pool()->FindServiceByName(
+          std::string(kServiceName));
+  FOVEA_CHECK(service != nullptr);
+  return *service;
+}
+
+namespace {
+
+// The methods of kServiceName as its descriptor lists them, in its order:
+// the one list of methods the metrics know.
+const std::vector<MethodInfo>& Methods() {
+  static const auto* const methods = [] {
+    auto* out = new std::vector<MethodInfo>;
+    const google::protobuf::ServiceDescriptor& service = PerceptionDescriptor();
+    for (int i = 0; i < service.method_count(); ++i) {
+      const google::protobuf::MethodDescriptor* m = service.method(i);
+      const bool in = m->client_streaming(), out_stream = m->server_streaming();
+      out->push_back({m->name(), in && out_stream ? "bidi_stream"
+                                 : in             ? "client_stream"
+                                 : out_stream     ? "server_stream"
+                                                  : "unary"});
+    }
+    return out;
+  }();
+  return *methods;
+}
 
 // go-grpc-prometheus' handling-time buckets (Prometheus' DefBuckets).
 const prometheus::Histogram::BucketBoundaries& HandlingBuckets() {
@@ -68,8 +95,9 @@ class Metrics {
   }
 
   MethodSeries& Method(std::string_view method) {
-    for (size_t i = 0; i < kMethods.size(); ++i) {
-      if (kMethods[i].name == method) return methods_[i];
+    const std::vector<MethodInfo>& methods = Methods();
+    for (size_t i = 0; i < methods.size(); ++i) {
+      if (methods[i].name == method) return methods_[i];
     }
     std::fprintf(stderr, "metrics: unknown method '%.*s'\n",
                  static_cast<int>(method.size()), method.data());
@@ -219,22 +247,24 @@ class Metrics {
                                .Help("Always 1; the label is the server "
                                      "version.")
                                .Register(*registry_)) {
-    for (size_t i = 0; i < kMethods.size(); ++i) {
+    const std::vector<MethodInfo>& methods = Methods();
+    methods_.resize(methods.size());
+    for (size_t i = 0; i < methods.size(); ++i) {
       const prometheus::Labels labels = {
-          {"grpc_type", std::string(kMethods[i].type)},
+          {"grpc_type", methods[i].type},
           {"grpc_service", std::string(kServiceName)},
-          {"grpc_method", std::string(kMethods[i].name)}};
+          {"grpc_method", methods[i].name}};
       MethodSeries& series = methods_[i];
       series.started = &started_family_.Add(labels);
       series.received = &received_family_.Add(labels);
       series.sent = &sent_family_.Add(labels);
       series.handling = &handling_family_.Add(labels, HandlingBuckets());
-      if (kMethods[i].type == "server_stream") {
-        FirstObject(kMethods[i].name);
-        Objects(kMethods[i].name);
+      if (methods[i].type == "server_stream") {
+        FirstObject(methods[i].name);
+        Objects(methods[i].name);
         for (const char* reason : {"done", "max_objects", "time_budget",
                                    "deadline", "cancelled", "error"}) {
-          Stops(kMethods[i].name, reason);
+          Stops(methods[i].name, reason);
         }
       }
       for (const char* reason : {"abandoned_in_queue", "stalled_stream"}) {
@@ -267,7 +297,7 @@ class Metrics {
   prometheus::Family<prometheus::Counter>& recorder_family_;
   prometheus::Gauge& recorder_bytes_;
   prometheus::Family<prometheus::Gauge>& build_info_family_;
-  std::array<MethodSeries, kMethods.size()> methods_;
+  std::vector<MethodSeries> methods_;  // per Methods() entry
 };
 
 size_t CodeIndex(absl::StatusCode code) {

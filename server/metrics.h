@@ -1,6 +1,8 @@
 #ifndef FOVEA_SERVER_METRICS_H_
 #define FOVEA_SERVER_METRICS_H_
 
+#include <google/protobuf/descriptor.h>
+
 #include <memory>
 #include <string>
 #include <string_view>
@@ -55,6 +57,10 @@ namespace fovea::server {
 
 // The gRPC service the gRPC series describe.
 inline constexpr std::string_view kServiceName = "fovea.v1.Perception";
+// kServiceName's descriptor (the generated pool's): its methods, in the
+// contract's order, are the one list the metrics and the service's
+// handlers (by index) take them from.
+const google::protobuf::ServiceDescriptor& PerceptionDescriptor();
 
 // Sets fovea_build_info{version} to 1. Call once at start-up; later calls
 // are ignored. Every other family and series exists at zero from the first

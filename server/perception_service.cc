@@ -19,6 +19,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
+#include "core/base/check.h"
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/base/tsan.h"
@@ -35,6 +36,15 @@
 
 namespace fovea::server {
 namespace {
+
+// `method`'s index in the service (the generated CallbackService registers
+// its handlers in the contract's order), from its descriptor.
+int MethodIndex(const std::string& method) {
+  const google::protobuf::MethodDescriptor* found =
+      PerceptionDescriptor().FindMethodByName(method);
+  FOVEA_CHECK(found != nullptr);
+  return found->index();
+}
 
 // One Detect call. Converts the options at once, then runs on a worker;
 // finishes exactly once and deletes itself in OnDone.
@@ -480,33 +490,38 @@ PerceptionService::PerceptionService(ServiceConfig config, WorkQueue* work)
   // request type is grpc::ByteBuffer, which gRPC never fails to
   // deserialise.
   MarkMethodCallback(
-      0,
+      MethodIndex("Detect"),
       new grpc::internal::CallbackUnaryHandler<grpc::ByteBuffer,
                                                v1::DetectResponse>(
           [this](grpc::CallbackServerContext* context,
                  const grpc::ByteBuffer* body, v1::DetectResponse* response) {
             return OnDetect(context, body, response);
           }));
-  MarkMethodCallback(1, new grpc::internal::CallbackServerStreamingHandler<
-                            grpc::ByteBuffer, v1::SegmentResponse>(
-                            [this](grpc::CallbackServerContext* context,
-                                   const grpc::ByteBuffer* body) {
-                              return OnSegment(context, body);
-                            }));
-  MarkMethodCallback(2, new grpc::internal::CallbackServerStreamingHandler<
-                            grpc::ByteBuffer, v1::SegmentResponse>(
-                            [this](grpc::CallbackServerContext* context,
-                                   const grpc::ByteBuffer* body) {
-                              return OnSegmentIncremental(context, body);
-                            }));
   MarkMethodCallback(
-      3, new grpc::internal::CallbackUnaryHandler<grpc::ByteBuffer,
-                                                  v1::GetCapabilitiesResponse>(
-             [this](grpc::CallbackServerContext* context,
-                    const grpc::ByteBuffer* body,
-                    v1::GetCapabilitiesResponse* response) {
-               return OnGetCapabilities(context, body, response);
-             }));
+      MethodIndex("Segment"),
+      new grpc::internal::CallbackServerStreamingHandler<grpc::ByteBuffer,
+                                                         v1::SegmentResponse>(
+          [this](grpc::CallbackServerContext* context,
+                 const grpc::ByteBuffer* body) {
+            return OnSegment(context, body);
+          }));
+  MarkMethodCallback(
+      MethodIndex("SegmentIncremental"),
+      new grpc::internal::CallbackServerStreamingHandler<grpc::ByteBuffer,
+                                                         v1::SegmentResponse>(
+          [this](grpc::CallbackServerContext* context,
+                 const grpc::ByteBuffer* body) {
+            return OnSegmentIncremental(context, body);
+          }));
+  MarkMethodCallback(
+      MethodIndex("GetCapabilities"),
+      new grpc::internal::CallbackUnaryHandler<grpc::ByteBuffer,
+                                               v1::GetCapabilitiesResponse>(
+          [this](grpc::CallbackServerContext* context,
+                 const grpc::ByteBuffer* body,
+                 v1::GetCapabilitiesResponse* response) {
+            return OnGetCapabilities(context, body, response);
+          }));
   // gRPC's threads call the methods below; what was built here (and the
   // work queue before it) happens before, through libgrpc (see
   // DetectReactor::OnDone).

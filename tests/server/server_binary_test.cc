@@ -135,6 +135,25 @@ TEST(ServerBinaryTest, FlagsComeFromTheEnvironmentAndTheCommandLineWins) {
     EXPECT_THAT(output, HasSubstr("FOVEA_CONCURRENCY"));
   }
   {
+    // Every flag of the server comes from the environment, the last one
+    // defined as well as the first (the list is the flags' own): a number
+    // that does not parse is refused naming its variable, an address
+    // that does not resolve is the one listened on.
+    for (const std::string variable :
+         {"FOVEA_HANDSHAKE_TIMEOUT_S", "FOVEA_RECORD_SAMPLE"}) {
+      const auto [output, status] =
+          RunToCompletion("--metrics_listen=", variable + "=not-a-number ");
+      EXPECT_TRUE(WIFEXITED(status)) << variable;
+      EXPECT_EQ(WEXITSTATUS(status), 2) << variable << ": " << output;
+      EXPECT_THAT(output, HasSubstr(variable));
+    }
+    const auto [output, status] =
+        RunToCompletion("--metrics_listen=", "FOVEA_LISTEN=no-such-host ");
+    EXPECT_TRUE(WIFEXITED(status));
+    EXPECT_NE(WEXITSTATUS(status), 0);
+    EXPECT_THAT(output, HasSubstr("cannot listen on 'no-such-host'"));
+  }
+  {
     // The command line overrides the environment: a good log level from
     // the environment, a bad one on the command line, and the bad one is
     // what start-up rejects.
