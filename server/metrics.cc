@@ -16,6 +16,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
+#include "fovea/v1/perception.pb.h"
 #include "server/status_util.h"
 
 namespace fovea::server {
@@ -29,9 +30,13 @@ struct MethodInfo {
 }  // namespace
 
 const google::protobuf::ServiceDescriptor& PerceptionDescriptor() {
+  // Through a message of perception.proto, so that every program linking
+  // the metrics links (and registers) the file that declares the service.
   static const google::protobuf::ServiceDescriptor* const service =
-      google::protobuf::DescriptorPool::generated_pool()->FindServiceByName(
-          std::string(kServiceName));
+      v1::GetCapabilitiesRequest::descriptor()
+          ->file()
+          ->pool()
+          ->FindServiceByName(std::string(kServiceName));
   FOVEA_CHECK(service != nullptr);
   return *service;
 }
