@@ -8,7 +8,7 @@
 #include "absl/status/statusor.h"
 #include "core/attention/attention_point.h"
 #include "core/frame/organized_cloud.h"
-#include "core/frame/table_scene.h"
+#include "core/scene/table_scene.h"
 
 namespace fovea {
 

@@ -22,7 +22,7 @@
 #include "core/base/check.h"
 #include "core/base/guarded.h"
 #include "core/base/status_macros.h"
-#include "core/frame/support_plane.h"
+#include "core/scene/support_plane.h"
 
 namespace fovea {
 namespace {

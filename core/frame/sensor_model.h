@@ -45,7 +45,7 @@ struct SensorModel {
   float sigma0_m = 0.0f;
   float sigma_per_z2 = 1.43e-3f;
   // Depth beyond which the sensor's data is not used by default, metres:
-  // the workspace's default maximum range (core/frame/workspace.h).
+  // the workspace's default maximum range (core/scene/workspace.h).
   float max_range_m = 3.0f;
   // Nearest usable depth, metres.
   float min_range_m = 0.2f;

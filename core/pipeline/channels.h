@@ -7,11 +7,11 @@
 
 #include "absl/status/statusor.h"
 #include "core/frame/organized_cloud.h"
-#include "core/frame/support_plane.h"
-#include "core/frame/table_scene.h"
 #include "core/pipeline/detect.h"
 #include "core/pipeline/saliency_registry.h"
 #include "core/pyramid/cloud_pyramid.h"
+#include "core/scene/support_plane.h"
+#include "core/scene/table_scene.h"
 
 namespace fovea {
 

@@ -21,10 +21,7 @@
 #include "core/frame/organized_cloud.h"
 #include "core/frame/rgbd_frame.h"
 #include "core/frame/sensor_model.h"
-#include "core/frame/support_plane.h"
 #include "core/frame/surface_edges.h"
-#include "core/frame/table_scene.h"
-#include "core/frame/workspace.h"
 #include "core/pyramid/cloud_pyramid.h"
 #include "core/pyramid/feature_pyramid.h"
 #include "core/pyramid/normalization.h"
@@ -37,6 +34,9 @@
 #include "core/saliency/sh.h"
 #include "core/saliency/sym3d.h"
 #include "core/saliency/top_down.h"
+#include "core/scene/support_plane.h"
+#include "core/scene/table_scene.h"
+#include "core/scene/workspace.h"
 
 namespace fovea {
 

@@ -7,7 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/guarded.h"
-#include "core/frame/hull_candidates.h"
+#include "core/scene/hull_candidates.h"
 
 namespace fovea {
 namespace {

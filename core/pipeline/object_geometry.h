@@ -8,7 +8,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/frame/organized_cloud.h"
-#include "core/frame/support_plane.h"
+#include "core/scene/support_plane.h"
 
 namespace fovea {
 

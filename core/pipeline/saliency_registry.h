@@ -8,9 +8,9 @@
 #include "absl/status/statusor.h"
 #include "absl/types/span.h"
 #include "core/frame/organized_cloud.h"
-#include "core/frame/support_plane.h"
-#include "core/frame/table_scene.h"
 #include "core/pipeline/detect.h"
+#include "core/scene/support_plane.h"
+#include "core/scene/table_scene.h"
 
 namespace fovea {
 

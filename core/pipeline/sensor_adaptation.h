@@ -2,8 +2,8 @@
 #define FOVEA_CORE_PIPELINE_SENSOR_ADAPTATION_H_
 
 #include "core/frame/sensor_model.h"
-#include "core/frame/support_plane.h"
-#include "core/frame/table_scene.h"
+#include "core/scene/support_plane.h"
+#include "core/scene/table_scene.h"
 #include "core/segmentation/surface_model.h"
 
 namespace fovea {

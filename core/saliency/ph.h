@@ -4,7 +4,7 @@
 #include <opencv2/core.hpp>
 
 #include "absl/status/statusor.h"
-#include "core/frame/table_scene.h"
+#include "core/scene/table_scene.h"
 
 namespace fovea {
 

@@ -5,8 +5,8 @@
 
 #include "absl/status/statusor.h"
 #include "core/frame/organized_cloud.h"
-#include "core/frame/support_plane.h"
-#include "core/frame/table_scene.h"
+#include "core/scene/support_plane.h"
+#include "core/scene/table_scene.h"
 
 namespace fovea {
 

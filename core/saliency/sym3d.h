@@ -5,7 +5,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/frame/organized_cloud.h"
-#include "core/frame/table_scene.h"
+#include "core/scene/table_scene.h"
 
 namespace fovea {
 

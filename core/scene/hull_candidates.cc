@@ -1,4 +1,4 @@
-#include "core/frame/hull_candidates.h"
+#include "core/scene/hull_candidates.h"
 
 #include <algorithm>
 #include <cmath>

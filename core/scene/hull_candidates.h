@@ -1,5 +1,5 @@
-#ifndef FOVEA_CORE_FRAME_HULL_CANDIDATES_H_
-#define FOVEA_CORE_FRAME_HULL_CANDIDATES_H_
+#ifndef FOVEA_CORE_SCENE_HULL_CANDIDATES_H_
+#define FOVEA_CORE_SCENE_HULL_CANDIDATES_H_
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
@@ -20,4 +20,4 @@ std::vector<cv::Point2f> HullCandidates(
 
 }  // namespace fovea
 
-#endif  // FOVEA_CORE_FRAME_HULL_CANDIDATES_H_
+#endif  // FOVEA_CORE_SCENE_HULL_CANDIDATES_H_

@@ -1,10 +1,10 @@
-#include "core/frame/hull_lookup.h"
+#include "core/scene/hull_lookup.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "core/frame/support_grid.h"
+#include "core/scene/support_grid.h"
 
 namespace fovea {
 

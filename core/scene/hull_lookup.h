@@ -1,11 +1,11 @@
-#ifndef FOVEA_CORE_FRAME_HULL_LOOKUP_H_
-#define FOVEA_CORE_FRAME_HULL_LOOKUP_H_
+#ifndef FOVEA_CORE_SCENE_HULL_LOOKUP_H_
+#define FOVEA_CORE_SCENE_HULL_LOOKUP_H_
 
 #include <Eigen/Core>
 #include <cstdint>
 #include <vector>
 
-#include "core/frame/support_plane.h"
+#include "core/scene/support_plane.h"
 
 namespace fovea {
 
@@ -45,4 +45,4 @@ class HullLookup {
 
 }  // namespace fovea
 
-#endif  // FOVEA_CORE_FRAME_HULL_LOOKUP_H_
+#endif  // FOVEA_CORE_SCENE_HULL_LOOKUP_H_

@@ -2,7 +2,7 @@
 // least-squares planes, plane coordinates and hulls, and a plane's
 // connected parts on the grid.
 
-#include "core/frame/support_grid.h"
+#include "core/scene/support_grid.h"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/frame/hull_candidates.h"
+#include "core/scene/hull_candidates.h"
 
 namespace fovea::support_internal {
 namespace {

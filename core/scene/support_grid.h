@@ -1,5 +1,5 @@
-#ifndef FOVEA_CORE_FRAME_SUPPORT_GRID_H_
-#define FOVEA_CORE_FRAME_SUPPORT_GRID_H_
+#ifndef FOVEA_CORE_SCENE_SUPPORT_GRID_H_
+#define FOVEA_CORE_SCENE_SUPPORT_GRID_H_
 
 // The pieces SearchSupport (support_plane.cc) is made of: a subsampled
 // grid of the cloud and its geometry (support_grid.cc), planes' connected
@@ -15,7 +15,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/frame/organized_cloud.h"
-#include "core/frame/support_plane.h"
+#include "core/scene/support_plane.h"
 
 namespace fovea::support_internal {
 
@@ -197,4 +197,4 @@ int LabelGridComponents(const Grid& grid, const std::vector<uint8_t>& mask,
 
 }  // namespace fovea::support_internal
 
-#endif  // FOVEA_CORE_FRAME_SUPPORT_GRID_H_
+#endif  // FOVEA_CORE_SCENE_SUPPORT_GRID_H_

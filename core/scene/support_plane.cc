@@ -2,7 +2,7 @@
 // connected parts as candidate surfaces, and the choice among them
 // (support_score.cc scores them, support_region.cc grows the chosen region).
 
-#include "core/frame/support_plane.h"
+#include "core/scene/support_plane.h"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -17,7 +17,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
-#include "core/frame/support_grid.h"
+#include "core/scene/support_grid.h"
 
 namespace fovea {
 namespace {

@@ -1,5 +1,5 @@
-#ifndef FOVEA_CORE_FRAME_SUPPORT_PLANE_H_
-#define FOVEA_CORE_FRAME_SUPPORT_PLANE_H_
+#ifndef FOVEA_CORE_SCENE_SUPPORT_PLANE_H_
+#define FOVEA_CORE_SCENE_SUPPORT_PLANE_H_
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -231,4 +231,4 @@ absl::StatusOr<SupportPlane> SupportPlaneFromInliers(
 
 }  // namespace fovea
 
-#endif  // FOVEA_CORE_FRAME_SUPPORT_PLANE_H_
+#endif  // FOVEA_CORE_SCENE_SUPPORT_PLANE_H_

@@ -14,7 +14,7 @@
 #include "absl/status/status.h"
 #include "core/base/lab.h"
 #include "core/base/parallel.h"
-#include "core/frame/support_grid.h"
+#include "core/scene/support_grid.h"
 
 namespace fovea::support_internal {
 namespace {

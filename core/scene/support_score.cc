@@ -8,7 +8,7 @@
 #include <optional>
 #include <vector>
 
-#include "core/frame/support_grid.h"
+#include "core/scene/support_grid.h"
 
 namespace fovea::support_internal {
 namespace {

@@ -1,4 +1,4 @@
-#include "core/frame/table_scene.h"
+#include "core/scene/table_scene.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/parallel.h"
-#include "core/frame/hull_lookup.h"
+#include "core/scene/hull_lookup.h"
 
 namespace fovea {
 

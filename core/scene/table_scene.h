@@ -1,5 +1,5 @@
-#ifndef FOVEA_CORE_FRAME_TABLE_SCENE_H_
-#define FOVEA_CORE_FRAME_TABLE_SCENE_H_
+#ifndef FOVEA_CORE_SCENE_TABLE_SCENE_H_
+#define FOVEA_CORE_SCENE_TABLE_SCENE_H_
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
@@ -7,7 +7,7 @@
 
 #include "absl/status/status.h"
 #include "core/frame/organized_cloud.h"
-#include "core/frame/support_plane.h"
+#include "core/scene/support_plane.h"
 
 namespace fovea {
 
@@ -79,4 +79,4 @@ TableScene PrepareTableScene(const OrganizedCloud& cloud,
 
 }  // namespace fovea
 
-#endif  // FOVEA_CORE_FRAME_TABLE_SCENE_H_
+#endif  // FOVEA_CORE_SCENE_TABLE_SCENE_H_

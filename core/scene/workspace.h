@@ -1,5 +1,5 @@
-#ifndef FOVEA_CORE_FRAME_WORKSPACE_H_
-#define FOVEA_CORE_FRAME_WORKSPACE_H_
+#ifndef FOVEA_CORE_SCENE_WORKSPACE_H_
+#define FOVEA_CORE_SCENE_WORKSPACE_H_
 
 #include <Eigen/Core>
 #include <optional>
@@ -48,4 +48,4 @@ int ApplyWorkspace(const Workspace& workspace, const SensorModel& sensor,
 
 }  // namespace fovea
 
-#endif  // FOVEA_CORE_FRAME_WORKSPACE_H_
+#endif  // FOVEA_CORE_SCENE_WORKSPACE_H_

@@ -11,7 +11,7 @@
 #include "core/base/interrupt.h"
 #include "core/base/stage_clock.h"
 #include "core/frame/organized_cloud.h"
-#include "core/frame/support_plane.h"
+#include "core/scene/support_plane.h"
 #include "core/segmentation/linear_svm.h"
 #include "core/segmentation/patch_features.h"
 #include "core/segmentation/planar_patches.h"

@@ -11,7 +11,7 @@
 #include "absl/status/statusor.h"
 #include "core/base/interrupt.h"
 #include "core/frame/organized_cloud.h"
-#include "core/frame/support_plane.h"
+#include "core/scene/support_plane.h"
 #include "core/segmentation/cos.h"
 #include "core/segmentation/rbf_svm.h"
 #include "core/segmentation/relations.h"

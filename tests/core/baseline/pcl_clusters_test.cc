@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "core/frame/support_plane.h"
+#include "core/scene/support_plane.h"
 #include "core/synth/synth_scene.h"
 
 namespace fovea {

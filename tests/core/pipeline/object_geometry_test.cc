@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "core/frame/organized_cloud.h"
-#include "core/frame/support_plane.h"
+#include "core/scene/support_plane.h"
 #include "core/synth/synth_scene.h"
 
 namespace fovea {

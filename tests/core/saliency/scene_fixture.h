@@ -4,8 +4,8 @@
 #include <gtest/gtest.h>
 
 #include "core/frame/organized_cloud.h"
-#include "core/frame/support_plane.h"
-#include "core/frame/table_scene.h"
+#include "core/scene/support_plane.h"
+#include "core/scene/table_scene.h"
 #include "tests/core/testing/scenes.h"
 
 namespace fovea::testing {

@@ -1,4 +1,4 @@
-#include "core/frame/hull_lookup.h"
+#include "core/scene/hull_lookup.h"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <random>
 #include <vector>
 
-#include "core/frame/support_plane.h"
+#include "core/scene/support_plane.h"
 
 namespace fovea {
 namespace {

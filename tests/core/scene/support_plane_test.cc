@@ -1,10 +1,10 @@
-#include "core/frame/support_plane.h"
+#include "core/scene/support_plane.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "core/frame/table_scene.h"
+#include "core/scene/table_scene.h"
 #include "tests/core/testing/scenes.h"
 
 namespace fovea {

@@ -9,7 +9,7 @@
 
 #include "core/frame/frame_transform.h"
 #include "core/frame/organized_cloud.h"
-#include "core/frame/support_plane.h"
+#include "core/scene/support_plane.h"
 #include "core/synth/synth_scene.h"
 
 namespace fovea {

@@ -1,4 +1,4 @@
-#include "core/frame/workspace.h"
+#include "core/scene/workspace.h"
 
 #include <gtest/gtest.h>
 
