@@ -1,10 +1,12 @@
 #include "core/frame/lzf.h"
 
-#include <algorithm>
-#include <cstring>
+#include <liblzf/lzf.h>
+
+#include <limits>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 
 namespace fovea {
 namespace {
@@ -16,39 +18,16 @@ constexpr size_t kLongReference = 7;
 // A back-reference copies its length field plus this many bytes.
 constexpr size_t kMinReferenceBytes = 2;
 
-// Copies this short are faster byte by byte than by a call to memcpy.
-constexpr size_t kShortCopy = 16;
-
-// Appends `length` bytes at `to` copied from `distance` bytes back, byte
-// by byte in effect: when the two overlap, the copied bytes repeat with
-// period `distance`. Copies in chunks that never overlap their source,
-// each a whole number of periods, so the chunks double in size.
-void CopyBackReference(uint8_t* to, size_t distance, size_t length) {
-  const uint8_t* from = to - distance;
-  if (length <= kShortCopy) {
-    for (size_t i = 0; i < length; ++i) to[i] = from[i];
-    return;
-  }
-  size_t copied = 0;  // a multiple of `distance` until the last chunk
-  while (copied < length) {
-    const size_t chunk = std::min(length - copied, distance + copied);
-    std::memcpy(to + copied, from, chunk);
-    copied += chunk;
-  }
-}
-
 absl::Status LzfError(size_t run, absl::string_view what) {
   return absl::InvalidArgumentError(
       absl::StrCat("LZF run at compressed byte ", run, ": ", what));
 }
 
-}  // namespace
-
-absl::StatusOr<std::vector<uint8_t>> LzfDecompress(absl::string_view compressed,
-                                                   size_t size) {
+// What is wrong with a stream liblzf refused: the same walk over its runs,
+// without copying, stopping at the first that cannot be (OK when none).
+absl::Status DiagnoseLzf(absl::string_view compressed, size_t size) {
   const auto* in = reinterpret_cast<const uint8_t*>(compressed.data());
   const size_t in_size = compressed.size();
-  std::vector<uint8_t> out(size);
   size_t ip = 0;  // next input byte
   size_t op = 0;  // next output byte
   while (ip < in_size) {
@@ -65,7 +44,6 @@ absl::StatusOr<std::vector<uint8_t>> LzfDecompress(absl::string_view compressed,
             run, absl::StrCat("literal of ", length, " bytes at output byte ",
                               op, " overruns the ", size, " expected"));
       }
-      std::memcpy(out.data() + op, in + ip, length);
       ip += length;
       op += length;
       continue;
@@ -88,7 +66,6 @@ absl::StatusOr<std::vector<uint8_t>> LzfDecompress(absl::string_view compressed,
                                         " bytes at output byte ", op,
                                         " overruns the ", size, " expected"));
     }
-    CopyBackReference(out.data() + op, distance, length);
     op += length;
   }
   if (op != size) {
@@ -96,7 +73,29 @@ absl::StatusOr<std::vector<uint8_t>> LzfDecompress(absl::string_view compressed,
         absl::StrCat("LZF stream of ", in_size, " bytes expands to ", op,
                      " bytes, ", size, " expected"));
   }
-  return out;
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::StatusOr<std::vector<uint8_t>> LzfDecompress(absl::string_view compressed,
+                                                   size_t size) {
+  constexpr size_t kMaxBytes = std::numeric_limits<unsigned int>::max();
+  if (compressed.size() > kMaxBytes || size > kMaxBytes) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("LZF stream of ", compressed.size(), " bytes to ", size,
+                     " bytes: liblzf takes at most ", kMaxBytes));
+  }
+  std::vector<uint8_t> out(size);
+  // Debian's liblzf checks every read and write (CHECK_INPUT) and returns 0
+  // for a stream it refuses; then the walk says why.
+  const unsigned int written = lzf_decompress(
+      compressed.data(), static_cast<unsigned int>(compressed.size()),
+      out.data(), static_cast<unsigned int>(size));
+  if (written == size && (size > 0 || compressed.empty())) return out;
+  FOVEA_RETURN_IF_ERROR(DiagnoseLzf(compressed, size));
+  return absl::InvalidArgumentError(absl::StrCat(
+      "LZF stream of ", compressed.size(), " bytes refused by liblzf"));
 }
 
 }  // namespace fovea

@@ -12,7 +12,8 @@ namespace fovea {
 
 // Decompresses an LZF stream (the format of Marc Lehmann's liblzf, which PCL
 // uses for `DATA binary_compressed` PCD bodies) that must expand to exactly
-// `size` bytes.
+// `size` bytes. Debian's liblzf decodes it; a stream it refuses is walked
+// run by run to say why (below).
 //
 // The stream is a sequence of runs, each starting with a control byte c:
 //   c < 32   a literal run: the next c + 1 bytes are copied to the output.
@@ -22,8 +23,9 @@ namespace fovea {
 //            and l + 2 bytes are copied from there one at a time (so they
 //            may overlap the bytes being written: d = 1 repeats a byte).
 //
-// Every read and write is bounds-checked. The output of `size` bytes is
-// allocated up front: the caller bounds `size` (LzfMaxExpansion). Errors
+// Every read and write is bounds-checked (liblzf's CHECK_INPUT). The output
+// of `size` bytes is allocated up front: the caller bounds `size`
+// (LzfMaxExpansion). Errors
 // are INVALID_ARGUMENT and name the byte offset of the offending run in
 // `compressed`: a run that reads past the end of the input, a
 // back-reference before the start of the output, output beyond `size`
