@@ -11,8 +11,8 @@
 #include "core/frame/frame_decode.h"
 #include "core/frame/organized_cloud.h"
 #include "core/frame/rgbd_frame.h"
-#include "core/frame/support_plane.h"
-#include "core/frame/table_scene.h"
+#include "core/scene/support_plane.h"
+#include "core/scene/table_scene.h"
 #include "core/segmentation/ebs.h"
 #include "core/synth/room.h"
 

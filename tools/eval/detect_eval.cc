@@ -11,8 +11,8 @@
 #include "core/base/status_macros.h"
 #include "core/frame/organized_cloud.h"
 #include "core/frame/osd_pcd.h"
-#include "core/frame/support_plane.h"
-#include "core/frame/table_scene.h"
+#include "core/scene/support_plane.h"
+#include "core/scene/table_scene.h"
 #include "tools/eval/scene_kind.h"
 #include "tools/eval/stats.h"
 

@@ -9,9 +9,9 @@
 #include "absl/status/statusor.h"
 #include "core/eval/segmentation_metrics.h"
 #include "core/frame/osd_pcd.h"
-#include "core/frame/support_plane.h"
 #include "core/pipeline/detect.h"
 #include "core/pipeline/segment.h"
+#include "core/scene/support_plane.h"
 
 namespace fovea::eval {
 
