@@ -92,9 +92,7 @@ int RunRandomPointsEval(const DetectOptions& detect,
 
 }  // namespace
 
-// The scenes of --data (an OSD-format folder; its kinds.txt, if any, names
-// the kinds) or of --piles (synthetic piles from --seed); nullopt after a
-// message.
+// commands.h
 std::optional<std::vector<LabelledFrame>> ScenesFromFlags() {
   const int piles = absl::GetFlag(FLAGS_piles);
   if (piles > 0) {
