@@ -42,22 +42,17 @@ absl::StatusOr<std::string> EncodeSaliencyPng(const cv::Mat& map) {
         absl::StrCat("saliency map is not a non-empty CV_32FC1 image (type ",
                      map.type(), ", ", map.cols, "x", map.rows, ")"));
   }
-  try {
-    cv::Mat finite = map.clone();
-    cv::patchNaNs(finite, 0.0);
-    cv::Mat pixels;
-    // convertTo rounds and saturates to [0, 65535].
-    finite.convertTo(pixels, CV_16UC1, kPngFullScale);
-    absl::StatusOr<std::string> png = EncodePng(pixels);
-    if (!png.ok()) {
-      return absl::InternalError(absl::StrCat(
-          "saliency map: PNG encoding failed: ", png.status().message()));
-    }
-    return png;
-  } catch (const std::exception& e) {
-    return absl::InternalError(
-        absl::StrCat("saliency map: PNG encoding failed: ", e.what()));
+  cv::Mat finite = map.clone();
+  cv::patchNaNs(finite, 0.0);
+  cv::Mat pixels;
+  // convertTo rounds and saturates to [0, 65535].
+  finite.convertTo(pixels, CV_16UC1, kPngFullScale);
+  absl::StatusOr<std::string> png = EncodePng(pixels);
+  if (!png.ok()) {
+    return absl::InternalError(absl::StrCat(
+        "saliency map: PNG encoding failed: ", png.status().message()));
   }
+  return png;
 }
 
 v1::SupportPlane ToProtoSupportPlane(const SupportPlane& plane) {

@@ -5,10 +5,8 @@
 #include <chrono>
 #include <condition_variable>
 #include <deque>
-#include <exception>
 #include <memory>
 #include <mutex>
-#include <new>
 #include <optional>
 #include <string>
 #include <utility>
@@ -20,6 +18,7 @@
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
 #include "core/base/check.h"
+#include "core/base/guarded.h"
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/base/tsan.h"
@@ -120,24 +119,12 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
 
  private:
   // On a worker thread. Completes the call exactly once, whatever
-  // happens: an exception from anywhere in the job (core catches its own,
-  // but decoding, conversion and the test hooks run outside it) becomes
+  // happens: the call's one exception boundary turns what anything in the
+  // job throws (decoding, core, conversion, the test hooks) into
   // RESOURCE_EXHAUSTED (out of memory) or INTERNAL instead of leaving the
   // call unfinished or reaching the WorkQueue.
   void Run() {
-    absl::Status status;
-    try {
-      status = Compute();
-    } catch (const std::bad_alloc&) {
-      status = absl::ResourceExhaustedError("Detect: out of memory");
-    } catch (const std::exception& e) {
-      status = absl::InternalError(
-          absl::StrCat("Detect: unexpected exception: ", e.what()));
-    } catch (...) {
-      status = absl::InternalError(
-          "Detect: unexpected exception of a non-standard type");
-    }
-    Complete(status);
+    Complete(Guarded("Detect", [this] { return Compute(); }));
   }
 
   // The job's work; fills *response_ when OK. May throw.
@@ -308,21 +295,11 @@ class StreamReactor final
 
   // On a worker thread.
   void Run() {
-    absl::Status status;
-    try {
-      status = Compute();
+    FinishOnce(Guarded(method_, [this] {
+      absl::Status status = Compute();
       if (status.ok()) WaitForTheLastWrites();
-    } catch (const std::bad_alloc&) {
-      status = absl::ResourceExhaustedError(
-          absl::StrCat(AbslView(method_), ": out of memory"));
-    } catch (const std::exception& e) {
-      status = absl::InternalError(absl::StrCat(
-          AbslView(method_), ": unexpected exception: ", e.what()));
-    } catch (...) {
-      status = absl::InternalError(absl::StrCat(
-          AbslView(method_), ": unexpected exception of a non-standard type"));
-    }
-    FinishOnce(status);
+      return status;
+    }));
   }
 
   absl::Status Compute() {

@@ -12,16 +12,23 @@
 
 namespace fovea {
 
-// The exception boundary of core/: nothing throws out of a core function,
-// but OpenCV, PCL, qhull's wrapper and the standard library can throw
-// inside one. Guarded runs `body` (returning absl::Status or
-// absl::StatusOr<T>) and turns what it throws into a status naming `what`:
+// The one exception boundary of a call. Core functions return a status for
+// every error they can name and catch nothing: what OpenCV, PCL, libsvm or
+// the standard library throw underneath them (out of memory, a library's
+// bug) passes through to the place where a call becomes a status, which
+// calls Guarded once: the server's job for each RPC
+// (server/perception_service.cc). The tools and the fuzz targets have no
+// boundary: there an exception ends the process with its what() printed,
+// which is what a bug should do. Guarded runs `body`
+// (returning absl::Status or absl::StatusOr<T>) and turns what it throws
+// into a status naming `what`:
 //   std::bad_alloc          RESOURCE_EXHAUSTED "<what>: out of memory"
-//   std::exception (and     INTERNAL "<what>: <e.what()>"
+//   std::exception (and     INTERNAL "<what>: unexpected exception: <what()>"
 //   cv::Exception)
-// Anything else propagates (core throws nothing of another type).
+//   anything else           INTERNAL "<what>: unexpected exception of a
+//                           non-standard type"
 //
-//   return Guarded("segment", [&] { return RunSegmentUnguarded(...); });
+//   status = Guarded("Detect", [&] { return Compute(); });
 template <typename Body>
 std::invoke_result_t<Body&> Guarded(std::string_view what, Body&& body) {
   try {
@@ -30,7 +37,11 @@ std::invoke_result_t<Body&> Guarded(std::string_view what, Body&& body) {
     return absl::ResourceExhaustedError(
         absl::StrCat(AbslView(what), ": out of memory"));
   } catch (const std::exception& e) {
-    return absl::InternalError(absl::StrCat(AbslView(what), ": ", e.what()));
+    return absl::InternalError(
+        absl::StrCat(AbslView(what), ": unexpected exception: ", e.what()));
+  } catch (...) {
+    return absl::InternalError(absl::StrCat(
+        AbslView(what), ": unexpected exception of a non-standard type"));
   }
 }
 

@@ -15,7 +15,6 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
-#include "core/base/guarded.h"
 #include "core/base/status_macros.h"
 
 namespace fovea {
@@ -192,9 +191,7 @@ absl::StatusOr<PixelClusters> ClusterPixels(const OrganizedCloud& cloud,
     return absl::InvalidArgumentError(
         "pcl_clusters: the mask must be CV_8UC1 of the cloud's size");
   }
-  return Guarded("pcl_clusters", [&]() -> absl::StatusOr<PixelClusters> {
-    return Cluster(cloud, mask, options);
-  });
+  return Cluster(cloud, mask, options);
 }
 
 absl::StatusOr<std::vector<AttentionPoint>> DetectPclClusters(

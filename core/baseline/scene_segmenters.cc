@@ -20,7 +20,6 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
-#include "core/base/guarded.h"
 #include "core/base/status_macros.h"
 #include "core/scene/support_plane.h"
 
@@ -394,17 +393,15 @@ absl::StatusOr<SceneSegmentation> SegmentSceneEuclidean(
   if (cloud.xyz.empty()) return SceneSegmentation{};
   FOVEA_RETURN_IF_ERROR(CheckCloud(cloud));
   if (!HasAnyPoint(cloud)) return NoSegments(cloud);
-  return Guarded("pcl-euclidean", [&]() -> absl::StatusOr<SceneSegmentation> {
-    FOVEA_ASSIGN_OR_RETURN(TableScene table,
-                           StandingOnSupport(cloud, options.support));
-    FOVEA_ASSIGN_OR_RETURN(
-        PixelClusters clusters,
-        ClusterPixels(cloud, table.candidate, options.clusters));
-    SceneSegmentation result;
-    result.labels = std::move(clusters.labels);
-    result.segments = static_cast<int>(clusters.voxels.size());
-    return result;
-  });
+  FOVEA_ASSIGN_OR_RETURN(TableScene table,
+                         StandingOnSupport(cloud, options.support));
+  FOVEA_ASSIGN_OR_RETURN(
+      PixelClusters clusters,
+      ClusterPixels(cloud, table.candidate, options.clusters));
+  SceneSegmentation result;
+  result.labels = std::move(clusters.labels);
+  result.segments = static_cast<int>(clusters.voxels.size());
+  return result;
 }
 
 absl::StatusOr<SceneSegmentation> SegmentSceneLccp(
@@ -413,11 +410,9 @@ absl::StatusOr<SceneSegmentation> SegmentSceneLccp(
   if (cloud.xyz.empty()) return SceneSegmentation{};
   FOVEA_RETURN_IF_ERROR(CheckCloud(cloud));
   if (!HasAnyPoint(cloud)) return NoSegments(cloud);
-  return Guarded("pcl-lccp", [&]() -> absl::StatusOr<SceneSegmentation> {
-    FOVEA_ASSIGN_OR_RETURN(TableScene table,
-                           StandingOnSupport(cloud, options.support));
-    return Lccp(cloud, table, options);
-  });
+  FOVEA_ASSIGN_OR_RETURN(TableScene table,
+                         StandingOnSupport(cloud, options.support));
+  return Lccp(cloud, table, options);
 }
 
 }  // namespace fovea

@@ -19,7 +19,6 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
 #include "core/base/check.h"
-#include "core/base/guarded.h"
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/frame/image_codec.h"
@@ -399,9 +398,57 @@ bool HasValidDepth(const cv::Mat& depth) {
   return false;
 }
 
-absl::StatusOr<RgbdFrame> DecodeValidatedFrame(
-    const RawFrame& raw, const FrameLimits& limits,
-    const InterruptCheck& interrupt) {
+}  // namespace
+
+absl::Status Validate(const FrameLimits& limits) {
+  if (limits.max_width == 0 || limits.max_width > kLargestLimit) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("limits.max_width: ", limits.max_width, " is not in [1, ",
+                     kLargestLimit, "]"));
+  }
+  if (limits.max_height == 0 || limits.max_height > kLargestLimit) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("limits.max_height: ", limits.max_height,
+                     " is not in [1, ", kLargestLimit, "]"));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status ValidateIntrinsics(const Intrinsics& intrinsics,
+                                std::string_view field_name) {
+  const absl::string_view field = AbslView(field_name);
+  const struct {
+    absl::string_view name;
+    double value;
+    bool positive;
+  } kParameters[] = {{"fx", intrinsics.fx, true},
+                     {"fy", intrinsics.fy, true},
+                     {"cx", intrinsics.cx, false},
+                     {"cy", intrinsics.cy, false}};
+  for (const auto& parameter : kParameters) {
+    if (!std::isfinite(parameter.value)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          field, ".", parameter.name, ": ", parameter.value, " is not finite"));
+    }
+    if (parameter.positive && parameter.value <= 0.0) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, ".", parameter.name, ": ", parameter.value,
+                       " must be > 0 (a focal length in pixels)"));
+    }
+    if (parameter.positive && (parameter.value < kMinFocalPixels ||
+                               parameter.value > kMaxFocalPixels)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, ".", parameter.name, ": ", parameter.value,
+                       " is not a plausible focal length; expected [",
+                       kMinFocalPixels, ", ", kMaxFocalPixels, "] pixels"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<RgbdFrame> DecodeFrame(const RawFrame& raw,
+                                      const FrameLimits& limits,
+                                      const InterruptCheck& interrupt) {
   absl::Status status = Validate(limits);
   if (!status.ok()) return status;
   status = ValidateIntrinsics(raw.intrinsics, "frame.intrinsics");
@@ -465,65 +512,6 @@ absl::StatusOr<RgbdFrame> DecodeValidatedFrame(
                                                     "frame.color", interrupt));
   frame.color = std::move(color);
   return frame;
-}
-
-}  // namespace
-
-absl::Status Validate(const FrameLimits& limits) {
-  if (limits.max_width == 0 || limits.max_width > kLargestLimit) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("limits.max_width: ", limits.max_width, " is not in [1, ",
-                     kLargestLimit, "]"));
-  }
-  if (limits.max_height == 0 || limits.max_height > kLargestLimit) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("limits.max_height: ", limits.max_height,
-                     " is not in [1, ", kLargestLimit, "]"));
-  }
-  return absl::OkStatus();
-}
-
-absl::Status ValidateIntrinsics(const Intrinsics& intrinsics,
-                                std::string_view field_name) {
-  const absl::string_view field = AbslView(field_name);
-  const struct {
-    absl::string_view name;
-    double value;
-    bool positive;
-  } kParameters[] = {{"fx", intrinsics.fx, true},
-                     {"fy", intrinsics.fy, true},
-                     {"cx", intrinsics.cx, false},
-                     {"cy", intrinsics.cy, false}};
-  for (const auto& parameter : kParameters) {
-    if (!std::isfinite(parameter.value)) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          field, ".", parameter.name, ": ", parameter.value, " is not finite"));
-    }
-    if (parameter.positive && parameter.value <= 0.0) {
-      return absl::InvalidArgumentError(
-          absl::StrCat(field, ".", parameter.name, ": ", parameter.value,
-                       " must be > 0 (a focal length in pixels)"));
-    }
-    if (parameter.positive && (parameter.value < kMinFocalPixels ||
-                               parameter.value > kMaxFocalPixels)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat(field, ".", parameter.name, ": ", parameter.value,
-                       " is not a plausible focal length; expected [",
-                       kMinFocalPixels, ", ", kMaxFocalPixels, "] pixels"));
-    }
-  }
-  return absl::OkStatus();
-}
-
-absl::StatusOr<RgbdFrame> DecodeFrame(const RawFrame& raw,
-                                      const FrameLimits& limits,
-                                      const InterruptCheck& interrupt) {
-  // Sizes are bounded by `limits` before anything is allocated, so an
-  // exception here is an allocation failure or an OpenCV bug; neither may
-  // leave core/.
-  return Guarded("DecodeFrame", [&]() -> absl::StatusOr<RgbdFrame> {
-    return DecodeValidatedFrame(raw, limits, interrupt);
-  });
 }
 
 }  // namespace fovea

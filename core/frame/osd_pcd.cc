@@ -20,7 +20,6 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
 #include "core/base/check.h"
-#include "core/base/guarded.h"
 #include "core/base/status_macros.h"
 #include "core/frame/frame_decode.h"
 #include "core/frame/pcd_reader.h"
@@ -227,7 +226,7 @@ void ProjectUnorganized(const PcdCloud& cloud, const CloudFields& fields,
                         LabelledFrame& out) {
   AllocateFrame(width, height, out);
   const bool has_color = fields.color.has_value();
-  // ReadCloud and LoadOsdPcdUnguarded: unorganized means height 1.
+  // ReadCloud and LoadOsdPcd: unorganized means height 1.
   FOVEA_CHECK(cloud.height == 1);
   for (size_t i = 0; i < cloud.width; ++i) {
     const Point point =
@@ -288,9 +287,11 @@ bool NaturalLess(const std::string& a, const std::string& b) {
   return a < b;
 }
 
-absl::StatusOr<LabelledFrame> LoadOsdPcdUnguarded(const std::string& path,
-                                                  const Intrinsics& intrinsics,
-                                                  int width, int height) {
+}  // namespace
+
+absl::StatusOr<LabelledFrame> LoadOsdPcd(const std::string& path,
+                                         const Intrinsics& intrinsics,
+                                         int width, int height) {
   absl::Status status = ValidateIntrinsics(intrinsics, "intrinsics");
   if (!status.ok()) return status;
   FOVEA_ASSIGN_OR_RETURN(PcdCloud cloud, ReadCloud(path));
@@ -311,16 +312,6 @@ absl::StatusOr<LabelledFrame> LoadOsdPcdUnguarded(const std::string& path,
   }
   ProjectUnorganized(cloud, fields, intrinsics, width, height, out);
   return out;
-}
-
-}  // namespace
-
-absl::StatusOr<LabelledFrame> LoadOsdPcd(const std::string& path,
-                                         const Intrinsics& intrinsics,
-                                         int width, int height) {
-  return Guarded(path, [&] {
-    return LoadOsdPcdUnguarded(path, intrinsics, width, height);
-  });
 }
 
 absl::StatusOr<std::vector<std::string>> ListPcdFiles(const std::string& dir) {

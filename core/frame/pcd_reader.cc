@@ -28,7 +28,6 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/string_view.h"
-#include "core/base/guarded.h"
 #include "core/base/status_macros.h"
 #include "core/frame/lzf.h"
 
@@ -455,7 +454,9 @@ absl::StatusOr<std::vector<uint8_t>> DecodeCompressed(
   return data;
 }
 
-absl::StatusOr<PcdCloud> ReadPcdUnguarded(const std::string& path) {
+}  // namespace
+
+absl::StatusOr<PcdCloud> ReadPcd(const std::string& path) {
   std::error_code error;
   const std::filesystem::file_status status =
       std::filesystem::status(path, error);
@@ -557,8 +558,6 @@ absl::StatusOr<PcdCloud> ReadPcdUnguarded(const std::string& path) {
   return cloud;
 }
 
-}  // namespace
-
 size_t PcdTypeSize(PcdType type) {
   switch (type) {
     case PcdType::kInt8:
@@ -584,10 +583,6 @@ const PcdField* FindPcdField(const PcdCloud& cloud, absl::string_view name) {
     if (field.name == name) return &field;
   }
   return nullptr;
-}
-
-absl::StatusOr<PcdCloud> ReadPcd(const std::string& path) {
-  return Guarded(path, [&] { return ReadPcdUnguarded(path); });
 }
 
 }  // namespace fovea

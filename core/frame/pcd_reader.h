@@ -82,8 +82,9 @@ const PcdField* FindPcdField(const PcdCloud& cloud, absl::string_view name);
 // more than 1 GiB of point data; a body too short for the POINTS the
 // header claims (checked before anything is allocated); an unparsable or
 // out-of-range ASCII value, or a line with the wrong number of values;
-// corrupt LZF data. NOT_FOUND for a missing file. Never throws; out of
-// memory is RESOURCE_EXHAUSTED. Assumes a little-endian machine.
+// corrupt LZF data. NOT_FOUND for a missing file. Running out of memory
+// throws std::bad_alloc (see core/base/guarded.h). Assumes a little-endian
+// machine.
 absl::StatusOr<PcdCloud> ReadPcd(const std::string& path);
 
 }  // namespace fovea

@@ -11,7 +11,6 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "core/base/guarded.h"
 #include "core/frame/image_codec.h"
 #include "core/frame/image_codec_internal.h"
 
@@ -146,19 +145,17 @@ absl::StatusOr<std::string> EncodePng(const cv::Mat& image,
 
   PngWriteState state;
   PngWriteGuard guard{&state};
-  return Guarded("EncodePng", [&]() -> absl::StatusOr<std::string> {
-    // libpng copies each row before transforming it, so the const image is
-    // only read.
-    std::vector<png_bytep> rows(image.rows);
-    for (int v = 0; v < image.rows; ++v) {
-      rows[v] = const_cast<png_bytep>(image.ptr<unsigned char>(v));
-    }
-    if (!PngWriteAll(&state, layout, rows.data())) {
-      return absl::InternalError(
-          absl::StrCat("EncodePng: libpng: ", state.error.message));
-    }
-    return std::string(reinterpret_cast<const char*>(state.bytes), state.size);
-  });
+  // libpng copies each row before transforming it, so the const image is
+  // only read.
+  std::vector<png_bytep> rows(image.rows);
+  for (int v = 0; v < image.rows; ++v) {
+    rows[v] = const_cast<png_bytep>(image.ptr<unsigned char>(v));
+  }
+  if (!PngWriteAll(&state, layout, rows.data())) {
+    return absl::InternalError(
+        absl::StrCat("EncodePng: libpng: ", state.error.message));
+  }
+  return std::string(reinterpret_cast<const char*>(state.bytes), state.size);
 }
 
 }  // namespace fovea

@@ -7,7 +7,6 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "core/base/guarded.h"
 #include "core/base/parallel.h"
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
@@ -124,16 +123,6 @@ absl::Status Validate(const DetectOptions& options) {
   return Validate(options.msr);
 }
 
-namespace {
-absl::StatusOr<PreparedScene> PrepareSceneUnguarded(
-    const RgbdFrame& frame, const DetectOptions& options,
-    const InterruptCheck& interrupt);
-absl::StatusOr<DetectResult> DetectOnSceneUnguarded(
-    const PreparedScene& scene, const DetectOptions& options,
-    const InterruptCheck& interrupt);
-
-}  // namespace
-
 absl::StatusOr<std::vector<AttentionPoint>> ExtractAttentionPoints(
     const cv::Mat& master, const DetectOptions& options) {
   for (const Extraction& row : Extractions()) {
@@ -156,22 +145,6 @@ std::vector<std::string> DetectStageNames() {
     }
   }
   return names;
-}
-
-absl::StatusOr<PreparedScene> PrepareScene(const RgbdFrame& frame,
-                                           const DetectOptions& options,
-                                           const InterruptCheck& interrupt) {
-  return Guarded("detect", [&] {
-    return PrepareSceneUnguarded(frame, options, interrupt);
-  });
-}
-
-absl::StatusOr<DetectResult> DetectOnScene(const PreparedScene& scene,
-                                           const DetectOptions& options,
-                                           const InterruptCheck& interrupt) {
-  return Guarded("detect", [&] {
-    return DetectOnSceneUnguarded(scene, options, interrupt);
-  });
 }
 
 absl::StatusOr<DetectResult> RunDetect(const RgbdFrame& frame,
@@ -203,12 +176,9 @@ absl::StatusOr<DetectResult> RunDetect(const RgbdFrame& frame,
   return result;
 }
 
-namespace {
-
-// PrepareScene without the exception guard.
-absl::StatusOr<PreparedScene> PrepareSceneUnguarded(
-    const RgbdFrame& frame, const DetectOptions& options,
-    const InterruptCheck& interrupt) {
+absl::StatusOr<PreparedScene> PrepareScene(const RgbdFrame& frame,
+                                           const DetectOptions& options,
+                                           const InterruptCheck& interrupt) {
   FOVEA_RETURN_IF_ERROR(Validate(options));
   PreparedScene scene;
   StageClock clock(scene.timings);
@@ -277,10 +247,9 @@ absl::StatusOr<PreparedScene> PrepareSceneUnguarded(
   return scene;
 }
 
-// DetectOnScene without the exception guard.
-absl::StatusOr<DetectResult> DetectOnSceneUnguarded(
-    const PreparedScene& scene, const DetectOptions& options,
-    const InterruptCheck& interrupt) {
+absl::StatusOr<DetectResult> DetectOnScene(const PreparedScene& scene,
+                                           const DetectOptions& options,
+                                           const InterruptCheck& interrupt) {
   FOVEA_RETURN_IF_ERROR(Validate(options));
   const auto start = std::chrono::steady_clock::now();
   DetectResult result;
@@ -337,7 +306,5 @@ absl::StatusOr<DetectResult> DetectOnSceneUnguarded(
           .count();
   return result;
 }
-
-}  // namespace
 
 }  // namespace fovea

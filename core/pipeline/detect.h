@@ -261,9 +261,9 @@ std::vector<std::string> DetectStageNames();
 // organized cloud and normals,
 // support plane, table scene, each channel's map, fusion, extraction.
 // Errors: INVALID_ARGUMENT / UNIMPLEMENTED from Validate; NOT_FOUND when
-// there is no support plane; whatever `interrupt` returns;
-// RESOURCE_EXHAUSTED when memory runs out and INTERNAL for any other
-// exception from a library underneath (nothing throws out of core/).
+// there is no support plane; whatever `interrupt` returns. What a library
+// underneath throws (out of memory, an OpenCV bug) passes through to the
+// caller's boundary (core/base/guarded.h).
 absl::StatusOr<DetectResult> RunDetect(const RgbdFrame& frame,
                                        const DetectOptions& options,
                                        const InterruptCheck& interrupt = {});

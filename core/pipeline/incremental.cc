@@ -7,7 +7,6 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "core/base/guarded.h"
 #include "core/base/parallel.h"
 #include "core/base/stage_clock.h"
 #include "core/base/status_macros.h"
@@ -19,12 +18,71 @@ namespace {
 // Focal length the attention sigma is given at, pixels.
 constexpr double kReferenceFocalPx = 525.0;
 
-absl::StatusOr<SegmentSummary> RunUnguarded(const RgbdFrame& frame,
-                                            const IncrementalOptions& options,
-                                            const RbfSvm* svm,
-                                            const SegmentSinks& sinks,
-                                            const InterruptCheck& interrupt,
-                                            SteadyClock::time_point start) {
+}  // namespace
+
+absl::Status Validate(const IncrementalOptions& options) {
+  if (absl::Status s = Validate(options.detect); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("detect: ", s.message()));
+  }
+  if (absl::Status s = Validate(options.inc); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("inc.", s.message()));
+  }
+  if (options.attention_points.size() >
+      static_cast<size_t>(kMaxAttentionPoints)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("attention_points: ", options.attention_points.size(),
+                     " given, at most ", kMaxAttentionPoints, " allowed"));
+  }
+  if (!(options.attention_sigma_px > 0.0f)) {
+    return absl::InvalidArgumentError("attention_sigma_px must be positive");
+  }
+  if (options.max_objects < 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "max_objects must not be negative, got ", options.max_objects));
+  }
+  if (!(options.min_object_area_m2 >= 0.0) ||
+      !std::isfinite(options.min_object_area_m2)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("min_object_area_m2 must be finite and >= 0, got ",
+                     options.min_object_area_m2));
+  }
+  if (!(options.time_budget_seconds >= 0.0) ||
+      !std::isfinite(options.time_budget_seconds)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("time_budget_seconds must be a non-negative number, got ",
+                     options.time_budget_seconds));
+  }
+  FOVEA_RETURN_IF_ERROR(Validate(options.box_fit));
+  return Validate(options.object_points);
+}
+
+cv::Mat AttentionPointsSaliency(const std::vector<cv::Point>& points,
+                                cv::Size size, float sigma_px) {
+  cv::Mat map(size, CV_32FC1, cv::Scalar(0));
+  const double n = static_cast<double>(points.size());
+  const double two_s2 = 2.0 * sigma_px * sigma_px;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const double weight = (n - static_cast<double>(i)) / n;
+    for (int v = 0; v < size.height; ++v) {
+      float* row = map.ptr<float>(v);
+      const double dv = v - points[i].y;
+      for (int u = 0; u < size.width; ++u) {
+        const double du = u - points[i].x;
+        row[u] += static_cast<float>(weight *
+                                     std::exp(-(du * du + dv * dv) / two_s2));
+      }
+    }
+  }
+  double max_value = 0.0;
+  cv::minMaxLoc(map, nullptr, &max_value);
+  if (max_value > 0.0) map /= max_value;
+  return map;
+}
+
+absl::StatusOr<SegmentSummary> RunSegmentIncremental(
+    const RgbdFrame& frame, const IncrementalOptions& options,
+    const RbfSvm* svm, const SegmentSinks& sinks,
+    const InterruptCheck& interrupt, SteadyClock::time_point start) {
   FOVEA_RETURN_IF_ERROR(Validate(options));
   for (const cv::Point& p : options.attention_points) {
     if (p.x < 0 || p.y < 0 || p.x >= frame.width() || p.y >= frame.height()) {
@@ -156,92 +214,16 @@ absl::StatusOr<SegmentSummary> RunUnguarded(const RgbdFrame& frame,
   return summary;
 }
 
-}  // namespace
-
-absl::Status Validate(const IncrementalOptions& options) {
-  if (absl::Status s = Validate(options.detect); !s.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat("detect: ", s.message()));
-  }
-  if (absl::Status s = Validate(options.inc); !s.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat("inc.", s.message()));
-  }
-  if (options.attention_points.size() >
-      static_cast<size_t>(kMaxAttentionPoints)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("attention_points: ", options.attention_points.size(),
-                     " given, at most ", kMaxAttentionPoints, " allowed"));
-  }
-  if (!(options.attention_sigma_px > 0.0f)) {
-    return absl::InvalidArgumentError("attention_sigma_px must be positive");
-  }
-  if (options.max_objects < 0) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "max_objects must not be negative, got ", options.max_objects));
-  }
-  if (!(options.min_object_area_m2 >= 0.0) ||
-      !std::isfinite(options.min_object_area_m2)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("min_object_area_m2 must be finite and >= 0, got ",
-                     options.min_object_area_m2));
-  }
-  if (!(options.time_budget_seconds >= 0.0) ||
-      !std::isfinite(options.time_budget_seconds)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("time_budget_seconds must be a non-negative number, got ",
-                     options.time_budget_seconds));
-  }
-  FOVEA_RETURN_IF_ERROR(Validate(options.box_fit));
-  return Validate(options.object_points);
-}
-
-cv::Mat AttentionPointsSaliency(const std::vector<cv::Point>& points,
-                                cv::Size size, float sigma_px) {
-  cv::Mat map(size, CV_32FC1, cv::Scalar(0));
-  const double n = static_cast<double>(points.size());
-  const double two_s2 = 2.0 * sigma_px * sigma_px;
-  for (size_t i = 0; i < points.size(); ++i) {
-    const double weight = (n - static_cast<double>(i)) / n;
-    for (int v = 0; v < size.height; ++v) {
-      float* row = map.ptr<float>(v);
-      const double dv = v - points[i].y;
-      for (int u = 0; u < size.width; ++u) {
-        const double du = u - points[i].x;
-        row[u] += static_cast<float>(weight *
-                                     std::exp(-(du * du + dv * dv) / two_s2));
-      }
-    }
-  }
-  double max_value = 0.0;
-  cv::minMaxLoc(map, nullptr, &max_value);
-  if (max_value > 0.0) map /= max_value;
-  return map;
-}
-
-absl::StatusOr<SegmentSummary> RunSegmentIncremental(
-    const RgbdFrame& frame, const IncrementalOptions& options,
-    const RbfSvm* relation_svm, const SegmentSinks& sinks,
-    const InterruptCheck& interrupt, SteadyClock::time_point start) {
-  // Nothing throws out of core/.
-  return Guarded("segment-incremental",
-                 [&]() -> absl::StatusOr<SegmentSummary> {
-                   return RunUnguarded(frame, options, relation_svm, sinks,
-                                       interrupt, start);
-                 });
-}
-
 absl::StatusOr<std::vector<SvmSample>> CollectIncSamples(
     const LabelledFrame& frame, int group, const DetectOptions& detect,
     const IncOptions& inc) {
-  return Guarded(
-      "inc samples", [&]() -> absl::StatusOr<std::vector<SvmSample>> {
-        FOVEA_ASSIGN_OR_RETURN(PreparedScene scene,
-                               PrepareScene(frame.frame, detect));
-        const cv::Mat flat(frame.frame.depth.size(), CV_32FC1, cv::Scalar(0));
-        FOVEA_ASSIGN_OR_RETURN(IncScene inc_scene,
-                               BuildIncScene(scene.cloud, scene.plane, flat,
-                                             inc, scene.table.region));
-        return IncTrainingSamples(inc_scene, frame.labels, group);
-      });
+  FOVEA_ASSIGN_OR_RETURN(PreparedScene scene,
+                         PrepareScene(frame.frame, detect));
+  const cv::Mat flat(frame.frame.depth.size(), CV_32FC1, cv::Scalar(0));
+  FOVEA_ASSIGN_OR_RETURN(
+      IncScene inc_scene,
+      BuildIncScene(scene.cloud, scene.plane, flat, inc, scene.table.region));
+  return IncTrainingSamples(inc_scene, frame.labels, group);
 }
 
 }  // namespace fovea

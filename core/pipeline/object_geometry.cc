@@ -6,7 +6,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include "absl/strings/str_cat.h"
-#include "core/base/guarded.h"
 #include "core/scene/hull_candidates.h"
 
 namespace fovea {
@@ -21,7 +20,23 @@ float Percentile(std::vector<float>& values, float percent) {
   return *at;
 }
 
-absl::StatusOr<ObjectGeometry> FitUnguarded(
+}  // namespace
+
+absl::Status Validate(const BoxFitOptions& options) {
+  if (!(options.trim_percent >= 0.0f && options.trim_percent < 25.0f)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "box_fit.trim_percent must be in [0, 25), got ", options.trim_percent));
+  }
+  if (!(options.rest_on_support_m >= 0.0f) ||
+      !std::isfinite(options.rest_on_support_m)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("box_fit.rest_on_support_m must be finite and >= 0, got ",
+                     options.rest_on_support_m));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<ObjectGeometry> FitSupportAlignedBox(
     const std::vector<Eigen::Vector3f>& points, const SupportPlane& plane,
     const BoxFitOptions& options) {
   if (absl::Status s = Validate(options); !s.ok()) return s;
@@ -104,30 +119,6 @@ absl::StatusOr<ObjectGeometry> FitUnguarded(
   g.height_above_support = top;
   g.footprint_area_m2 = length * width;
   return g;
-}
-
-}  // namespace
-
-absl::Status Validate(const BoxFitOptions& options) {
-  if (!(options.trim_percent >= 0.0f && options.trim_percent < 25.0f)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "box_fit.trim_percent must be in [0, 25), got ", options.trim_percent));
-  }
-  if (!(options.rest_on_support_m >= 0.0f) ||
-      !std::isfinite(options.rest_on_support_m)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("box_fit.rest_on_support_m must be finite and >= 0, got ",
-                     options.rest_on_support_m));
-  }
-  return absl::OkStatus();
-}
-
-absl::StatusOr<ObjectGeometry> FitSupportAlignedBox(
-    const std::vector<Eigen::Vector3f>& points, const SupportPlane& plane,
-    const BoxFitOptions& options) {
-  // cv::minAreaRect can throw; nothing throws out of core/.
-  return Guarded("object box",
-                 [&] { return FitUnguarded(points, plane, options); });
 }
 
 std::vector<Eigen::Vector3f> MaskPoints(const OrganizedCloud& cloud,

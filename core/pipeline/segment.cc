@@ -13,7 +13,6 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
-#include "core/base/guarded.h"
 #include "core/base/parallel.h"
 #include "core/base/stage_clock.h"
 #include "core/base/status_macros.h"
@@ -373,10 +372,69 @@ absl::StatusOr<std::vector<AttentionPoint>> TakeSeeds(
   return std::move(detect.points);
 }
 
-absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
-    const RgbdFrame& frame, const SegmentOptions& options,
-    const SegmentModels& models, const SegmentSinks& sinks,
-    const InterruptCheck& interrupt, SteadyClock::time_point start) {
+}  // namespace
+
+absl::Span<const SegmentMethodRow> SegmentMethods() { return kSegmentMethods; }
+
+const SegmentMethodRow* FindSegmentMethod(SegmentMethod method) {
+  for (const SegmentMethodRow& row : kSegmentMethods) {
+    if (row.method == method) return &row;
+  }
+  return nullptr;
+}
+
+std::string_view SegmentMethodName(SegmentMethod method) {
+  const SegmentMethodRow* row = FindSegmentMethod(method);
+  return row != nullptr ? row->name : "unknown";
+}
+
+absl::StatusOr<SegmentMethod> ParseSegmentMethod(std::string_view text) {
+  std::vector<absl::string_view> known;
+  for (const SegmentMethodRow& row : kSegmentMethods) {
+    if (row.name == text) return row.method;
+    known.push_back(AbslView(row.name));
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat("unknown segmentation method '", AbslView(text),
+                   "' (known: ", absl::StrJoin(known, ", "), ")"));
+}
+
+absl::Status Validate(const SegmentOptions& options) {
+  if (absl::Status s = Validate(options.detect); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("detect: ", s.message()));
+  }
+  if (absl::Status s = Validate(options.cos); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("cos.", s.message()));
+  }
+  if (absl::Status s = Validate(options.ebs_contour); !s.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("ebs_contour.", s.message()));
+  }
+  if (options.max_objects < 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "max_objects must not be negative, got ", options.max_objects));
+  }
+  if (!(options.min_object_area_m2 >= 0.0) ||
+      !std::isfinite(options.min_object_area_m2)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("min_object_area_m2 must be finite and >= 0, got ",
+                     options.min_object_area_m2));
+  }
+  if (options.seeds.size() > static_cast<size_t>(kMaxAttentionPoints)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("seeds: ", options.seeds.size(), " given, at most ",
+                     kMaxAttentionPoints, " allowed"));
+  }
+  FOVEA_RETURN_IF_ERROR(Validate(options.box_fit));
+  return Validate(options.object_points);
+}
+
+absl::StatusOr<SegmentSummary> RunSegment(const RgbdFrame& frame,
+                                          const SegmentOptions& options,
+                                          const SegmentModels& models,
+                                          const SegmentSinks& sinks,
+                                          const InterruptCheck& interrupt,
+                                          SteadyClock::time_point start) {
   FOVEA_RETURN_IF_ERROR(Validate(options));
   for (const cv::Point& p : options.seeds) {
     if (p.x < 0 || p.y < 0 || p.x >= frame.width() || p.y >= frame.height()) {
@@ -503,88 +561,15 @@ absl::StatusOr<SegmentSummary> RunSegmentUnguarded(
   return summary;
 }
 
-}  // namespace
-
-absl::Span<const SegmentMethodRow> SegmentMethods() { return kSegmentMethods; }
-
-const SegmentMethodRow* FindSegmentMethod(SegmentMethod method) {
-  for (const SegmentMethodRow& row : kSegmentMethods) {
-    if (row.method == method) return &row;
-  }
-  return nullptr;
-}
-
-std::string_view SegmentMethodName(SegmentMethod method) {
-  const SegmentMethodRow* row = FindSegmentMethod(method);
-  return row != nullptr ? row->name : "unknown";
-}
-
-absl::StatusOr<SegmentMethod> ParseSegmentMethod(std::string_view text) {
-  std::vector<absl::string_view> known;
-  for (const SegmentMethodRow& row : kSegmentMethods) {
-    if (row.name == text) return row.method;
-    known.push_back(AbslView(row.name));
-  }
-  return absl::InvalidArgumentError(
-      absl::StrCat("unknown segmentation method '", AbslView(text),
-                   "' (known: ", absl::StrJoin(known, ", "), ")"));
-}
-
-absl::Status Validate(const SegmentOptions& options) {
-  if (absl::Status s = Validate(options.detect); !s.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat("detect: ", s.message()));
-  }
-  if (absl::Status s = Validate(options.cos); !s.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat("cos.", s.message()));
-  }
-  if (absl::Status s = Validate(options.ebs_contour); !s.ok()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("ebs_contour.", s.message()));
-  }
-  if (options.max_objects < 0) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "max_objects must not be negative, got ", options.max_objects));
-  }
-  if (!(options.min_object_area_m2 >= 0.0) ||
-      !std::isfinite(options.min_object_area_m2)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("min_object_area_m2 must be finite and >= 0, got ",
-                     options.min_object_area_m2));
-  }
-  if (options.seeds.size() > static_cast<size_t>(kMaxAttentionPoints)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("seeds: ", options.seeds.size(), " given, at most ",
-                     kMaxAttentionPoints, " allowed"));
-  }
-  FOVEA_RETURN_IF_ERROR(Validate(options.box_fit));
-  return Validate(options.object_points);
-}
-
-absl::StatusOr<SegmentSummary> RunSegment(const RgbdFrame& frame,
-                                          const SegmentOptions& options,
-                                          const SegmentModels& models,
-                                          const SegmentSinks& sinks,
-                                          const InterruptCheck& interrupt,
-                                          SteadyClock::time_point start) {
-  // Nothing throws out of core/: OpenCV, qhull's wrapper and the standard
-  // library can.
-  return Guarded("segment", [&]() -> absl::StatusOr<SegmentSummary> {
-    return RunSegmentUnguarded(frame, options, models, sinks, interrupt, start);
-  });
-}
-
 absl::StatusOr<std::vector<SvmSample>> CollectCosSamples(
     const LabelledFrame& frame, int group, const DetectOptions& detect,
     const CosOptions& cos) {
-  return Guarded(
-      "cos samples", [&]() -> absl::StatusOr<std::vector<SvmSample>> {
-        FOVEA_ASSIGN_OR_RETURN(PreparedScene scene,
-                               PrepareScene(frame.frame, detect));
-        FOVEA_ASSIGN_OR_RETURN(
-            CosScene cos_scene,
-            BuildCosScene(scene.cloud, scene.plane, cos, scene.table.region));
-        return CosTrainingSamples(cos_scene, frame.labels, group, cos);
-      });
+  FOVEA_ASSIGN_OR_RETURN(PreparedScene scene,
+                         PrepareScene(frame.frame, detect));
+  FOVEA_ASSIGN_OR_RETURN(
+      CosScene cos_scene,
+      BuildCosScene(scene.cloud, scene.plane, cos, scene.table.region));
+  return CosTrainingSamples(cos_scene, frame.labels, group, cos);
 }
 
 }  // namespace fovea

@@ -11,7 +11,6 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
-#include "core/base/guarded.h"
 #include "core/base/parallel.h"
 #include "core/base/status_macros.h"
 
@@ -211,9 +210,7 @@ Intrinsics DownsampleIntrinsics(const Intrinsics& intrinsics) {
 
 absl::StatusOr<OrganizedCloud> DownsampleCloud(const OrganizedCloud& cloud) {
   FOVEA_RETURN_IF_ERROR(ValidateCloud(cloud));
-  return Guarded("DownsampleCloud", [&]() -> absl::StatusOr<OrganizedCloud> {
-    return Downsample(cloud);
-  });
+  return Downsample(cloud);
 }
 
 absl::StatusOr<CloudPyramid> BuildCloudPyramid(
@@ -223,18 +220,16 @@ absl::StatusOr<CloudPyramid> BuildCloudPyramid(
   CloudPyramid pyramid;
   pyramid.levels.reserve(options.max_levels);
   pyramid.levels.push_back(cloud);  // cv::Mat headers: shares the pixels
-  return Guarded("BuildCloudPyramid", [&]() -> absl::StatusOr<CloudPyramid> {
-    while (pyramid.size() < options.max_levels) {
-      const OrganizedCloud& last = pyramid.levels.back();
-      if (HalfUp(last.width()) < options.min_size ||
-          HalfUp(last.height()) < options.min_size) {
-        break;
-      }
-      OrganizedCloud next = Downsample(last);
-      pyramid.levels.push_back(std::move(next));
+  while (pyramid.size() < options.max_levels) {
+    const OrganizedCloud& last = pyramid.levels.back();
+    if (HalfUp(last.width()) < options.min_size ||
+        HalfUp(last.height()) < options.min_size) {
+      break;
     }
-    return std::move(pyramid);
-  });
+    OrganizedCloud next = Downsample(last);
+    pyramid.levels.push_back(std::move(next));
+  }
+  return pyramid;
 }
 
 }  // namespace fovea

@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "core/base/guarded.h"
 #include "core/base/status_macros.h"
 
 namespace fovea {
@@ -56,7 +55,7 @@ class FeatureCache {
                        map.type(), " ", map.cols, "x", map.rows));
     }
     maps_[level] = map;
-    return std::move(map);
+    return map;
   }
 
  private:
@@ -176,20 +175,18 @@ absl::StatusOr<cv::Mat> ResampleBetweenLevels(const cv::Mat& map, int from,
         absl::StrCat("map to resample must be CV_32FC1 ", size.width, "x",
                      size.height, " (level ", from, ")"));
   }
-  return Guarded("ResampleBetweenLevels", [&]() -> absl::StatusOr<cv::Mat> {
-    cv::Mat out = map;
-    for (int l = from; l < to; ++l) {
-      cv::Mat next;
-      cv::pyrDown(out, next, LevelSize(pyramid, l + 1));
-      out = std::move(next);
-    }
-    for (int l = from; l > to; --l) {
-      cv::Mat next;
-      cv::pyrUp(out, next, LevelSize(pyramid, l - 1));
-      out = std::move(next);
-    }
-    return from == to ? map.clone() : out;
-  });
+  cv::Mat out = map;
+  for (int l = from; l < to; ++l) {
+    cv::Mat next;
+    cv::pyrDown(out, next, LevelSize(pyramid, l + 1));
+    out = std::move(next);
+  }
+  for (int l = from; l > to; --l) {
+    cv::Mat next;
+    cv::pyrUp(out, next, LevelSize(pyramid, l - 1));
+    out = std::move(next);
+  }
+  return from == to ? map.clone() : out;
 }
 
 absl::StatusOr<Conspicuity> BuildConspicuityMap(
@@ -202,8 +199,7 @@ absl::StatusOr<Conspicuity> BuildConspicuityMap(
   if (!feature) {
     return absl::InvalidArgumentError("the level feature function is empty");
   }
-  return Guarded("BuildConspicuityMap",
-                 [&] { return Build(pyramid, feature, options); });
+  return Build(pyramid, feature, options);
 }
 
 }  // namespace fovea

@@ -6,7 +6,6 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
-#include "core/base/guarded.h"
 #include "core/base/status_macros.h"
 
 namespace fovea {
@@ -53,28 +52,25 @@ absl::StatusOr<cv::Mat> FuseChannels(const std::vector<cv::Mat>& maps,
                                      const std::vector<float>& weights,
                                      ChannelFusion fusion) {
   FOVEA_RETURN_IF_ERROR(ValidateInputs(maps, weights));
-  return Guarded("FuseChannels", [&]() -> absl::StatusOr<cv::Mat> {
-    double norm = 0.0;
-    for (float w : weights) {
-      norm =
-          fusion == ChannelFusion::kSum ? norm + w : std::max(norm, double{w});
+  double norm = 0.0;
+  for (float w : weights) {
+    norm = fusion == ChannelFusion::kSum ? norm + w : std::max(norm, double{w});
+  }
+  cv::Mat out = cv::Mat::zeros(maps[0].size(), CV_32FC1);
+  bool first = true;
+  for (size_t i = 0; i < maps.size(); ++i) {
+    const double w = weights[i] / norm;
+    if (w <= 0.0) continue;
+    if (fusion == ChannelFusion::kSum) {
+      cv::scaleAdd(maps[i], w, out, out);
+    } else if (first) {
+      maps[i].convertTo(out, CV_32FC1, w);
+    } else {
+      cv::max(out, maps[i] * w, out);
     }
-    cv::Mat out = cv::Mat::zeros(maps[0].size(), CV_32FC1);
-    bool first = true;
-    for (size_t i = 0; i < maps.size(); ++i) {
-      const double w = weights[i] / norm;
-      if (w <= 0.0) continue;
-      if (fusion == ChannelFusion::kSum) {
-        cv::scaleAdd(maps[i], w, out, out);
-      } else if (first) {
-        maps[i].convertTo(out, CV_32FC1, w);
-      } else {
-        cv::max(out, maps[i] * w, out);
-      }
-      first = false;
-    }
-    return out;
-  });
+    first = false;
+  }
+  return out;
 }
 
 }  // namespace fovea

@@ -9,7 +9,6 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
-#include "core/base/guarded.h"
 #include "core/base/status_macros.h"
 
 namespace fovea {
@@ -169,21 +168,19 @@ absl::StatusOr<cv::Mat> NormalizeMap(const cv::Mat& map, MapNormalization kind,
     return absl::InvalidArgumentError("map must be CV_32FC1");
   }
   FOVEA_RETURN_IF_ERROR(CheckValues(map));
-  return Guarded("NormalizeMap", [&]() -> absl::StatusOr<cv::Mat> {
-    double max_value = 0.0;
-    cv::minMaxLoc(map, nullptr, &max_value);
-    if (max_value <= 0.0) return cv::Mat(cv::Mat::zeros(map.size(), CV_32FC1));
-    cv::Mat scaled;
-    map.convertTo(scaled, CV_32FC1, 1.0 / max_value);
-    if (kind == MapNormalization::kLin) return scaled;
-    const std::vector<LocalMaximum> maxima =
-        FindLocalMaxima(scaled, options.min_peak, options.min_peak_distance);
-    const float factor = kind == MapNormalization::kNms
-                             ? NmsFactor(maxima)
-                             : NlmFactor(maxima, options.nlm_range);
-    scaled *= factor;
-    return scaled;
-  });
+  double max_value = 0.0;
+  cv::minMaxLoc(map, nullptr, &max_value);
+  if (max_value <= 0.0) return cv::Mat(cv::Mat::zeros(map.size(), CV_32FC1));
+  cv::Mat scaled;
+  map.convertTo(scaled, CV_32FC1, 1.0 / max_value);
+  if (kind == MapNormalization::kLin) return scaled;
+  const std::vector<LocalMaximum> maxima =
+      FindLocalMaxima(scaled, options.min_peak, options.min_peak_distance);
+  const float factor = kind == MapNormalization::kNms
+                           ? NmsFactor(maxima)
+                           : NlmFactor(maxima, options.nlm_range);
+  scaled *= factor;
+  return scaled;
 }
 
 }  // namespace fovea

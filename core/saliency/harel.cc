@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "core/base/guarded.h"
 #include "core/base/status_macros.h"
 #include "core/saliency/saliency_map.h"
 
@@ -321,19 +320,16 @@ absl::StatusOr<cv::Mat> ComputeHarelSaliency(const cv::Mat& color,
                                              const HarelOptions& options) {
   FOVEA_RETURN_IF_ERROR(CheckColorImage(color));
   FOVEA_RETURN_IF_ERROR(Validate(options));
-  return Guarded("harel", [&]() -> absl::StatusOr<cv::Mat> {
-    const cv::Mat grid_map = ComputeGridMap(color, options);
-    cv::Mat map;
-    cv::resize(grid_map, map, color.size(), 0, 0, cv::INTER_LINEAR);
-    const double sigma =
-        options.blur_fraction * std::max(color.cols, color.rows);
-    if (sigma > 0.0) {
-      cv::GaussianBlur(map, map, cv::Size(0, 0), sigma, sigma,
-                       cv::BORDER_REPLICATE);
-    }
-    StretchToUnit(map, kRelativeFlatTolerance);
-    return map;
-  });
+  const cv::Mat grid_map = ComputeGridMap(color, options);
+  cv::Mat map;
+  cv::resize(grid_map, map, color.size(), 0, 0, cv::INTER_LINEAR);
+  const double sigma = options.blur_fraction * std::max(color.cols, color.rows);
+  if (sigma > 0.0) {
+    cv::GaussianBlur(map, map, cv::Size(0, 0), sigma, sigma,
+                     cv::BORDER_REPLICATE);
+  }
+  StretchToUnit(map, kRelativeFlatTolerance);
+  return map;
 }
 
 }  // namespace fovea

@@ -6,7 +6,6 @@
 #include <string>
 
 #include "absl/strings/str_cat.h"
-#include "core/base/guarded.h"
 #include "core/base/status_macros.h"
 #include "core/saliency/saliency_map.h"
 
@@ -85,22 +84,20 @@ absl::StatusOr<cv::Mat> ComputeHouSaliency(const cv::Mat& color,
                                            const HouOptions& options) {
   FOVEA_RETURN_IF_ERROR(CheckColorImage(color));
   FOVEA_RETURN_IF_ERROR(Validate(options));
-  return Guarded("hou", [&]() -> absl::StatusOr<cv::Mat> {
-    const cv::Mat grey = WorkingGrey(color, options.working_width);
-    cv::Mat signal = grey;
-    if (options.mirror_border) {
-      cv::copyMakeBorder(grey, signal, 0, grey.rows, 0, grey.cols,
-                         cv::BORDER_REFLECT);
-    }
-    cv::Mat energy = SpectralResidualEnergy(signal, options.average_size);
-    cv::GaussianBlur(energy, energy, cv::Size(0, 0), options.blur_sigma_px,
-                     options.blur_sigma_px, cv::BORDER_REPLICATE);
-    cv::Mat map;
-    cv::resize(energy(cv::Rect(0, 0, grey.cols, grey.rows)), map, color.size(),
-               0, 0, cv::INTER_LINEAR);
-    StretchToUnit(map, kRelativeFlatTolerance);
-    return map;
-  });
+  const cv::Mat grey = WorkingGrey(color, options.working_width);
+  cv::Mat signal = grey;
+  if (options.mirror_border) {
+    cv::copyMakeBorder(grey, signal, 0, grey.rows, 0, grey.cols,
+                       cv::BORDER_REFLECT);
+  }
+  cv::Mat energy = SpectralResidualEnergy(signal, options.average_size);
+  cv::GaussianBlur(energy, energy, cv::Size(0, 0), options.blur_sigma_px,
+                   options.blur_sigma_px, cv::BORDER_REPLICATE);
+  cv::Mat map;
+  cv::resize(energy(cv::Rect(0, 0, grey.cols, grey.rows)), map, color.size(), 0,
+             0, cv::INTER_LINEAR);
+  StretchToUnit(map, kRelativeFlatTolerance);
+  return map;
 }
 
 }  // namespace fovea

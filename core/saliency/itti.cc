@@ -7,7 +7,6 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "core/base/guarded.h"
 #include "core/base/status_macros.h"
 #include "core/saliency/saliency_map.h"
 
@@ -266,12 +265,10 @@ absl::StatusOr<cv::Mat> ComputeIttiSaliency(const cv::Mat& color,
                                             const IttiOptions& options) {
   FOVEA_RETURN_IF_ERROR(CheckColorImage(color));
   FOVEA_RETURN_IF_ERROR(Validate(options));
-  return Guarded("itti", [&]() -> absl::StatusOr<cv::Mat> {
-    const cv::Mat master = ComputeMasterMap(color, options);
-    cv::Mat map;
-    cv::resize(master, map, color.size(), 0, 0, cv::INTER_LINEAR);
-    return StretchToUnitAbsolute(map);
-  });
+  const cv::Mat master = ComputeMasterMap(color, options);
+  cv::Mat map;
+  cv::resize(master, map, color.size(), 0, 0, cv::INTER_LINEAR);
+  return StretchToUnitAbsolute(map);
 }
 
 }  // namespace fovea

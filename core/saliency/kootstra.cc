@@ -6,7 +6,6 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "core/base/guarded.h"
 #include "core/base/status_macros.h"
 #include "core/saliency/saliency_map.h"
 
@@ -168,34 +167,31 @@ absl::StatusOr<cv::Mat> ComputeKootstraSaliency(
     const cv::Mat& color, const KootstraOptions& options) {
   FOVEA_RETURN_IF_ERROR(CheckColorImage(color));
   FOVEA_RETURN_IF_ERROR(Validate(options));
-  return Guarded("kootstra", [&]() -> absl::StatusOr<cv::Mat> {
-    cv::Mat grey8, level;
-    cv::cvtColor(color, grey8, cv::COLOR_RGB2GRAY);
-    grey8.convertTo(level, CV_32F);
-    cv::Mat map = cv::Mat::zeros(color.size(), CV_32F);
-    const int last = options.min_level + options.num_scales - 1;
-    for (int l = 0; l <= last; ++l) {
-      if (l > 0) cv::pyrDown(level, level);
-      if (l < options.min_level) continue;
-      if (level.cols < kMinScaleSide || level.rows < kMinScaleSide) break;
-      cv::Mat votes =
-          VoteSymmetry(SelectEdgels(level, options), level.size(), options);
-      if (options.smoothing_sigma_px > 0.0f) {
-        cv::GaussianBlur(votes, votes, cv::Size(0, 0),
-                         options.smoothing_sigma_px, options.smoothing_sigma_px,
-                         cv::BORDER_REPLICATE);
-      }
-      double max_vote = 0.0;
-      cv::minMaxLoc(votes, nullptr, &max_vote);
-      if (max_vote <= 0.0) continue;
-      cv::Mat resized;
-      cv::resize(votes * (1.0 / max_vote), resized, color.size(), 0, 0,
-                 cv::INTER_LINEAR);
-      map += resized;
+  cv::Mat grey8, level;
+  cv::cvtColor(color, grey8, cv::COLOR_RGB2GRAY);
+  grey8.convertTo(level, CV_32F);
+  cv::Mat map = cv::Mat::zeros(color.size(), CV_32F);
+  const int last = options.min_level + options.num_scales - 1;
+  for (int l = 0; l <= last; ++l) {
+    if (l > 0) cv::pyrDown(level, level);
+    if (l < options.min_level) continue;
+    if (level.cols < kMinScaleSide || level.rows < kMinScaleSide) break;
+    cv::Mat votes =
+        VoteSymmetry(SelectEdgels(level, options), level.size(), options);
+    if (options.smoothing_sigma_px > 0.0f) {
+      cv::GaussianBlur(votes, votes, cv::Size(0, 0), options.smoothing_sigma_px,
+                       options.smoothing_sigma_px, cv::BORDER_REPLICATE);
     }
-    StretchToUnit(map, kRelativeFlatTolerance);
-    return map;
-  });
+    double max_vote = 0.0;
+    cv::minMaxLoc(votes, nullptr, &max_vote);
+    if (max_vote <= 0.0) continue;
+    cv::Mat resized;
+    cv::resize(votes * (1.0 / max_vote), resized, color.size(), 0, 0,
+               cv::INTER_LINEAR);
+    map += resized;
+  }
+  StretchToUnit(map, kRelativeFlatTolerance);
+  return map;
 }
 
 }  // namespace fovea

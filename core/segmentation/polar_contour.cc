@@ -10,7 +10,6 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
-#include "core/base/guarded.h"
 #include "core/base/status_macros.h"
 
 namespace fovea {
@@ -266,9 +265,7 @@ absl::StatusOr<PolarContour> FindPolarContour(
         "polar_contour: seed (", seed.x, ", ", seed.y, ") is outside the ",
         edge_probability.cols, " x ", edge_probability.rows, " map"));
   }
-  return Guarded("polar_contour", [&]() -> absl::StatusOr<PolarContour> {
-    return SolveClosedContour(edge_probability, seed, options, interrupt);
-  });
+  return SolveClosedContour(edge_probability, seed, options, interrupt);
 }
 
 cv::Mat FillPolarContour(const PolarContour& contour, cv::Size size) {

@@ -1,5 +1,6 @@
 #include "tests/server/server_fixture.h"
 
+#include <new>
 #include <stdexcept>
 #include <utility>
 
@@ -121,6 +122,8 @@ void ServerTest::ThrowIfAsked() {
       throw std::runtime_error("test hook: thrown on purpose");
     case Throw::kInt:
       throw 42;
+    case Throw::kBadAlloc:
+      throw std::bad_alloc();
   }
 }
 

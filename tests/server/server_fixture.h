@@ -50,7 +50,7 @@ class Gate {
 class ServerTest : public ::testing::Test {
  protected:
   // What the next Detect job throws from its start hook.
-  enum class Throw { kNothing, kStdException, kInt };
+  enum class Throw { kNothing, kStdException, kInt, kBadAlloc };
 
   // Starts a server with `config` adjusted for the test (free ports, the
   // hooks above) and, when `wait_serving`, waits for health SERVING.

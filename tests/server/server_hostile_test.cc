@@ -144,8 +144,9 @@ TEST_F(HostileRequestTest, HundredThousandRepeatedOperatorsAreRefusedQuickly) {
   ExpectStillServing();
 }
 
-// Anything a job throws outside core (decoding, conversion, hooks) ends
-// the call with INTERNAL; the worker and the process live on.
+// Anything a job throws (decoding, core's libraries, conversion, hooks)
+// reaches the call's one boundary: out of memory is RESOURCE_EXHAUSTED,
+// the rest INTERNAL; the worker and the process live on.
 TEST_F(HostileRequestTest, ExceptionInAJobIsInternalAndServerGoesOn) {
   ServerConfig config = DefaultConfig();
   config.concurrency = 1;  // both throws hit the same worker
@@ -162,6 +163,11 @@ TEST_F(HostileRequestTest, ExceptionInAJobIsInternalAndServerGoesOn) {
   status = Detect(ShRequest(), &response);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INTERNAL);
   EXPECT_THAT(status.error_message(), HasSubstr("exception"));
+
+  ThrowInNextJob(Throw::kBadAlloc);
+  status = Detect(ShRequest(), &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_EQ(status.error_message(), "Detect: out of memory");
 
   ExpectStillServing();
   const std::string after = Scrape();

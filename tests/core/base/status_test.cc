@@ -76,7 +76,10 @@ TEST(Guarded, TurnsWhatIsThrownIntoAStatusNamingTheOperation) {
   });
   EXPECT_EQ(bug.status().code(), absl::StatusCode::kInternal);
   EXPECT_THAT(bug.status().message(),
-              HasSubstr("fit: matrix not positive definite"));
+              HasSubstr("fit: unexpected exception: matrix not positive"));
+  const absl::Status odd = Guarded("fit", []() -> absl::Status { throw 7; });
+  EXPECT_EQ(odd.code(), absl::StatusCode::kInternal);
+  EXPECT_EQ(odd.message(), "fit: unexpected exception of a non-standard type");
 
   const absl::StatusOr<int> fine =
       Guarded("fit", []() -> absl::StatusOr<int> { return 4; });
