@@ -43,15 +43,33 @@ ABSL_FLAG(std::string, request_id, "",
           "request id, echoed back (default: generated)");
 
 // Detect options (empty = the server's default).
+// The lists of names in the help text are read from the contract's enums
+// (client/option_names.h), as the flags' values are.
 ABSL_FLAG(std::string, saliency, "",
-          "saliency channels: ph, sh, rso, sym3d, itti, harel, hou, "
-          "kootstra, target_color, location_prior; combine with '+' (equal "
-          "weights) or give weights as name:w, e.g. ph+sh+rso, ph:2+rso:1");
-ABSL_FLAG(std::string, extract, "", "attention points: msr | wta | tj");
-ABSL_FLAG(std::string, pyramid, "", "pyramid: none | simple | itti");
-ABSL_FLAG(std::string, norm, "", "map normalisation: lin | nms | nlm");
-ABSL_FLAG(std::string, combine, "", "pyramid level combination: sum | max");
-ABSL_FLAG(std::string, fusion, "", "channel fusion: sum | max");
+          absl::StrCat("saliency channels: ",
+                       fovea::client::NameList(
+                           *fovea::v1::SaliencyOperator_descriptor(), ", "),
+                       "; combine with '+' (equal weights) or give weights as "
+                       "name:w, e.g. ph+sh+rso, ph:2+rso:1"));
+ABSL_FLAG(
+    std::string, extract, "",
+    absl::StrCat("attention points: ",
+                 fovea::client::NameList(*fovea::v1::Extraction_descriptor())));
+ABSL_FLAG(std::string, pyramid, "",
+          absl::StrCat("pyramid: ", fovea::client::NameList(
+                                        *fovea::v1::Pyramid_descriptor())));
+ABSL_FLAG(std::string, norm, "",
+          absl::StrCat(
+              "map normalisation: ",
+              fovea::client::NameList(*fovea::v1::Normalization_descriptor())));
+ABSL_FLAG(std::string, combine, "",
+          absl::StrCat("pyramid level combination: ",
+                       fovea::client::NameList(
+                           *fovea::v1::LevelCombination_descriptor())));
+ABSL_FLAG(
+    std::string, fusion, "",
+    absl::StrCat("channel fusion: ",
+                 fovea::client::NameList(*fovea::v1::Fusion_descriptor())));
 ABSL_FLAG(bool, maps, false, "ask for each channel's saliency map");
 ABSL_FLAG(std::string, target_color, "",
           "target_color operator: the colour looked for, R,G,B (0-255), "
@@ -70,9 +88,11 @@ ABSL_FLAG(int32_t, points, 0,
           "(one per salient region, at most 100)");
 
 // The scene.
-ABSL_FLAG(std::string, sensor, "",
-          "depth noise model: generic (chosen from the intrinsics, the "
-          "default) | kinect_v1 | active_stereo");
+ABSL_FLAG(
+    std::string, sensor, "",
+    absl::StrCat("depth noise model: ",
+                 fovea::client::NameList(*fovea::v1::SensorModel_descriptor()),
+                 " (default generic: chosen from the intrinsics)"));
 ABSL_FLAG(int32_t, processing_width, 0,
           "frames wider than this are processed reduced, pixels (0: the "
           "server's 640)");
@@ -90,7 +110,10 @@ ABSL_FLAG(double, max_depth, 0.0,
           "farthest depth considered, metres (0: the sensor's)");
 
 // Segmentation.
-ABSL_FLAG(std::string, method, "", "segment: cos | ebs");
+ABSL_FLAG(std::string, method, "",
+          absl::StrCat("segment: ",
+                       fovea::client::NameList(
+                           *fovea::v1::SegmentationMethod_descriptor())));
 ABSL_FLAG(int32_t, max_objects, 0, "segment: most objects, 0 = no limit");
 ABSL_FLAG(std::string, seeds, "",
           "segment: seed pixels 'u,v;u,v;...' used in this order instead of "
@@ -151,17 +174,10 @@ absl::StatusOr<std::vector<std::pair<uint32_t, uint32_t>>> ParseSeeds(
 
 // The scene options of the flags (the server validates the values).
 absl::Status SceneFromFlags(fovea::v1::SceneOptions& scene) {
-  const std::string sensor = absl::GetFlag(FLAGS_sensor);
-  if (sensor == "generic") {
-    scene.set_sensor(fovea::v1::SENSOR_MODEL_GENERIC);
-  } else if (sensor == "kinect_v1") {
-    scene.set_sensor(fovea::v1::SENSOR_MODEL_KINECT_V1);
-  } else if (sensor == "active_stereo") {
-    scene.set_sensor(fovea::v1::SENSOR_MODEL_ACTIVE_STEREO);
-  } else if (!sensor.empty()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("sensor: unknown model '", sensor,
-                     "' (known: generic kinect_v1 active_stereo)"));
+  if (const std::string sensor = absl::GetFlag(FLAGS_sensor); !sensor.empty()) {
+    FOVEA_ASSIGN_OR_RETURN(const fovea::v1::SensorModel model,
+                           ParseSensorModel(sensor));
+    scene.set_sensor(model);
   }
   if (absl::GetFlag(FLAGS_processing_width) < 0) {
     return absl::InvalidArgumentError("processing_width: must be >= 0");

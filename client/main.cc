@@ -31,6 +31,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
 #include "client/cli_frame.h"
@@ -74,7 +75,7 @@ constexpr int kExitFailure = 1;
 constexpr int kExitCallFailed = 2;
 constexpr int kExitUsage = 64;  // EX_USAGE
 
-constexpr char kUsage[] =
+constexpr char kUsageHead[] =
     R"(calls a Fovea perception server.
 
 usage: fovea-client [--server SERVERS] COMMAND [flags]
@@ -86,13 +87,9 @@ SERVING; one that fails with UNAVAILABLE before replying is retried on the
 next. health asks one replica (the next reachable one).
 
 commands:
-  health                 print the serving status; exit 0 when SERVING
-  capabilities           what the server accepts and offers
-  detect FRAME           attention points, most salient first
-  segment FRAME          object masks, streamed as each completes
-  segment-incremental FRAME
-                         anytime incremental segmentation, streamed
+)";
 
+constexpr char kUsageTail[] = R"(
 FRAME is one of
   --color C.png --depth D.png [--fx F --fy F --cx C --cy C] [--depth_scale S]
   --pcd scene.pcd        (OSD Kinect intrinsics unless given)
@@ -329,12 +326,54 @@ bool IsClientFlagFile(absl::string_view file) {
   return absl::StrContains(file, "client/");
 }
 
+// The commands, in the order the usage lists them; the usage and the
+// unknown-command error are made from this table.
+struct Command {
+  absl::string_view name;
+  absl::string_view arguments;  // after the name in the usage
+  absl::string_view summary;
+  int (*run)();
+};
+
+const std::vector<Command>& Commands() {
+  static const auto* const kCommands = new std::vector<Command>{
+      {"health", "", "print the serving status; exit 0 when SERVING",
+       &RunHealth},
+      {"capabilities", "", "what the server accepts and offers",
+       &RunCapabilities},
+      {"detect", "FRAME", "attention points, most salient first", &RunDetect},
+      {"segment", "FRAME", "object masks, streamed as each completes",
+       [] { return RunSegment(/*incremental=*/false); }},
+      {"segment-incremental", "FRAME",
+       "anytime incremental segmentation, streamed",
+       [] { return RunSegment(/*incremental=*/true); }},
+  };
+  return *kCommands;
+}
+
+std::string Usage() {
+  std::string usage = kUsageHead;
+  for (const Command& row : Commands()) {
+    std::string call = absl::StrCat("  ", row.name);
+    if (!row.arguments.empty()) absl::StrAppend(&call, " ", row.arguments);
+    constexpr size_t kColumn = 25;
+    if (call.size() + 1 > kColumn) {
+      absl::StrAppend(&usage, call, "\n", std::string(kColumn, ' '));
+    } else {
+      absl::StrAppend(&usage, call, std::string(kColumn - call.size(), ' '));
+    }
+    absl::StrAppend(&usage, row.summary, "\n");
+  }
+  return absl::StrCat(usage, kUsageTail);
+}
+
 }  // namespace
 }  // namespace fovea::client
 
 int main(int argc, char** argv) {
   using namespace fovea::client;  // NOLINT: main only
-  absl::SetProgramUsageMessage(kUsage);
+  const std::string usage = Usage();
+  absl::SetProgramUsageMessage(usage);
   absl::FlagsUsageConfig usage_config;
   usage_config.contains_help_flags = IsClientFlagFile;
   usage_config.contains_helpshort_flags = IsClientFlagFile;
@@ -346,7 +385,7 @@ int main(int argc, char** argv) {
 
   std::vector<char*> positional = absl::ParseCommandLine(argc, argv);
   if (positional.size() < 2) {
-    std::cerr << "fovea-client " << kUsage << "\n";
+    std::cerr << "fovea-client " << usage << "\n";
     return kExitUsage;
   }
   const std::string command = positional[1];
@@ -355,17 +394,16 @@ int main(int argc, char** argv) {
               << "\" after " << command << "\n";
     return kExitUsage;
   }
-  if (command == "health") return RunHealth();
-  if (command == "capabilities") return RunCapabilities();
-  if (command == "detect") return RunDetect();
-  if (command == "segment") return RunSegment(/*incremental=*/false);
-  if (command == "segment-incremental") return RunSegment(/*incremental=*/true);
   if (command == "help") {
-    std::cout << "fovea-client " << kUsage << "\n";
+    std::cout << "fovea-client " << usage << "\n";
     return kExitOk;
   }
-  std::cerr << "fovea-client: unknown command \"" << command
-            << "\" (health, capabilities, detect, segment, "
-               "segment-incremental)\n";
+  std::vector<absl::string_view> known;
+  for (const Command& row : Commands()) {
+    if (command == row.name) return row.run();
+    known.push_back(row.name);
+  }
+  std::cerr << "fovea-client: unknown command \"" << command << "\" ("
+            << absl::StrJoin(known, ", ") << ")\n";
   return kExitUsage;
 }

@@ -117,32 +117,28 @@ absl::StatusOr<fovea::v1::Extraction> ParseExtraction(absl::string_view text) {
 
 absl::StatusOr<fovea::v1::Pyramid> ParsePyramid(absl::string_view text) {
   static const auto* const kNames =
-      new NameTable<fovea::v1::Pyramid>{{"none", fovea::v1::PYRAMID_NONE},
-                                        {"simple", fovea::v1::PYRAMID_SIMPLE},
-                                        {"itti", fovea::v1::PYRAMID_ITTI}};
+      DescriptorNames<fovea::v1::Pyramid>(fovea::v1::Pyramid_descriptor());
   return Lookup("pyramid", text, *kNames);
 }
 
 absl::StatusOr<fovea::v1::Normalization> ParseNormalization(
     absl::string_view text) {
-  static const auto* const kNames = new NameTable<fovea::v1::Normalization>{
-      {"lin", fovea::v1::NORMALIZATION_LIN},
-      {"nms", fovea::v1::NORMALIZATION_NMS},
-      {"nlm", fovea::v1::NORMALIZATION_NLM}};
+  static const auto* const kNames = DescriptorNames<fovea::v1::Normalization>(
+      fovea::v1::Normalization_descriptor());
   return Lookup("norm", text, *kNames);
 }
 
 absl::StatusOr<fovea::v1::LevelCombination> ParseLevelCombination(
     absl::string_view text) {
-  static const auto* const kNames = new NameTable<fovea::v1::LevelCombination>{
-      {"sum", fovea::v1::LEVEL_COMBINATION_SUM},
-      {"max", fovea::v1::LEVEL_COMBINATION_MAX}};
+  static const auto* const kNames =
+      DescriptorNames<fovea::v1::LevelCombination>(
+          fovea::v1::LevelCombination_descriptor());
   return Lookup("combine", text, *kNames);
 }
 
 absl::StatusOr<fovea::v1::Fusion> ParseFusion(absl::string_view text) {
-  static const auto* const kNames = new NameTable<fovea::v1::Fusion>{
-      {"sum", fovea::v1::FUSION_SUM}, {"max", fovea::v1::FUSION_MAX}};
+  static const auto* const kNames =
+      DescriptorNames<fovea::v1::Fusion>(fovea::v1::Fusion_descriptor());
   return Lookup("fusion", text, *kNames);
 }
 
@@ -152,6 +148,23 @@ absl::StatusOr<fovea::v1::SegmentationMethod> ParseSegmentationMethod(
       DescriptorNames<fovea::v1::SegmentationMethod>(
           fovea::v1::SegmentationMethod_descriptor());
   return Lookup("method", text, *kNames);
+}
+
+absl::StatusOr<fovea::v1::SensorModel> ParseSensorModel(
+    absl::string_view text) {
+  static const auto* const kNames = DescriptorNames<fovea::v1::SensorModel>(
+      fovea::v1::SensorModel_descriptor());
+  return Lookup("sensor", text, *kNames);
+}
+
+std::string NameList(const google::protobuf::EnumDescriptor& type,
+                     absl::string_view separator) {
+  std::vector<std::string> names;
+  for (int i = 0; i < type.value_count(); ++i) {
+    const google::protobuf::EnumValueDescriptor* value = type.value(i);
+    if (value->number() != 0) names.push_back(fovea::v1::ShortEnumName(*value));
+  }
+  return absl::StrJoin(names, separator);
 }
 
 namespace {

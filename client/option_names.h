@@ -14,16 +14,17 @@
 namespace fovea::client {
 
 // Short, case-insensitive names for the enums of detect.proto and
-// segment.proto, as typed on a command line. Every parser returns
-// INVALID_ARGUMENT naming the unknown word and listing the known ones.
+// segment.proto, as typed on a command line: each value's name without its
+// prefix, in lower case, read from the contract's descriptors. Every parser
+// returns INVALID_ARGUMENT naming the unknown word and listing the known ones.
 // Nothing is checked against what a server implements: a server answers
 // UNIMPLEMENTED for what it has not built.
 
 // Saliency channels: names joined by '+', each optionally followed by
 // ":WEIGHT" (a number >= 0), e.g. "rso", "ph+sh+rso" (equal weights, 1 each),
-// "ph:2+rso:1". Names: ph, sh, rso, sym3d, itti, harel, hou, kootstra,
-// target_color, location_prior. An empty string gives an empty list (the
-// server's default channels). A name given twice is an error.
+// "ph:2+rso:1". Names: those of SaliencyOperator (NameList). An empty string
+// gives an empty list (the server's default channels). A name given twice is an
+// error.
 absl::StatusOr<std::vector<fovea::v1::WeightedOperator>> ParseSaliency(
     absl::string_view text);
 
@@ -42,6 +43,14 @@ absl::StatusOr<fovea::v1::Fusion> ParseFusion(absl::string_view text);
 // "cos", "ebs".
 absl::StatusOr<fovea::v1::SegmentationMethod> ParseSegmentationMethod(
     absl::string_view text);
+// "generic", "kinect_v1", "active_stereo".
+absl::StatusOr<fovea::v1::SensorModel> ParseSensorModel(absl::string_view text);
+
+// The names the parsers above accept for `type`'s values, in the
+// contract's order, joined by `separator` ("msr | wta | tj"): the flags'
+// help text is made of these, so it lists what the contract has.
+std::string NameList(const google::protobuf::EnumDescriptor& type,
+                     absl::string_view separator = " | ");
 
 // The colour the target_color operator looks for: "R,G,B", three integers
 // 0-255 ("200,30,30"); INVALID_ARGUMENT naming `flag` otherwise.

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/name_table.h"
 #include "core/base/strings.h"
 
 namespace fovea {
@@ -29,32 +30,23 @@ constexpr double kPrimeSenseFx640Min = 500.0;
 constexpr double kPrimeSenseFx640Max = 590.0;
 constexpr float kGenericMaxRange = 3.0f;
 
-struct NamedKind {
-  SensorKind kind;
-  std::string_view name;
-};
-constexpr NamedKind kKinds[] = {
-    {SensorKind::kGeneric, "generic"},
-    {SensorKind::kKinectV1, "kinect_v1"},
-    {SensorKind::kActiveStereo, "active_stereo"},
-};
-
 }  // namespace
 
+absl::Span<const NamedValue<SensorKind>> SensorKinds() {
+  static constexpr NamedValue<SensorKind> kTable[] = {
+      {SensorKind::kGeneric, "generic"},
+      {SensorKind::kKinectV1, "kinect_v1"},
+      {SensorKind::kActiveStereo, "active_stereo"},
+  };
+  return kTable;
+}
+
 std::string_view SensorKindName(SensorKind kind) {
-  for (const NamedKind& k : kKinds) {
-    if (k.kind == kind) return k.name;
-  }
-  return "unknown";
+  return NameOf(SensorKinds(), kind);
 }
 
 absl::StatusOr<SensorKind> ParseSensorKind(std::string_view text) {
-  for (const NamedKind& k : kKinds) {
-    if (k.name == text) return k.kind;
-  }
-  return absl::InvalidArgumentError(
-      absl::StrCat("sensor: unknown model '", AbslView(text),
-                   "' (known: generic kinect_v1 active_stereo)"));
+  return ParseNamed(SensorKinds(), "sensor", "model", text);
 }
 
 SensorModel SensorModelFor(SensorKind kind, const Intrinsics& intrinsics) {

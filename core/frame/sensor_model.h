@@ -4,6 +4,7 @@
 #include <string_view>
 
 #include "absl/status/statusor.h"
+#include "core/base/name_table.h"
 #include "core/frame/rgbd_frame.h"
 
 namespace fovea {
@@ -29,6 +30,8 @@ enum class SensorKind {
 };
 
 // "generic", "kinect_v1", "active_stereo".
+// The kinds' names (core/base/name_table.h): generic kinect_v1 active_stereo.
+absl::Span<const NamedValue<SensorKind>> SensorKinds();
 std::string_view SensorKindName(SensorKind kind);
 // The inverse of SensorKindName; INVALID_ARGUMENT listing the known names.
 absl::StatusOr<SensorKind> ParseSensorKind(std::string_view text);

@@ -15,6 +15,7 @@
 #include "core/attention/tj.h"
 #include "core/attention/wta.h"
 #include "core/base/interrupt.h"
+#include "core/base/name_table.h"
 #include "core/base/stage_clock.h"
 #include "core/frame/frame_scale.h"
 #include "core/frame/hole_filling.h"
@@ -81,6 +82,14 @@ absl::Span<const Extraction> Extractions();
 std::string_view SaliencyOpName(SaliencyOp op);        // "ph", "sym3d", ...
 std::string_view ExtractionName(ExtractionKind kind);  // "msr", "wta", "tj"
 std::string_view PyramidName(PyramidKind kind);  // "none", "simple", "itti"
+// Each small option's table of names (core/base/name_table.h), read by its
+// parser below and by the tools' help text.
+absl::Span<const NamedValue<PyramidKind>> PyramidKinds();
+absl::Span<const NamedValue<LevelCombination>> LevelCombinations();
+absl::Span<const NamedValue<NormalizationKind>> NormalizationKinds();
+absl::Span<const NamedValue<FusionKind>> FusionKinds();
+// The names of Extractions(), joined by `separator`: "msr wta tj".
+std::string ExtractionNames(std::string_view separator = " ");
 // Parses "ph", "ph+sh+rso", ... into equally weighted channels.
 absl::StatusOr<std::vector<SaliencyOp>> ParseSaliencyOps(std::string_view text);
 absl::StatusOr<ExtractionKind> ParseExtraction(std::string_view text);

@@ -6,6 +6,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "core/base/name_table.h"
 #include "core/base/strings.h"
 #include "core/pipeline/detect.h"
 #include "core/pipeline/saliency_registry.h"
@@ -49,15 +50,7 @@ std::string_view ExtractionName(ExtractionKind kind) {
 }
 
 std::string_view PyramidName(PyramidKind kind) {
-  switch (kind) {
-    case PyramidKind::kNone:
-      return "none";
-    case PyramidKind::kSimple:
-      return "simple";
-    case PyramidKind::kItti:
-      return "itti";
-  }
-  return "unknown";
+  return NameOf(PyramidKinds(), kind);
 }
 
 std::string ChannelsText(const std::vector<WeightedChannel>& channels) {
@@ -86,45 +79,65 @@ absl::StatusOr<std::vector<SaliencyOp>> ParseSaliencyOps(
 }
 
 absl::StatusOr<ExtractionKind> ParseExtraction(std::string_view text) {
-  std::string known;
   for (const Extraction& row : kExtractions) {
     if (row.name == text) return row.kind;
-    absl::StrAppend(&known, known.empty() ? "" : " ", AbslView(row.name));
   }
-  return absl::InvalidArgumentError(absl::StrCat(
-      "extract: unknown strategy '", AbslView(text), "' (known: ", known, ")"));
+  return absl::InvalidArgumentError(
+      absl::StrCat("extract: unknown strategy '", AbslView(text),
+                   "' (known: ", ExtractionNames(), ")"));
+}
+
+absl::Span<const NamedValue<PyramidKind>> PyramidKinds() {
+  static constexpr NamedValue<PyramidKind> kTable[] = {
+      {PyramidKind::kNone, "none"},
+      {PyramidKind::kSimple, "simple"},
+      {PyramidKind::kItti, "itti"}};
+  return kTable;
+}
+
+absl::Span<const NamedValue<LevelCombination>> LevelCombinations() {
+  static constexpr NamedValue<LevelCombination> kTable[] = {
+      {LevelCombination::kSum, "sum"}, {LevelCombination::kMax, "max"}};
+  return kTable;
+}
+
+absl::Span<const NamedValue<NormalizationKind>> NormalizationKinds() {
+  static constexpr NamedValue<NormalizationKind> kTable[] = {
+      {NormalizationKind::kLin, "lin"},
+      {NormalizationKind::kNms, "nms"},
+      {NormalizationKind::kNlm, "nlm"}};
+  return kTable;
+}
+
+absl::Span<const NamedValue<FusionKind>> FusionKinds() {
+  static constexpr NamedValue<FusionKind> kTable[] = {
+      {FusionKind::kSum, "sum"}, {FusionKind::kMax, "max"}};
+  return kTable;
+}
+
+std::string ExtractionNames(std::string_view separator) {
+  std::string names;
+  for (const Extraction& row : kExtractions) {
+    absl::StrAppend(&names, names.empty() ? "" : AbslView(separator),
+                    AbslView(row.name));
+  }
+  return names;
 }
 
 absl::StatusOr<PyramidKind> ParsePyramid(std::string_view text) {
-  if (text == "none") return PyramidKind::kNone;
-  if (text == "simple") return PyramidKind::kSimple;
-  if (text == "itti") return PyramidKind::kItti;
-  return absl::InvalidArgumentError(
-      absl::StrCat("pyramid: unknown kind '", AbslView(text),
-                   "' (known: none simple itti)"));
+  return ParseNamed(PyramidKinds(), "pyramid", "kind", text);
 }
 
 absl::StatusOr<LevelCombination> ParseLevelCombination(std::string_view text) {
-  if (text == "sum") return LevelCombination::kSum;
-  if (text == "max") return LevelCombination::kMax;
-  return absl::InvalidArgumentError(absl::StrCat(
-      "combine: unknown combination '", AbslView(text), "' (known: sum max)"));
+  return ParseNamed(LevelCombinations(), "combine", "combination", text);
 }
 
 absl::StatusOr<NormalizationKind> ParseNormalization(std::string_view text) {
-  if (text == "lin") return NormalizationKind::kLin;
-  if (text == "nms") return NormalizationKind::kNms;
-  if (text == "nlm") return NormalizationKind::kNlm;
-  return absl::InvalidArgumentError(
-      absl::StrCat("norm: unknown normalisation '", AbslView(text),
-                   "' (known: lin nms nlm)"));
+  return ParseNamed(NormalizationKinds(), "norm", "normalisation", text);
 }
 
 absl::StatusOr<FusionKind> ParseFusion(std::string_view text) {
-  if (text == "sum") return FusionKind::kSum;
-  if (text == "max") return FusionKind::kMax;
-  return absl::InvalidArgumentError(absl::StrCat(
-      "fusion: unknown fusion '", AbslView(text), "' (known: sum max)"));
+  return ParseNamed(FusionKinds(), "fusion", "fusion", text);
 }
 
 }  // namespace fovea

@@ -16,9 +16,12 @@
 #include "absl/flags/usage.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
+#include "core/frame/sensor_model.h"
 #include "core/pipeline/detect.h"
 #include "core/pipeline/models.h"
+#include "core/pipeline/saliency_registry.h"
 #include "core/segmentation/svm_training.h"
 #include "core/synth/synth_scene.h"
 #ifdef FOVEA_EVAL_REPLAY
@@ -31,6 +34,7 @@
 #include "tools/eval/raw_frame_eval.h"
 #include "tools/eval/room_eval.h"
 #include "tools/eval/scene_kind.h"
+#include "tools/eval/scene_runner.h"
 #include "tools/eval/scorecard.h"
 #include "tools/eval/sweep.h"
 
@@ -39,12 +43,14 @@ ABSL_FLAG(std::string, data, "",
           "Defaults to $FOVEA_OSD_DIR.");
 ABSL_FLAG(std::string, saliency,
           fovea::ChannelsText(fovea::DetectOptions().channels),
-          "Saliency channels: ph, sh, rso, or a combination like ph+sh+rso "
-          "(equal weights); or pcl-clusters, the peer: Euclidean clusters on "
-          "the support plane, largest first (ignores --extract).");
+          absl::StrCat("Saliency channels: ", fovea::SaliencyOperatorNames(),
+                       ", or a combination like ph+sh+rso (equal weights); or "
+                       "pcl-clusters, the peer: Euclidean clusters on the "
+                       "support plane, largest first (ignores --extract)."));
 ABSL_FLAG(std::string, extract,
           std::string(fovea::ExtractionName(fovea::DetectOptions().extraction)),
-          "Attention-point extraction: msr, wta or tj.");
+          absl::StrCat("Attention-point extraction: ",
+                       fovea::ExtractionNames(", "), "."));
 ABSL_FLAG(int, points, fovea::DetectOptions().max_points,
           "Attention points per scene at most. HR counts the first "
           "max(K, 10) of them for a scene of K objects, as the thesis's "
@@ -52,11 +58,18 @@ ABSL_FLAG(int, points, fovea::DetectOptions().max_points,
           "point returned.");
 ABSL_FLAG(std::string, pyramid,
           std::string(fovea::PyramidName(fovea::DetectOptions().pyramid)),
-          "Pyramid: none, simple or itti.");
+          absl::StrCat("Pyramid: ",
+                       fovea::NameList(fovea::PyramidKinds(), ", "), "."));
 ABSL_FLAG(std::string, combine, "sum",
-          "Across-scale combination with a pyramid: sum or max.");
-ABSL_FLAG(std::string, norm, "lin", "Map normalisation: lin, nms or nlm.");
-ABSL_FLAG(std::string, fusion, "sum", "Channel fusion: sum or max.");
+          absl::StrCat("Across-scale combination with a pyramid: ",
+                       fovea::NameList(fovea::LevelCombinations(), ", "), "."));
+ABSL_FLAG(std::string, norm, "lin",
+          absl::StrCat("Map normalisation: ",
+                       fovea::NameList(fovea::NormalizationKinds(), ", "),
+                       "."));
+ABSL_FLAG(std::string, fusion, "sum",
+          absl::StrCat("Channel fusion: ",
+                       fovea::NameList(fovea::FusionKinds(), ", "), "."));
 ABSL_FLAG(int, sym3d_level, fovea::DetectOptions().sym3d_level,
           "Pyramid level SYM3D runs on without a pyramid.");
 ABSL_FLAG(int, sym3d_kernel, fovea::DetectOptions().sym3d.kernel_size,
@@ -92,8 +105,9 @@ ABSL_FLAG(bool, fill_holes, false,
           "(thesis section 2.2).");
 ABSL_FLAG(std::string, sensor,
           std::string(fovea::SensorKindName(fovea::SceneOptions().sensor)),
-          "Depth noise model the thresholds follow: generic (from the "
-          "intrinsics), kinect_v1 or active_stereo.");
+          absl::StrCat("Depth noise model the thresholds follow: ",
+                       fovea::NameList(fovea::SensorKinds(), ", "),
+                       " (generic: chosen from the intrinsics)."));
 ABSL_FLAG(int, processing_width, fovea::SceneOptions().processing_width,
           "Frames wider than this are processed reduced, pixels.");
 ABSL_FLAG(bool, json, false,
@@ -107,14 +121,17 @@ ABSL_FLAG(std::string, out, "",
           "points numbered) into this folder.");
 ABSL_FLAG(bool, verbose, false, "One line per scene on stderr.");
 ABSL_FLAG(std::string, method, "cos",
-          "segment: cos, ebs, inc, a peer (pcl-euclidean, pcl-lccp), several "
-          "of them comma-separated (one run, side by side), or all.");
+          absl::StrCat("segment: ",
+                       fovea::NameList(fovea::eval::SceneMethods(), ", "),
+                       "; several of them comma-separated (one run, side by "
+                       "side), or all."));
 ABSL_FLAG(std::string, inc_saliency, "sym3d",
           "segment --method inc: sym3d (Detect's map, F from one run) or "
           "random-points (per object 5 sequences of 5 points, section 3.3.3).");
 ABSL_FLAG(std::string, seeds, "",
-          "segment: where the seeds come from, tj, wta or msr (Detect's "
-          "extraction; overrides --extract).");
+          absl::StrCat("segment: where the seeds come from, ",
+                       fovea::ExtractionNames(", "),
+                       " (Detect's extraction; overrides --extract)."));
 ABSL_FLAG(int, folds, 0,
           "segment: 0 scores the models as shipped (--models); K >= 2 "
           "cross-validates instead: scene i is scored with models trained on "
@@ -131,7 +148,9 @@ ABSL_FLAG(int, piles, 0,
           "household objects each, seeds from --seed) instead of --data.");
 ABSL_FLAG(uint64_t, seed, 1, "rooms: the first room's seed.");
 ABSL_FLAG(std::string, room_sensors, "kinect_v1,active_stereo",
-          "rooms: sensor noise models to render with, comma-separated.");
+          absl::StrCat("rooms: sensor noise models to render with, "
+                       "comma-separated (",
+                       fovea::NameList(fovea::SensorKinds(), ", "), ")."));
 ABSL_FLAG(std::string, sizes, "640x480",
           "rooms: resolutions, comma-separated WxH (e.g. 640x480,1280x720).");
 ABSL_FLAG(std::string, models, FOVEA_DEFAULT_MODELS_DIR,
@@ -148,55 +167,112 @@ ABSL_FLAG(std::string, filter, "",
 
 #include "tools/eval/commands.h"
 
+namespace fovea::eval {
+namespace {
+
+// The commands in the order the usage lists them; the usage and the
+// unknown-command error are made from this table, and the lists of names
+// in it from core's tables (name_table.h), so they say what is built.
+struct Command {
+  std::string_view name;
+  std::string arguments;  // after the name in the usage
+  std::string_view summary;
+  int (*run)(const std::vector<char*>& args);
+};
+
+std::string Alternatives(const std::string& names) {
+  return absl::StrJoin(absl::StrSplit(names, ' ', absl::SkipEmpty()), "|");
+}
+
+#ifdef FOVEA_EVAL_REPLAY
+int RunReplayCommand(const std::vector<char*>& args) {
+  ReplayOptions options;
+  options.server = absl::GetFlag(FLAGS_server);
+  return RunReplay(args.size() > 2 ? args[2] : "", options,
+                   absl::GetFlag(FLAGS_json),
+                   absl::GetFlag(FLAGS_fail_on_change));
+}
+#endif
+
+std::vector<Command> Commands() {
+  const std::string extractions = Alternatives(ExtractionNames());
+  return {
+      {"detect",
+       absl::StrCat("--data DIR [--saliency ",
+                    Alternatives(SaliencyOperatorNames()),
+                    "|ph+sh+rso|pcl-clusters|...] [--pyramid ",
+                    NameList(PyramidKinds(), "|"), "] [--combine ",
+                    NameList(LevelCombinations(), "|"), "] [--norm ",
+                    NameList(NormalizationKinds(), "|"), "] [--extract ",
+                    extractions, "] [--json] [--out DIR]"),
+       "attention points against the labels (Tables 2.4/2.5)",
+       [](const std::vector<char*>&) { return RunDetectEval(); }},
+      {"sweep", "--data DIR --out DIR [--filter TEXT]",
+       "the grid of Tables 2.4/2.5 as Markdown and CSV",
+       [](const std::vector<char*>&) { return RunSweepCommand(); }},
+      {"segment",
+       absl::StrCat("--method ", NameList(SceneMethods(), "|"),
+                    " --data DIR [--seeds ", extractions,
+                    "] [--inc_saliency sym3d|random-points] [--folds 5] "
+                    "[--json] [--out DIR]"),
+       "Table 3.1; --folds cross-validates",
+       [](const std::vector<char*>&) { return RunSegmentEval(); }},
+      {"rooms",
+       absl::StrCat("[--count 200] [--seed 1] [--room_sensors ",
+                    NameList(SensorKinds(), ","),
+                    "] [--sizes 640x480,1280x720] [--method ",
+                    NameList(SceneMethods(), "|"),
+                    "] [--models DIR] [--json] [--out DIR]"),
+       "synthetic rooms, held out: support, recall, false objects",
+       [](const std::vector<char*>&) { return RunRoomsCommand(); }},
+      {"raw",
+       absl::StrCat("--data DIR [--method ", NameList(SceneMethods(), "|"),
+                    "]"),
+       "each raw frames/<scene>_*.png against its cropped learn/<scene>.pcd",
+       [](const std::vector<char*>&) { return RunRawCommand(); }},
+#ifdef FOVEA_EVAL_REPLAY
+      {"replay", "DIR --server HOST:PORT [--json] [--fail_on_change]",
+       "the calls fovea-server --record_dir kept, sent again: points moved, "
+       "masks' IoU, objects found or lost, time",
+       &RunReplayCommand},
+#endif
+      {"scorecard",
+       "[--short] [--sets osd,...] [--methods inc,cos] [--baseline "
+       "docs/scorecard.json] [--write_json F] [--out DIR]",
+       "every kind of scene in one table; exit 3 when a figure fell below "
+       "the baseline",
+       [](const std::vector<char*>&) { return RunScorecardCommand(); }},
+  };
+}
+
+std::string Usage() {
+  std::string usage = "Quality figures on labelled and synthetic scenes.\n";
+  for (const Command& row : Commands()) {
+    absl::StrAppend(&usage, "  fovea-eval ", AbslView(row.name), " ",
+                    row.arguments, "\n      (", AbslView(row.summary), ")\n");
+  }
+  return usage;
+}
+
+}  // namespace
+}  // namespace fovea::eval
+
 int main(int argc, char** argv) {
-  absl::SetProgramUsageMessage(
-      "Detection quality on labelled OSD scenes.\n"
-      "  fovea-eval detect --data DIR [--saliency ph|sh|rso|sym3d|ph+sh+rso|"
-      "pcl-clusters|...] [--pyramid none|simple|itti] [--combine sum|max] "
-      "[--norm lin|nms|nlm] [--extract wta|msr|tj] [--json] [--out DIR]\n"
-      "  fovea-eval sweep --data DIR --out DIR [--filter TEXT]   (the grid "
-      "of Tables 2.4/2.5 as Markdown and CSV)\n"
-      "  fovea-eval segment --method cos|ebs|inc --data DIR [--seeds "
-      "tj|wta|msr] "
-      "[--inc_saliency sym3d|random-points] "
-      "[--folds 5] [--json] [--out DIR]   (Table 3.1, cross-validated)\n"
-      "  fovea-eval rooms [--count 200] [--seed 1] [--room_sensors "
-      "kinect_v1,active_stereo] [--sizes 640x480,1280x720] [--method "
-      "inc|cos|ebs|pcl-lccp|pcl-euclidean] [--models DIR] [--json] [--out "
-      "DIR]   (synthetic rooms, held out: support, recall, false objects)\n"
-      "  fovea-eval raw --data DIR [--method inc|cos|...]   (each raw "
-      "frames/<scene>_*.png against its cropped learn/<scene>.pcd)\n"
-      "  fovea-eval replay DIR --server HOST:PORT [--json] "
-      "[--fail_on_change]   (the calls fovea-server --record_dir kept, sent "
-      "again: points moved, masks' IoU, objects found or lost, time)\n"
-      "  fovea-eval scorecard [--short] [--sets osd,...] [--methods inc,cos] "
-      "[--baseline docs/scorecard.json] [--write_json F] [--out DIR]   "
-      "(every kind of scene in one table; exit 3 when a figure fell below "
-      "the baseline)");
+  const std::string usage = fovea::eval::Usage();
+  absl::SetProgramUsageMessage(usage);
   std::vector<char*> args = absl::ParseCommandLine(argc, argv);
   if (args.size() < 2) {
-    std::fprintf(stderr, "%s\n",
-                 std::string(absl::ProgramUsageMessage()).c_str());
+    std::fprintf(stderr, "%s\n", usage.c_str());
     return fovea::eval::kUsageError;
   }
   const std::string command = args[1];
-  if (command == "detect") return fovea::eval::RunDetectEval();
-  if (command == "sweep") return fovea::eval::RunSweepCommand();
-  if (command == "segment") return fovea::eval::RunSegmentEval();
-  if (command == "rooms") return fovea::eval::RunRoomsCommand();
-  if (command == "raw") return fovea::eval::RunRawCommand();
-  if (command == "scorecard") return fovea::eval::RunScorecardCommand();
-#ifdef FOVEA_EVAL_REPLAY
-  if (command == "replay") {
-    fovea::eval::ReplayOptions options;
-    options.server = absl::GetFlag(FLAGS_server);
-    return fovea::eval::RunReplay(args.size() > 2 ? args[2] : "", options,
-                                  absl::GetFlag(FLAGS_json),
-                                  absl::GetFlag(FLAGS_fail_on_change));
+  std::vector<absl::string_view> known;
+  for (const fovea::eval::Command& row : fovea::eval::Commands()) {
+    if (command == row.name) return row.run(args);
+    known.push_back(fovea::AbslView(row.name));
   }
-#endif
-  std::fprintf(stderr, "fovea-eval: unknown command '%s'\n%s\n",
-               command.c_str(),
-               std::string(absl::ProgramUsageMessage()).c_str());
+  std::fprintf(stderr, "fovea-eval: unknown command '%s' (%s)\n%s\n",
+               command.c_str(), absl::StrJoin(known, ", ").c_str(),
+               usage.c_str());
   return fovea::eval::kUsageError;
 }

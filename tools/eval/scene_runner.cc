@@ -40,18 +40,6 @@ cv::Point CentralPixel(const cv::Mat& mask) {
   return best;
 }
 
-struct NamedMethod {
-  SceneMethod method;
-  std::string_view name;
-};
-constexpr NamedMethod kMethods[] = {
-    {SceneMethod::kInc, "inc"},
-    {SceneMethod::kCos, "cos"},
-    {SceneMethod::kEbs, "ebs"},
-    {SceneMethod::kPclLccp, "pcl-lccp"},
-    {SceneMethod::kPclEuclidean, "pcl-euclidean"},
-};
-
 absl::StatusOr<SceneRun> RunPeer(const LabelledFrame& scene,
                                  SceneMethod method) {
   SceneRun run;
@@ -76,20 +64,23 @@ absl::StatusOr<SceneRun> RunPeer(const LabelledFrame& scene,
 
 }  // namespace
 
+absl::Span<const NamedValue<SceneMethod>> SceneMethods() {
+  static constexpr NamedValue<SceneMethod> kTable[] = {
+      {SceneMethod::kInc, "inc"},
+      {SceneMethod::kCos, "cos"},
+      {SceneMethod::kEbs, "ebs"},
+      {SceneMethod::kPclLccp, "pcl-lccp"},
+      {SceneMethod::kPclEuclidean, "pcl-euclidean"},
+  };
+  return kTable;
+}
+
 std::string_view SceneMethodName(SceneMethod method) {
-  for (const NamedMethod& m : kMethods) {
-    if (m.method == method) return m.name;
-  }
-  return "unknown";
+  return NameOf(SceneMethods(), method);
 }
 
 absl::StatusOr<SceneMethod> ParseSceneMethod(std::string_view text) {
-  for (const NamedMethod& m : kMethods) {
-    if (m.name == text) return m.method;
-  }
-  return absl::InvalidArgumentError(
-      absl::StrCat("unknown method '", AbslView(text),
-                   "' (known: inc cos ebs pcl-lccp pcl-euclidean)"));
+  return ParseNamed(SceneMethods(), "", "method", text);
 }
 
 absl::StatusOr<SceneRun> RunOnScene(const LabelledFrame& scene,

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/base/name_table.h"
 #include "core/eval/segmentation_metrics.h"
 #include "core/frame/osd_pcd.h"
 #include "core/pipeline/detect.h"
@@ -20,7 +21,8 @@ namespace fovea::eval {
 // evaluations (rooms, piles, any folder) score.
 enum class SceneMethod { kInc, kCos, kEbs, kPclLccp, kPclEuclidean };
 
-// "inc", "cos", "ebs", "pcl-lccp", "pcl-euclidean".
+// "inc", "cos", "ebs", "pcl-lccp", "pcl-euclidean" (core/base/name_table.h).
+absl::Span<const NamedValue<SceneMethod>> SceneMethods();
 std::string_view SceneMethodName(SceneMethod method);
 absl::StatusOr<SceneMethod> ParseSceneMethod(std::string_view text);
 
