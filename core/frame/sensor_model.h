@@ -29,7 +29,6 @@ enum class SensorKind {
   kActiveStereo,
 };
 
-// "generic", "kinect_v1", "active_stereo".
 // The kinds' names (core/base/name_table.h): generic kinect_v1 active_stereo.
 absl::Span<const NamedValue<SensorKind>> SensorKinds();
 std::string_view SensorKindName(SensorKind kind);

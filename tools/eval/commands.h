@@ -29,6 +29,7 @@ int RunSegmentEval();   // segment_command.cc
 int RunRoomsCommand();  // rooms_command.cc
 int RunRawCommand();    // rooms_command.cc
 int RunSweepCommand();  // rooms_command.cc
+int RunTrackCommand();  // track_command.cc
 
 }  // namespace fovea::eval
 

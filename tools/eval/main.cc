@@ -27,6 +27,7 @@
 #ifdef FOVEA_EVAL_REPLAY
 #include "tools/eval/replay.h"
 #endif
+#include "core/synth/sequence.h"
 #include "tools/eval/detect_eval.h"
 #include "tools/eval/inc_eval.h"
 #include "tools/eval/json_lines.h"
@@ -142,7 +143,8 @@ ABSL_FLAG(bool, cover_scene, true,
           "objects); false: the attention points' objects only.");
 ABSL_FLAG(double, svm_c, fovea::LinearSvmTrainingOptions().c,
           "segment: the COS SVM's soft-margin penalty C.");
-ABSL_FLAG(int, count, 200, "rooms: rooms per sensor and size.");
+ABSL_FLAG(int, count, 200,
+          "rooms: rooms per sensor and size; track: sequences per kind.");
 ABSL_FLAG(int, piles, 0,
           "detect / segment: evaluate on this many synthetic piles (8-16 "
           "household objects each, seeds from --seed) instead of --data.");
@@ -161,6 +163,14 @@ ABSL_FLAG(std::string, server, "",
           "fovea-client target).");
 ABSL_FLAG(bool, fail_on_change, false,
           "replay: exit 3 when any record's answer changed.");
+ABSL_FLAG(int, track_frames, 12, "track: frames per sequence.");
+ABSL_FLAG(std::string, kinds, "",
+          absl::StrCat("track: sequence kinds, comma-separated (",
+                       fovea::NameList(fovea::synth::SequenceKinds(), ", "),
+                       "); empty: all."));
+ABSL_FLAG(bool, pose, true,
+          "track: send each frame's camera pose (false: the tracker "
+          "anchors on the scene alone).");
 ABSL_FLAG(std::string, filter, "",
           "sweep: only the rows whose label saliency/pyramid/combine/norm/"
           "extract contains this.");
@@ -236,6 +246,13 @@ std::vector<Command> Commands() {
        "masks' IoU, objects found or lost, time",
        &RunReplayCommand},
 #endif
+      {"track",
+       absl::StrCat("[--kinds ", NameList(synth::SequenceKinds(), ","),
+                    "] [--count 20] [--track_frames 12] [--seed 1] "
+                    "[--pose=false] [--json]"),
+       "synthetic frame streams with identities: IDF1, switches, overlap F "
+       "beside single-frame INC, cost per frame",
+       [](const std::vector<char*>&) { return RunTrackCommand(); }},
       {"scorecard",
        "[--short] [--sets osd,...] [--methods inc,cos] [--baseline "
        "docs/scorecard.json] [--write_json F] [--out DIR]",

@@ -1,0 +1,501 @@
+#include "core/track/tracker.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <opencv2/imgproc.hpp>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
+#include "core/eval/hungarian.h"
+#include "core/frame/sensor_model.h"
+
+namespace fovea {
+namespace {
+
+Eigen::Vector3f ToWorld(const std::optional<Eigen::Isometry3f>& pose,
+                        const Eigen::Vector3f& p) {
+  return pose ? Eigen::Vector3f(*pose * p) : p;
+}
+
+float LargestExtent(const SegmentedObject& object) {
+  return object.extent.maxCoeff();
+}
+
+// The median of each coordinate of `v` (zero when empty).
+Eigen::Vector3f CoordinateMedian(std::vector<Eigen::Vector3f> v) {
+  Eigen::Vector3f m = Eigen::Vector3f::Zero();
+  if (v.empty()) return m;
+  for (int axis = 0; axis < 3; ++axis) {
+    auto mid = v.begin() + static_cast<ptrdiff_t>(v.size() / 2);
+    std::nth_element(
+        v.begin(), mid, v.end(),
+        [axis](const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
+          return a[axis] < b[axis];
+        });
+    m[axis] = (*mid)[axis];
+  }
+  return m;
+}
+
+// Whether masks `a` and `b` (CV_8UC1, same size) touch: `a` grown by
+// `radius` pixels overlaps `b`.
+bool Touch(const cv::Mat& a, const cv::Rect& a_box, const cv::Mat& b,
+           const cv::Rect& b_box, int radius) {
+  const cv::Rect grown =
+      cv::Rect(a_box.x - radius, a_box.y - radius, a_box.width + 2 * radius,
+               a_box.height + 2 * radius) &
+      cv::Rect(0, 0, a.cols, a.rows);
+  const cv::Rect both = grown & b_box;
+  if (both.empty()) return false;
+  cv::Mat dilated;
+  cv::dilate(a(grown), dilated,
+             cv::getStructuringElement(
+                 cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1)));
+  const cv::Rect local(both.x - grown.x, both.y - grown.y, both.width,
+                       both.height);
+  cv::Mat overlap;
+  cv::bitwise_and(dilated(local), b(both), overlap);
+  return cv::countNonZero(overlap) > 0;
+}
+
+// Adds `piece` to `into`: the union of the masks, the box and area of the
+// union, the area-weighted centroid, the larger extent.
+void Join(const SegmentedObject& piece, SegmentedObject& into) {
+  const double total = static_cast<double>(into.area) + piece.area;
+  if (total > 0) {
+    into.centroid = ((into.centroid * static_cast<float>(into.area)) +
+                     (piece.centroid * static_cast<float>(piece.area))) /
+                    static_cast<float>(total);
+  }
+  into.extent = into.extent.cwiseMax(piece.extent);
+  cv::bitwise_or(into.mask, piece.mask, into.mask);
+  into.box = into.box | piece.box;
+  into.area = cv::countNonZero(into.mask);
+  into.geometry.reset();  // the pieces' boxes are not the whole's
+  into.point_indices.insert(into.point_indices.end(),
+                            piece.point_indices.begin(),
+                            piece.point_indices.end());
+  into.points.insert(into.points.end(), piece.points.begin(),
+                     piece.points.end());
+}
+
+int StateOrder(TrackState state) {
+  switch (state) {
+    case TrackState::kAppeared:
+      return 0;
+    case TrackState::kMoved:
+      return 1;
+    case TrackState::kKept:
+      return 2;
+    case TrackState::kGone:
+      return 3;
+  }
+  return 4;
+}
+
+}  // namespace
+
+std::string_view TrackStateName(TrackState state) {
+  switch (state) {
+    case TrackState::kAppeared:
+      return "appeared";
+    case TrackState::kKept:
+      return "kept";
+    case TrackState::kMoved:
+      return "moved";
+    case TrackState::kGone:
+      return "gone";
+  }
+  return "unknown";
+}
+
+absl::Status Validate(const TrackerOptions& options) {
+  FOVEA_RETURN_IF_ERROR(Validate(options.segment));
+  const auto positive = [](std::string_view name, double value) {
+    if (std::isfinite(value) && value > 0.0) return absl::OkStatus();
+    return absl::InvalidArgumentError(
+        absl::StrCat("track.", AbslView(name), ": ", value, " is not > 0"));
+  };
+  FOVEA_RETURN_IF_ERROR(positive("change_sigmas", options.change_sigmas));
+  FOVEA_RETURN_IF_ERROR(positive("change_min_m", options.change_min_m));
+  FOVEA_RETURN_IF_ERROR(positive("color_change", options.color_change));
+  FOVEA_RETURN_IF_ERROR(positive("still_m", options.still_m));
+  FOVEA_RETURN_IF_ERROR(positive("still_rad", options.still_rad));
+  FOVEA_RETURN_IF_ERROR(positive("match_m", options.match_m));
+  FOVEA_RETURN_IF_ERROR(positive("moved_m", options.moved_m));
+  FOVEA_RETURN_IF_ERROR(positive("joint_motion_m", options.joint_motion_m));
+  if (!(options.static_fraction >= 0.0 && options.static_fraction < 1.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("track.static_fraction: ", options.static_fraction,
+                     " is not in [0, 1)"));
+  }
+  if (!(options.match_extent_fraction >= 0.0f)) {
+    return absl::InvalidArgumentError(
+        "track.match_extent_fraction: must be >= 0");
+  }
+  if (options.remember_frames < 0) {
+    return absl::InvalidArgumentError("track.remember_frames: must be >= 0");
+  }
+  return absl::OkStatus();
+}
+
+Tracker::Tracker(const TrackerOptions& options, const RbfSvm* relation_svm)
+    : options_(options), relation_svm_(relation_svm) {}
+
+double Tracker::ChangedFraction(const RgbdFrame& frame) const {
+  const bool colors = !frame.color.empty() && !reference_.color.empty() &&
+                      frame.color.size() == reference_.color.size() &&
+                      frame.color.type() == CV_8UC3 &&
+                      reference_.color.type() == CV_8UC3;
+  cv::Mat changed(frame.depth.size(), CV_8UC1, cv::Scalar(0));
+  int64_t valid = 0;
+  for (int v = 0; v < frame.depth.rows; ++v) {
+    const float* z = frame.depth.ptr<float>(v);
+    const float* z0 = reference_.depth.ptr<float>(v);
+    const cv::Vec3b* c = colors ? frame.color.ptr<cv::Vec3b>(v) : nullptr;
+    const cv::Vec3b* c0 = colors ? reference_.color.ptr<cv::Vec3b>(v) : nullptr;
+    uint8_t* out = changed.ptr<uint8_t>(v);
+    for (int u = 0; u < frame.depth.cols; ++u) {
+      const bool has = z[u] > 0.0f;  // false for NaN
+      const bool had = z0[u] > 0.0f;
+      if (!has && !had) continue;
+      ++valid;
+      // Depth that came or went counts as a change: an object placed on a
+      // dark table, or taken away, may show as exactly that.
+      bool moved = has != had;
+      if (!moved) {
+        const float limit =
+            std::max(options_.change_min_m,
+                     options_.change_sigmas * sensor_.DepthSigma(z0[u]));
+        moved = std::abs(z[u] - z0[u]) > limit;
+      }
+      if (!moved && colors) {
+        for (int k = 0; k < 3; ++k) {
+          moved |= std::abs(static_cast<int>(c[u][k]) - c0[u][k]) >
+                   options_.color_change;
+        }
+      }
+      out[u] = moved ? 255 : 0;
+    }
+  }
+  // Noise changes single pixels and the rims of depth edges (dropouts come
+  // and go there); a real change is a region: what survives an opening.
+  cv::morphologyEx(changed, changed, cv::MORPH_OPEN,
+                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5)));
+  return valid == 0 ? 1.0
+                    : static_cast<double>(cv::countNonZero(changed)) / valid;
+}
+
+bool Tracker::CameraStill(const std::optional<Eigen::Isometry3f>& pose) const {
+  if (pose.has_value() != reference_pose_.has_value()) return false;
+  if (!pose) return true;  // the pixels decide
+  const Eigen::Isometry3f delta = reference_pose_->inverse() * *pose;
+  const float angle = Eigen::AngleAxisf(delta.rotation()).angle();
+  return delta.translation().norm() <= options_.still_m &&
+         std::abs(angle) <= options_.still_rad;
+}
+
+absl::StatusOr<TrackedFrame> Tracker::Process(
+    const RgbdFrame& frame,
+    const std::optional<Eigen::Isometry3f>& camera_to_world,
+    const InterruptCheck& interrupt) {
+  FOVEA_RETURN_IF_ERROR(Validate(options_));
+  const SteadyClock::time_point start = SteadyClock::now();
+  TrackedFrame out;
+  out.frame_index = frame_index_;
+  StageClock clock(out.timings);
+  sensor_ =
+      SensorModelFor(options_.segment.detect.scene.sensor, frame.intrinsics);
+  std::vector<Track> tracks = tracks_;
+  const bool same_size = segmentations_ > 0 && !reference_.depth.empty() &&
+                         reference_.depth.size() == frame.depth.size();
+  if (!same_size) {
+    // A new camera (or the first frame): what was in view is gone.
+    for (const Track& t : tracks) {
+      if (t.last_seen_frame != frame_index_ - 1) continue;
+      TrackedObject gone;
+      gone.track_id = t.id;
+      gone.state = TrackState::kGone;
+      gone.world_centroid = t.world_centroid;
+      gone.frames_seen = t.frames_seen;
+      gone.object.index = -1;
+      gone.object.centroid = t.object.centroid;
+      out.objects.push_back(std::move(gone));
+    }
+    tracks.clear();
+  }
+  // A camera known to have moved sees every pixel change: not looked at.
+  const bool still = same_size && CameraStill(camera_to_world);
+  out.changed_fraction = still ? ChangedFraction(frame) : 1.0;
+  clock.Lap("change");
+
+  const bool reuse = still && out.changed_fraction <= options_.static_fraction;
+  if (reuse) {
+    out.reused = true;
+    for (Track& t : tracks) {
+      if (t.last_seen_frame != frame_index_ - 1) continue;
+      t.last_seen_frame = frame_index_;
+      ++t.frames_seen;
+      TrackedObject kept;
+      kept.track_id = t.id;
+      kept.state = TrackState::kKept;
+      kept.object = t.object;
+      kept.world_centroid = t.world_centroid;
+      kept.frames_seen = t.frames_seen;
+      out.objects.push_back(std::move(kept));
+    }
+  } else {
+    std::vector<SegmentedObject> found;
+    SegmentSinks sinks;
+    sinks.object = [&found](SegmentedObject object) {
+      found.push_back(std::move(object));
+      return absl::OkStatus();
+    };
+    FOVEA_RETURN_IF_ERROR(RunSegmentIncremental(frame, options_.segment,
+                                                relation_svm_, sinks, interrupt)
+                              .status());
+    clock.Lap("segment");
+
+    // Candidates: tracks seen within remember_frames.
+    std::vector<int> candidates;
+    for (int i = 0; i < static_cast<int>(tracks.size()); ++i) {
+      if (tracks[i].last_seen_frame >=
+          frame_index_ - 1 - options_.remember_frames) {
+        candidates.push_back(i);
+      }
+    }
+    std::vector<Eigen::Vector3f> world(found.size());
+    for (size_t j = 0; j < found.size(); ++j) {
+      world[j] = ToWorld(camera_to_world, found[j].centroid);
+    }
+    // Assigns found objects to candidate tracks, distances taken after
+    // subtracting `shift` from the new centroids.
+    const auto assign = [&](const Eigen::Vector3f& shift) {
+      std::vector<std::vector<double>> score(
+          candidates.size(), std::vector<double>(found.size(), 0.0));
+      std::vector<std::vector<double>> gate(
+          candidates.size(), std::vector<double>(found.size(), 0.0));
+      double big = 0.0;
+      for (size_t i = 0; i < candidates.size(); ++i) {
+        const Track& t = tracks[candidates[i]];
+        for (size_t j = 0; j < found.size(); ++j) {
+          gate[i][j] = std::max(
+              options_.match_m,
+              options_.match_extent_fraction *
+                  std::max(LargestExtent(t.object), LargestExtent(found[j])));
+          big = std::max(big, gate[i][j]);
+        }
+      }
+      for (size_t i = 0; i < candidates.size(); ++i) {
+        const Track& t = tracks[candidates[i]];
+        for (size_t j = 0; j < found.size(); ++j) {
+          const double d = (world[j] - shift - t.world_centroid).norm();
+          score[i][j] = d < gate[i][j] ? 2.0 * big - d : 0.0;
+        }
+      }
+      std::vector<int> match = MaxWeightAssignment(score);
+      for (size_t i = 0; i < match.size(); ++i) {
+        if (match[i] >= 0 && score[i][match[i]] <= 0.0) match[i] = -1;
+      }
+      return match;
+    };
+    Eigen::Vector3f shift = Eigen::Vector3f::Zero();
+    std::vector<int> match = assign(shift);
+    if (!camera_to_world) {
+      // The camera's own motion, as the objects' common displacement.
+      std::vector<Eigen::Vector3f> moves;
+      for (size_t i = 0; i < match.size(); ++i) {
+        if (match[i] >= 0) {
+          moves.push_back(world[match[i]] -
+                          tracks[candidates[i]].world_centroid);
+        }
+      }
+      if (moves.size() >= 2) {
+        shift = CoordinateMedian(moves);
+        match = assign(shift);
+      }
+    }
+
+    std::vector<int> track_of(found.size(), -1);
+    std::vector<Eigen::Vector3f> displacement(found.size(),
+                                              Eigen::Vector3f::Zero());
+    for (size_t i = 0; i < match.size(); ++i) {
+      if (match[i] < 0) continue;
+      track_of[match[i]] = candidates[i];
+      displacement[match[i]] =
+          world[match[i]] - shift - tracks[candidates[i]].world_centroid;
+    }
+    std::vector<TrackState> state(found.size(), TrackState::kAppeared);
+    for (size_t j = 0; j < found.size(); ++j) {
+      if (track_of[j] < 0) continue;
+      state[j] = displacement[j].norm() > options_.moved_m ? TrackState::kMoved
+                                                           : TrackState::kKept;
+    }
+    // Pieces that moved together: join the younger into the older.
+    std::vector<bool> absorbed(found.size(), false);
+    std::vector<bool> composite(found.size(), false);
+    for (size_t a = 0; a < found.size(); ++a) {
+      if (state[a] != TrackState::kMoved || absorbed[a]) continue;
+      for (size_t b = 0; b < found.size(); ++b) {
+        if (b == a || absorbed[b] || state[b] != TrackState::kMoved) continue;
+        if ((displacement[a] - displacement[b]).norm() >
+            options_.joint_motion_m) {
+          continue;
+        }
+        if (!Touch(found[a].mask, found[a].box, found[b].mask, found[b].box,
+                   3)) {
+          continue;
+        }
+        const bool a_older = tracks[track_of[a]].id < tracks[track_of[b]].id;
+        const size_t keep = a_older ? a : b;
+        const size_t drop = a_older ? b : a;
+        Join(found[drop], found[keep]);
+        composite[keep] = true;
+        world[keep] = ToWorld(camera_to_world, found[keep].centroid);
+        tracks[track_of[drop]].last_seen_frame = -1;  // forgotten
+        tracks[track_of[drop]].id = 0;
+        absorbed[drop] = true;
+        ++out.joined;
+        if (drop == a) break;
+      }
+    }
+    // A piece that appeared inside the last mask of a track that was joined
+    // before is that track's again (INC cuts it in two again).
+    for (size_t j = 0; j < found.size(); ++j) {
+      if (absorbed[j] || track_of[j] >= 0) continue;
+      for (size_t k = 0; k < found.size(); ++k) {
+        if (k == j || absorbed[k] || track_of[k] < 0) continue;
+        const Track& t = tracks[track_of[k]];
+        if (t.composite && !t.object.mask.empty() &&
+            t.object.mask.size() == found[j].mask.size()) {
+          cv::Mat inside;
+          cv::bitwise_and(found[j].mask, t.object.mask, inside);
+          if (cv::countNonZero(inside) * 2 > found[j].area) {
+            Join(found[j], found[k]);
+            composite[k] = true;
+            world[k] = ToWorld(camera_to_world, found[k].centroid);
+            absorbed[j] = true;
+            break;
+          }
+        }
+      }
+    }
+
+    // A track seen last frame and matched to nothing, whose last mask is
+    // mostly under one object's mask now, was a piece of that object: its
+    // identity joins the object's (the pieces of an object INC cut in two
+    // become one object when it comes whole).
+    std::vector<bool> matched_track(tracks.size(), false);
+    for (size_t j = 0; j < found.size(); ++j) {
+      if (track_of[j] >= 0) matched_track[track_of[j]] = true;
+    }
+    for (size_t i = 0; i < tracks.size(); ++i) {
+      Track& t = tracks[i];
+      if (matched_track[i] || t.id == 0 ||
+          t.last_seen_frame != frame_index_ - 1 || t.object.mask.empty()) {
+        continue;
+      }
+      for (size_t k = 0; k < found.size(); ++k) {
+        if (absorbed[k] || track_of[k] < 0 ||
+            found[k].mask.size() != t.object.mask.size()) {
+          continue;
+        }
+        cv::Mat under;
+        cv::bitwise_and(t.object.mask, found[k].mask, under);
+        if (2 * cv::countNonZero(under) > t.object.area) {
+          // The object goes on under the identity of its larger piece.
+          Track& whole = tracks[track_of[k]];
+          if (t.object.area > whole.object.area) {
+            std::swap(t.id, whole.id);
+            whole.frames_seen = std::max(whole.frames_seen, t.frames_seen);
+          }
+          composite[k] = true;
+          t.id = 0;  // forgotten below
+          ++out.joined;
+          break;
+        }
+      }
+    }
+
+    std::vector<bool> seen(tracks.size(), false);
+    for (size_t j = 0; j < found.size(); ++j) {
+      if (absorbed[j]) continue;
+      TrackedObject result;
+      if (track_of[j] >= 0) {
+        Track& t = tracks[track_of[j]];
+        seen[track_of[j]] = true;
+        // Moved when both the piece first matched and the object as joined
+        // moved: joining changes a centroid without the object moving.
+        const float joined_move = (world[j] - shift - t.world_centroid).norm();
+        result.state =
+            state[j] == TrackState::kMoved && joined_move > options_.moved_m
+                ? TrackState::kMoved
+                : TrackState::kKept;
+        t.object = found[j];
+        t.world_centroid = world[j];
+        t.last_seen_frame = frame_index_;
+        t.composite = t.composite || composite[j];
+        ++t.frames_seen;
+        result.track_id = t.id;
+        result.frames_seen = t.frames_seen;
+      } else {
+        Track t;
+        t.id = next_id_++;
+        t.object = found[j];
+        t.world_centroid = world[j];
+        t.last_seen_frame = frame_index_;
+        t.frames_seen = 1;
+        result.state = TrackState::kAppeared;
+        result.track_id = t.id;
+        result.frames_seen = 1;
+        tracks.push_back(t);
+        seen.push_back(true);
+      }
+      result.object = std::move(found[j]);
+      result.world_centroid = world[j];
+      out.objects.push_back(std::move(result));
+    }
+    for (size_t i = 0; i < tracks.size(); ++i) {
+      const Track& t = tracks[i];
+      if (seen[i] || t.id == 0 || t.last_seen_frame != frame_index_ - 1) {
+        continue;
+      }
+      TrackedObject gone;
+      gone.track_id = t.id;
+      gone.state = TrackState::kGone;
+      gone.world_centroid = t.world_centroid;
+      gone.frames_seen = t.frames_seen;
+      gone.object.index = -1;
+      gone.object.centroid = t.object.centroid;
+      out.objects.push_back(std::move(gone));
+    }
+    // Forget what has been gone too long, and joined tracks.
+    tracks.erase(std::remove_if(tracks.begin(), tracks.end(),
+                                [&](const Track& t) {
+                                  return t.id == 0 ||
+                                         t.last_seen_frame <
+                                             frame_index_ -
+                                                 options_.remember_frames;
+                                }),
+                 tracks.end());
+    reference_.color = frame.color.clone();
+    reference_.depth = frame.depth.clone();
+    reference_.intrinsics = frame.intrinsics;
+    reference_pose_ = camera_to_world;
+    ++segmentations_;
+    clock.Lap("associate");
+  }
+  std::stable_sort(out.objects.begin(), out.objects.end(),
+                   [](const TrackedObject& a, const TrackedObject& b) {
+                     return StateOrder(a.state) < StateOrder(b.state);
+                   });
+  tracks_ = std::move(tracks);
+  ++frame_index_;
+  out.seconds = SecondsSince(start);
+  return out;
+}
+
+}  // namespace fovea

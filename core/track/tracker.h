@@ -1,0 +1,151 @@
+#ifndef FOVEA_CORE_TRACK_TRACKER_H_
+#define FOVEA_CORE_TRACK_TRACKER_H_
+
+#include <Eigen/Geometry>
+#include <optional>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/base/interrupt.h"
+#include "core/base/stage_clock.h"
+#include "core/frame/rgbd_frame.h"
+#include "core/frame/sensor_model.h"
+#include "core/pipeline/incremental.h"
+#include "core/pipeline/segment.h"
+#include "core/segmentation/rbf_svm.h"
+
+namespace fovea {
+
+// A camera that keeps looking: the frames of one stream, segmented with
+// INC (incremental.h) and their objects given identities that persist
+// while they stay in view.
+//
+// What time is used for:
+//   - A frame in which neither depth nor colour changed beyond the
+//     sensor's noise since the frame last segmented (and whose camera pose,
+//     when given, did not move) is not segmented again: its objects are the
+//     last ones, kept. This is the cheap case, a static scene.
+//   - Objects are associated from frame to frame in 3D: their centroids in
+//     the world when the camera pose is given, else in the camera frame
+//     (the support and the objects anchor a camera that moves a little
+//     between frames), by the one-to-one assignment of least distance
+//     within a gate.
+//   - What changed comes first: objects that appeared or moved are reported
+//     before those kept.
+//   - Pieces that move rigidly together become one object: two tracks whose
+//     masks touch and that moved by the same displacement (more than
+//     moved_m, within joint_motion_m of each other) join; the older
+//     identity stays.
+
+enum class TrackState {
+  kAppeared,  // first seen in this frame: a new track_id
+  kKept,      // seen before, still where it was
+  kMoved,     // seen before, its centroid moved more than moved_m
+  kGone,      // seen before, not in this frame (reported once, no mask)
+};
+
+// "appeared", "kept", "moved", "gone".
+std::string_view TrackStateName(TrackState state);
+
+struct TrackerOptions {
+  IncrementalOptions segment;  // each fresh segmentation
+  // A pixel changed when its depth moved more than
+  // max(change_min_m, change_sigmas * the sensor's sigma(z)), came or went,
+  // or a colour channel moved more than color_change (8-bit units); what
+  // survives a 5 x 5 opening of those pixels is the change (noise changes
+  // single pixels). A frame is unchanged when the change is at most
+  // static_fraction of the pixels with depth in either frame (0.0005: 150
+  // pixels of a 640 x 480 frame, a 3 cm object at 1 m).
+  float change_sigmas = 5.0f;
+  float change_min_m = 0.004f;
+  float color_change = 40.0f;
+  double static_fraction = 0.0005;
+  // With poses: a camera that moved less than this is still.
+  float still_m = 0.003f;
+  float still_rad = 0.005f;
+  // Association gate: centroids further apart than
+  // max(match_m, match_extent_fraction * the object's largest extent) are
+  // not the same object.
+  float match_m = 0.06f;
+  float match_extent_fraction = 0.5f;
+  float moved_m = 0.02f;
+  float joint_motion_m = 0.01f;
+  // A gone track may come back (same identity) within this many frames.
+  int remember_frames = 30;
+};
+
+absl::Status Validate(const TrackerOptions& options);
+
+struct TrackedObject {
+  int track_id = 0;  // 1, 2, ...: unique in the stream
+  TrackState state = TrackState::kAppeared;
+  // The object in this frame (mask at the frame's size, box, centroid,
+  // geometry, ...); empty mask for kGone.
+  SegmentedObject object;
+  // Its centroid in the world (camera frame when no pose is given).
+  Eigen::Vector3f world_centroid = Eigen::Vector3f::Zero();
+  int frames_seen = 0;  // frames it was in, this one included
+};
+
+struct TrackedFrame {
+  int frame_index = 0;  // 0, 1, ... of the stream
+  // Appeared and moved first, then kept, then gone.
+  std::vector<TrackedObject> objects;
+  // The scene did not change: the last segmentation was reused.
+  bool reused = false;
+  // See TrackerOptions::static_fraction; 1 when the pose says the camera
+  // moved (the pixels are then not compared).
+  double changed_fraction = 0.0;
+  int joined = 0;                    // tracks joined into others in this frame
+  std::vector<StageTiming> timings;  // "change", INC's stages, "associate"
+  double seconds = 0.0;
+};
+
+class Tracker {
+ public:
+  // `relation_svm` (not owned) is INC's model; it outlives the tracker.
+  Tracker(const TrackerOptions& options, const RbfSvm* relation_svm);
+
+  // One frame of the stream: segments it (or reuses the last segmentation)
+  // and associates its objects with the tracks. `camera_to_world`, when
+  // given, is the camera's pose. A frame of another size than the last one
+  // starts afresh (every track gone). Errors: Validate's (options);
+  // RunSegmentIncremental's; `interrupt`'s. After an error the tracker
+  // is as before the call.
+  absl::StatusOr<TrackedFrame> Process(
+      const RgbdFrame& frame,
+      const std::optional<Eigen::Isometry3f>& camera_to_world,
+      const InterruptCheck& interrupt = {});
+
+  int frames() const { return frame_index_; }
+  int segmentations() const { return segmentations_; }
+
+ private:
+  struct Track {
+    int id = 0;
+    SegmentedObject object;  // as last seen
+    Eigen::Vector3f world_centroid = Eigen::Vector3f::Zero();
+    int frames_seen = 0;
+    int last_seen_frame = 0;
+    bool composite = false;  // pieces were joined into it
+  };
+
+  // The fraction of pixels that changed from the reference frame.
+  double ChangedFraction(const RgbdFrame& frame) const;
+  bool CameraStill(const std::optional<Eigen::Isometry3f>& pose) const;
+
+  TrackerOptions options_;
+  const RbfSvm* relation_svm_;
+  SensorModel sensor_;
+  // The frame last segmented and its pose.
+  RgbdFrame reference_;
+  std::optional<Eigen::Isometry3f> reference_pose_;
+  std::vector<Track> tracks_;  // in view at the last frame, or remembered
+  int next_id_ = 1;
+  int frame_index_ = 0;
+  int segmentations_ = 0;
+};
+
+}  // namespace fovea
+
+#endif  // FOVEA_CORE_TRACK_TRACKER_H_

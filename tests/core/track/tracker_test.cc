@@ -1,0 +1,187 @@
+// The tracker on synthetic sequences with ground-truth identities: a still
+// scene is segmented once and keeps its identities, an object taken away
+// is reported gone once, a drifting camera keeps every identity.
+
+#include "core/track/tracker.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <opencv2/core.hpp>
+#include <set>
+#include <vector>
+
+#include "core/pipeline/models.h"
+#include "core/synth/sequence.h"
+
+namespace fovea {
+namespace {
+
+using synth::GenerateSequence;
+using synth::Sequence;
+using synth::SequenceKind;
+
+const LoadedModels* Models() {
+  static const LoadedModels* models = [] {
+    const char* source = std::getenv("FOVEA_SOURCE_DIR");
+    absl::StatusOr<LoadedModels> loaded = LoadModels(
+        (std::filesystem::path(source ? source : ".") / "models").string());
+    return loaded.ok() ? new LoadedModels(*std::move(loaded)) : nullptr;
+  }();
+  return models;
+}
+
+// The ground-truth identity of at least 80 % of `mask`'s pixels (-1:
+// none: the table, or a mask holding two objects, whose identity is
+// neither's).
+int TruthOf(const synth::SequenceFrame& frame, const cv::Mat& mask) {
+  std::map<int, int> votes;
+  for (int v = 0; v < mask.rows; ++v) {
+    const uint8_t* m = mask.ptr<uint8_t>(v);
+    const int* label = frame.frame.labels.ptr<int>(v);
+    for (int u = 0; u < mask.cols; ++u) {
+      if (m[u] == 0) continue;
+      const int k = label[u] / 10 - 2;
+      if (label[u] >= 20 && k < static_cast<int>(frame.object_ids.size())) {
+        ++votes[frame.object_ids[k]];
+      }
+    }
+  }
+  int best = -1;
+  int most = cv::countNonZero(mask) * 4 / 5;
+  for (const auto& [id, count] : votes) {
+    if (count > most) {
+      best = id;
+      most = count;
+    }
+  }
+  return best;
+}
+
+// Plays `sequence` through a tracker; for each ground-truth object, the
+// track ids that carried its largest mask, frame after frame (a piece of an
+// object cut in two is not a second identity; a new id on its largest piece
+// is).
+std::map<int, std::set<int>> Play(const Sequence& sequence, bool with_pose,
+                                  std::vector<TrackedFrame>* frames = nullptr) {
+  Tracker tracker(TrackerOptions{}, &*Models()->inc);
+  std::map<int, std::set<int>> tracks_of_truth;
+  for (const synth::SequenceFrame& f : sequence.frames) {
+    std::optional<Eigen::Isometry3f> pose;
+    if (with_pose) pose = f.camera_to_world;
+    absl::StatusOr<TrackedFrame> out = tracker.Process(f.frame.frame, pose);
+    EXPECT_TRUE(out.ok()) << out.status();
+    if (!out.ok()) return {};
+    std::map<int, std::pair<int, int>> largest;  // truth -> (area, track)
+    for (const TrackedObject& o : out->objects) {
+      if (o.state == TrackState::kGone) continue;
+      const int truth = TruthOf(f, o.object.mask);
+      if (truth < 0) continue;
+      std::pair<int, int>& best = largest[truth];
+      if (o.object.area > best.first) best = {o.object.area, o.track_id};
+    }
+    for (const auto& [truth, best] : largest) {
+      tracks_of_truth[truth].insert(best.second);
+    }
+    if (frames != nullptr) frames->push_back(*std::move(out));
+  }
+  return tracks_of_truth;
+}
+
+TEST(Tracker, AStillSceneIsSegmentedOnceAndKeepsItsIdentities) {
+  ASSERT_NE(Models(), nullptr);
+  const Sequence sequence = GenerateSequence(SequenceKind::kStatic, 3, 4);
+  std::vector<TrackedFrame> frames;
+  const std::map<int, std::set<int>> tracks = Play(sequence, false, &frames);
+  ASSERT_EQ(frames.size(), 4u);
+  EXPECT_FALSE(frames[0].reused);
+  ASSERT_FALSE(frames[0].objects.empty());
+  for (size_t t = 1; t < frames.size(); ++t) {
+    // Fresh sensor noise every frame is not a change.
+    EXPECT_TRUE(frames[t].reused)
+        << "frame " << t << " changed " << frames[t].changed_fraction;
+    ASSERT_EQ(frames[t].objects.size(), frames[0].objects.size());
+    for (size_t i = 0; i < frames[t].objects.size(); ++i) {
+      EXPECT_EQ(frames[t].objects[i].state, TrackState::kKept);
+      EXPECT_EQ(frames[t].objects[i].track_id, frames[0].objects[i].track_id);
+    }
+  }
+  for (const auto& [truth, ids] : tracks) {
+    EXPECT_EQ(ids.size(), 1u) << "object " << truth;
+  }
+}
+
+TEST(Tracker, AnObjectTakenAwayIsGoneOnceAndTheOthersKeepTheirIdentities) {
+  ASSERT_NE(Models(), nullptr);
+  const Sequence sequence = GenerateSequence(SequenceKind::kRemove, 5, 8);
+  std::vector<TrackedFrame> frames;
+  Play(sequence, false, &frames);
+  int gone = 0;
+  std::set<int> gone_ids;
+  for (const TrackedFrame& f : frames) {
+    for (const TrackedObject& o : f.objects) {
+      if (o.state != TrackState::kGone) continue;
+      ++gone;
+      EXPECT_TRUE(gone_ids.insert(o.track_id).second)
+          << "track " << o.track_id << " reported gone twice";
+      EXPECT_TRUE(o.object.mask.empty());
+    }
+  }
+  const int taken_away =
+      static_cast<int>(sequence.frames.front().object_ids.size() -
+                       sequence.frames.back().object_ids.size());
+  ASSERT_GT(taken_away, 0);
+  EXPECT_GE(gone, taken_away);
+  // The one object that stays keeps one identity all along.
+  const int stays = sequence.frames.back().object_ids.front();
+  std::set<int> ids_of_stays;
+  for (size_t t = 0; t < frames.size(); ++t) {
+    for (const TrackedObject& o : frames[t].objects) {
+      if (o.state != TrackState::kGone &&
+          TruthOf(sequence.frames[t], o.object.mask) == stays) {
+        ids_of_stays.insert(o.track_id);
+      }
+    }
+  }
+  EXPECT_EQ(ids_of_stays.size(), 1u);
+}
+
+TEST(Tracker, ADriftingCameraKeepsEveryIdentityWithAndWithoutItsPose) {
+  ASSERT_NE(Models(), nullptr);
+  const Sequence sequence = GenerateSequence(SequenceKind::kDrift, 7, 6);
+  for (const bool with_pose : {true, false}) {
+    std::vector<TrackedFrame> frames;
+    const std::map<int, std::set<int>> tracks =
+        Play(sequence, with_pose, &frames);
+    EXPECT_FALSE(tracks.empty());
+    for (const auto& [truth, ids] : tracks) {
+      EXPECT_EQ(ids.size(), 1u)
+          << "object " << truth << (with_pose ? " with" : " without")
+          << " the pose";
+    }
+    for (size_t t = 1; t < frames.size(); ++t) {
+      EXPECT_FALSE(frames[t].reused);  // the camera moved
+    }
+  }
+}
+
+TEST(Tracker, BadOptionsAreNamed) {
+  TrackerOptions options;
+  options.static_fraction = 1.5;
+  EXPECT_EQ(Validate(options).code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(Validate(options).message().find("track.static_fraction"),
+            std::string::npos);
+  options = TrackerOptions{};
+  options.match_m = 0.0f;
+  EXPECT_NE(Validate(options).message().find("track.match_m"),
+            std::string::npos);
+  Tracker tracker(options, nullptr);
+  RgbdFrame frame;
+  EXPECT_EQ(tracker.Process(frame, std::nullopt).status().code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace fovea

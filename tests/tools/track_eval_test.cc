@@ -1,0 +1,76 @@
+// The identity figures of fovea-eval track on hand-made frames whose
+// answer can be counted by hand.
+
+#include "tools/eval/track_eval.h"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+namespace fovea::eval {
+namespace {
+
+TEST(CountIdentities, AFlawlessSequenceScoresOne) {
+  // Two objects, tracks 7 and 9, matched in all three frames.
+  std::vector<FrameIdentities> frames(3,
+                                      FrameIdentities{2, 2, {{0, 7}, {1, 9}}});
+  const IdentityCounts c = CountIdentities(frames);
+  EXPECT_EQ(c.idtp, 6);
+  EXPECT_EQ(c.idfp, 0);
+  EXPECT_EQ(c.idfn, 0);
+  EXPECT_EQ(c.switches, 0);
+  EXPECT_EQ(c.truth_frames, 6);
+  EXPECT_DOUBLE_EQ(Idf1(c), 1.0);
+}
+
+TEST(CountIdentities, ASwitchCostsTheFramesAfterItAndCountsOnce) {
+  // Object 0 is track 1 for two frames, then track 2 for two frames.
+  std::vector<FrameIdentities> frames = {
+      {1, 1, {{0, 1}}}, {1, 1, {{0, 1}}}, {1, 1, {{0, 2}}}, {1, 1, {{0, 2}}}};
+  const IdentityCounts c = CountIdentities(frames);
+  EXPECT_EQ(c.switches, 1);
+  // One identity pairing keeps 2 of the 4 frames: IDTP 2, IDFN 2, IDFP 2.
+  EXPECT_EQ(c.idtp, 2);
+  EXPECT_EQ(c.idfn, 2);
+  EXPECT_EQ(c.idfp, 2);
+  EXPECT_DOUBLE_EQ(Idf1(c), 0.5);
+}
+
+TEST(CountIdentities, MissesAndExtraTracksLowerIdf1WithoutSwitches) {
+  // One object seen in 2 frames, found in 1; a stray track in frame 2.
+  std::vector<FrameIdentities> frames = {{1, 1, {{0, 4}}}, {1, 1, {}}};
+  const IdentityCounts c = CountIdentities(frames);
+  EXPECT_EQ(c.switches, 0);
+  EXPECT_EQ(c.idtp, 1);
+  EXPECT_EQ(c.idfn, 1);
+  EXPECT_EQ(c.idfp, 1);
+  EXPECT_DOUBLE_EQ(Idf1(c), 0.5);
+  EXPECT_DOUBLE_EQ(Idf1(IdentityCounts{}), 1.0);
+}
+
+TEST(MatchFrame, AMaskMatchesTheObjectItCoversAtIouOneHalf) {
+  synth::SequenceFrame frame;
+  frame.frame.labels = cv::Mat(10, 10, CV_32SC1, cv::Scalar(1));
+  frame.frame.labels(cv::Rect(0, 0, 4, 5)).setTo(20);   // object id 3, 20 px
+  frame.frame.labels(cv::Rect(6, 0, 4, 10)).setTo(30);  // object id 5, 40 px
+  frame.object_ids = {3, 5};
+  TrackedObject good;  // 20 of object 3's pixels and 4 more: IoU 20/24
+  good.track_id = 11;
+  good.object.mask = cv::Mat(10, 10, CV_8UC1, cv::Scalar(0));
+  good.object.mask(cv::Rect(0, 0, 4, 6)).setTo(255);
+  TrackedObject half;  // 16 of object 5's 40 pixels: IoU 0.4, no match
+  half.track_id = 12;
+  half.object.mask = cv::Mat(10, 10, CV_8UC1, cv::Scalar(0));
+  half.object.mask(cv::Rect(6, 0, 4, 4)).setTo(255);
+  TrackedObject gone;
+  gone.track_id = 13;
+  gone.state = TrackState::kGone;
+  const FrameIdentities f = MatchFrame(frame, {good, half, gone}, 10);
+  EXPECT_EQ(f.truths, 2);
+  EXPECT_EQ(f.tracks, 2);  // the gone track has no mask
+  ASSERT_EQ(f.matched.size(), 1u);
+  EXPECT_EQ(f.matched[0], std::make_pair(3, 11));
+}
+
+}  // namespace
+}  // namespace fovea::eval
