@@ -95,6 +95,17 @@ ABSL_FLAG(double, stream_stall_timeout_s,
           fovea::server::ServerConfig{}.stream_stall_timeout_s,
           "A Segment stream whose client takes no message for this long "
           "while results wait for it is cancelled and its worker freed.");
+ABSL_FLAG(int, max_track_streams,
+          fovea::server::ServerConfig{}.max_track_streams,
+          "Track streams open at once, from all clients; a stream beyond is "
+          "RESOURCE_EXHAUSTED.");
+ABSL_FLAG(int, max_track_streams_per_peer,
+          fovea::server::ServerConfig{}.max_track_streams_per_peer,
+          "Track streams open at once from one client address.");
+ABSL_FLAG(double, track_idle_timeout_s,
+          fovea::server::ServerConfig{}.track_idle_timeout_s,
+          "A Track stream whose client sent nothing (no frame) for this long "
+          "is closed (CANCELLED).");
 ABSL_FLAG(double, handshake_timeout_s,
           fovea::server::ServerConfig{}.handshake_timeout_s,
           "A connection that has not completed the HTTP/2 (or TLS) "
@@ -199,6 +210,10 @@ int main(int argc, char** argv) {
   config.max_connection_age_grace_s =
       absl::GetFlag(FLAGS_max_connection_age_grace_s);
   config.stream_stall_timeout_s = absl::GetFlag(FLAGS_stream_stall_timeout_s);
+  config.max_track_streams = absl::GetFlag(FLAGS_max_track_streams);
+  config.max_track_streams_per_peer =
+      absl::GetFlag(FLAGS_max_track_streams_per_peer);
+  config.track_idle_timeout_s = absl::GetFlag(FLAGS_track_idle_timeout_s);
   config.handshake_timeout_s = absl::GetFlag(FLAGS_handshake_timeout_s);
   config.drain_delay_s = absl::GetFlag(FLAGS_drain_delay_s);
   config.reflection = absl::GetFlag(FLAGS_reflection);

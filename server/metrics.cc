@@ -130,6 +130,12 @@ class Metrics {
                               {"reason", std::string(reason)}});
   }
 
+  prometheus::Counter& TrackFrames(std::string_view outcome) {
+    return track_frames_family_.Add({{"outcome", std::string(outcome)}});
+  }
+  prometheus::Gauge& track_streams() { return track_streams_; }
+  prometheus::Histogram& track_frame_seconds() { return track_frame_seconds_; }
+
   prometheus::Counter& Shed(std::string_view reason) {
     return shed_family_.Add({{"reason", std::string(reason)}});
   }
@@ -207,6 +213,26 @@ class Metrics {
                                "took the call), stalled_stream (the client "
                                "stopped reading a stream).")
                          .Register(*registry_)),
+        track_frames_family_(
+            prometheus::BuildCounter()
+                .Name("fovea_track_frames_total")
+                .Help("Frames of Track streams by outcome: segmented, reused "
+                      "(the scene had not changed), skipped (a newer frame "
+                      "replaced it before it was processed, or the server was "
+                      "busy).")
+                .Register(*registry_)),
+        track_streams_(prometheus::BuildGauge()
+                           .Name("fovea_track_open_streams")
+                           .Help("Track streams open now.")
+                           .Register(*registry_)
+                           .Add({})),
+        track_frame_seconds_(
+            prometheus::BuildHistogram()
+                .Name("fovea_track_frame_seconds")
+                .Help("From a Track frame's arrival to its response, "
+                      "seconds.")
+                .Register(*registry_)
+                .Add({}, StageBuckets())),
         open_fds_(prometheus::BuildGauge()
                       .Name("fovea_open_file_descriptors")
                       .Help("File descriptors the process holds.")
@@ -272,8 +298,12 @@ class Metrics {
           Stops(methods[i].name, reason);
         }
       }
-      for (const char* reason : {"abandoned_in_queue", "stalled_stream"}) {
+      for (const char* reason : {"abandoned_in_queue", "stalled_stream",
+                                 "idle_stream", "stream_limit"}) {
         Shed(reason);
+      }
+      for (const char* outcome : {"segmented", "reused", "skipped"}) {
+        TrackFrames(outcome);
       }
       for (size_t c = 0; c < kAllStatusCodes.size(); ++c) {
         prometheus::Labels with_code = labels;
@@ -294,6 +324,9 @@ class Metrics {
   prometheus::Family<prometheus::Histogram>& objects_family_;
   prometheus::Family<prometheus::Counter>& stops_family_;
   prometheus::Family<prometheus::Counter>& shed_family_;
+  prometheus::Family<prometheus::Counter>& track_frames_family_;
+  prometheus::Gauge& track_streams_;
+  prometheus::Histogram& track_frame_seconds_;
   prometheus::Gauge& open_fds_;
   prometheus::Gauge& fd_limit_;
   prometheus::Counter& refused_;
@@ -369,6 +402,20 @@ void RecordAbandonedInQueue() {
 
 void RecordStalledStream() {
   Metrics::Get().Shed("stalled_stream").Increment();
+}
+
+void RecordShed(std::string_view reason) {
+  Metrics::Get().Shed(reason).Increment();
+}
+
+void AddTrackStreams(int delta) {
+  Metrics::Get().track_streams().Increment(delta);
+}
+
+void RecordTrackFrame(std::string_view outcome, double seconds) {
+  Metrics& metrics = Metrics::Get();
+  metrics.TrackFrames(outcome).Increment();
+  if (outcome != "skipped") metrics.track_frame_seconds().Observe(seconds);
 }
 
 void RecordDescriptors(int open, int limit, int64_t refused_total) {

@@ -47,6 +47,11 @@ namespace fovea::server {
 //   fovea_calls_shed_total{reason}       counter: calls the server ended
 //                                        itself (abandoned_in_queue,
 //                                        stalled_stream)
+//   fovea_track_open_streams               gauge: Track streams open
+//   fovea_track_frames_total{outcome}      counter: segmented, reused,
+//                                        skipped
+//   fovea_track_frame_seconds              histogram: a frame's arrival to
+//                                        its response
 //   fovea_open_file_descriptors, fovea_file_descriptor_limit  gauges
 //   fovea_connections_refused_total      counter: closed by the accept guard
 //   fovea_inflight_requests              gauge: calls started, not finished
@@ -90,6 +95,15 @@ void RecordStopReason(std::string_view method, std::string_view reason);
 // worker; a stream cancelled because its client stopped reading.
 void RecordAbandonedInQueue();
 void RecordStalledStream();
+// fovea_calls_shed_total{reason}: idle_stream (a Track stream that sent
+// nothing for its idle timeout), stream_limit (a Track stream refused by the
+// open-stream limits).
+void RecordShed(std::string_view reason);
+// Track: fovea_track_open_streams (gauge), fovea_track_frames_total{outcome}
+// (segmented, reused, skipped) and fovea_track_frame_seconds (arrival to
+// response, for the frames processed).
+void AddTrackStreams(int delta);
+void RecordTrackFrame(std::string_view outcome, double seconds);
 void IncrementInflight();
 void DecrementInflight();
 // fovea_open_file_descriptors, fovea_file_descriptor_limit (gauges) and

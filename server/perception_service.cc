@@ -32,6 +32,7 @@
 #include "server/metrics.h"
 #include "server/request_parse.h"
 #include "server/status_util.h"
+#include "server/track_reactor.h"
 
 namespace fovea::server {
 namespace {
@@ -456,10 +457,12 @@ class StreamReactor final
 }  // namespace
 
 PerceptionService::PerceptionService(ServiceConfig config, WorkQueue* work)
-    : config_(std::move(config)),
-      work_(work),
-      capabilities_(BuildCapabilities(config_.limits, config_.max_message_bytes,
-                                      config_.model_versions)) {
+    : config_(std::move(config)), work_(work), capabilities_([this] {
+        v1::GetCapabilitiesResponse c = BuildCapabilities(
+            config_.limits, config_.max_message_bytes, config_.model_versions);
+        c.set_track(config_.streams != nullptr);
+        return c;
+      }()) {
   // Each method takes its request's bytes (see ParseRequest) and answers
   // typed messages: the handlers the generated CallbackService registered
   // are replaced, in the service's method order, with handlers of the
@@ -499,6 +502,12 @@ PerceptionService::PerceptionService(ServiceConfig config, WorkQueue* work)
                  v1::GetCapabilitiesResponse* response) {
             return OnGetCapabilities(context, body, response);
           }));
+  MarkMethodCallback(MethodIndex("Track"),
+                     new grpc::internal::CallbackBidiHandler<grpc::ByteBuffer,
+                                                             v1::TrackResponse>(
+                         [this](grpc::CallbackServerContext* context) {
+                           return OnTrack(context);
+                         }));
   // gRPC's threads call the methods below; what was built here (and the
   // work queue before it) happens before, through libgrpc (see
   // DetectReactor::OnDone).
@@ -535,6 +544,12 @@ PerceptionService::OnSegmentIncremental(grpc::CallbackServerContext* context,
   return new StreamReactor<v1::SegmentIncrementalRequest, IncrementalOptions>(
       "SegmentIncremental", &ToIncrementalOptions, &HandleSegmentIncremental,
       config_, *work_, context, std::move(request), parsed);
+}
+
+grpc::ServerBidiReactor<grpc::ByteBuffer, v1::TrackResponse>*
+PerceptionService::OnTrack(grpc::CallbackServerContext* context) {
+  TsanHappensAfter(&config_);
+  return NewTrackReactor(config_, *work_, context);
 }
 
 grpc::ServerUnaryReactor* PerceptionService::OnGetCapabilities(

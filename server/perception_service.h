@@ -13,6 +13,7 @@
 #include "core/pipeline/segment.h"
 #include "fovea/v1/perception.grpc.pb.h"
 #include "server/flight_recorder.h"
+#include "server/stream_registry.h"
 #include "server/work_queue.h"
 
 namespace fovea::server {
@@ -56,6 +57,9 @@ struct ServiceConfig {
   // then no call is recorded. Detect, Segment and SegmentIncremental calls
   // that start work are offered to it as they end (flight_recorder.h).
   FlightRecorder* recorder = nullptr;
+  // The open Track streams and their limits (not owned: it outlives the
+  // service), or null: then Track is UNIMPLEMENTED.
+  StreamRegistry* streams = nullptr;
 };
 
 // fovea.v1.Perception on gRPC's callback API. Handlers are thin: they
@@ -86,6 +90,8 @@ struct ServiceConfig {
 // SegmentIncremental: the same streaming, with INC's objects in order of
 // saliency; also stops on the request's time budget.
 // GetCapabilities: BuildCapabilities, computed once.
+// Track: a stream of frames, one response per processed frame
+// (track_reactor.h).
 // Every method parses its request's body itself: a body that is not a
 // valid request (truncated, a proto3 string that is not UTF-8, ...) is
 // INVALID_ARGUMENT saying what and where, counted and logged like any
@@ -106,6 +112,8 @@ class PerceptionService final : public v1::Perception::CallbackService {
       grpc::CallbackServerContext* context, const grpc::ByteBuffer* body);
   grpc::ServerWriteReactor<v1::SegmentResponse>* OnSegmentIncremental(
       grpc::CallbackServerContext* context, const grpc::ByteBuffer* body);
+  grpc::ServerBidiReactor<grpc::ByteBuffer, v1::TrackResponse>* OnTrack(
+      grpc::CallbackServerContext* context);
   grpc::ServerUnaryReactor* OnGetCapabilities(
       grpc::CallbackServerContext* context, const grpc::ByteBuffer* body,
       v1::GetCapabilitiesResponse* response);

@@ -214,6 +214,23 @@ absl::Status Validate(const ServerConfig& config) {
         "--stream_stall_timeout_s: ", config.stream_stall_timeout_s,
         " is not in (0, 3600]"));
   }
+  if (config.max_track_streams < 1 || config.max_track_streams > 100000) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--max_track_streams: ", config.max_track_streams,
+                     " is not in [1, 100000]"));
+  }
+  if (config.max_track_streams_per_peer < 1 ||
+      config.max_track_streams_per_peer > 100000) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--max_track_streams_per_peer: ", config.max_track_streams_per_peer,
+        " is not in [1, 100000]"));
+  }
+  if (!(config.track_idle_timeout_s > 0.0) ||
+      config.track_idle_timeout_s > 3600.0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--track_idle_timeout_s: ", config.track_idle_timeout_s,
+                     " is not in (0, 3600]"));
+  }
   if (!(config.handshake_timeout_s > 0.0) ||
       config.handshake_timeout_s > 120.0) {
     return absl::InvalidArgumentError(
@@ -285,6 +302,13 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
     FOVEA_ASSIGN_OR_RETURN(server->recorder_, FlightRecorder::Start(recorder));
     service.recorder = server->recorder_.get();
   }
+  StreamLimits stream_limits;
+  stream_limits.max_streams = config.max_track_streams;
+  stream_limits.max_streams_per_peer = config.max_track_streams_per_peer;
+  stream_limits.idle_timeout = std::chrono::milliseconds(
+      std::lround(config.track_idle_timeout_s * 1000.0));
+  server->streams_ = std::make_unique<StreamRegistry>(stream_limits);
+  service.streams = server->streams_.get();
   server->service_ = std::make_unique<PerceptionService>(std::move(service),
                                                          server->work_.get());
 

@@ -17,6 +17,7 @@
 #include "server/flight_recorder.h"
 #include "server/metrics.h"
 #include "server/perception_service.h"
+#include "server/stream_registry.h"
 #include "server/work_queue.h"
 
 namespace fovea::server {
@@ -67,6 +68,12 @@ struct ServerConfig {
   // wait for it is cancelled (ServiceConfig::stream_stall_timeout), (0,
   // 3600].
   double stream_stall_timeout_s = 5.0;
+  // Track streams: open at once in all and from one peer address, [1,
+  // 100000]; one whose client sent nothing for track_idle_timeout_s is
+  // closed, (0, 3600].
+  int max_track_streams = 64;
+  int max_track_streams_per_peer = 8;
+  double track_idle_timeout_s = 10.0;
   // A connection that has not completed the HTTP/2 handshake (preface and
   // settings) within this many seconds is closed: silent connections
   // cannot pile up to the descriptor limit. (0, 120].
@@ -186,6 +193,7 @@ class FoveaServer {
   std::unique_ptr<WorkQueue> work_;
   // Before service_: the calls hand themselves to it until the last ends.
   std::unique_ptr<FlightRecorder> recorder_;
+  std::unique_ptr<StreamRegistry> streams_;  // the Track streams
   std::shared_ptr<ServiceState> service_state_;
   double drain_delay_s_ = 0.0;
   std::unique_ptr<PerceptionService> service_;
