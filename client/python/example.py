@@ -99,8 +99,12 @@ def main(argv):
                 detect = client.detect_request(
                     detect_pb2.DetectRequest(frame=frame), timeout=args.timeout)
                 stream = client.segment_request(
-                    segment_pb2.SegmentRequest(frame=frame, method=args.method,
-                                               max_objects=args.max_objects),
+                    segment_pb2.SegmentRequest(
+                        frame=frame,
+                        # The contract's enum values carry their prefix.
+                        method=segment_pb2.SegmentationMethod.Value(
+                            "SEGMENTATION_METHOD_" + args.method),
+                        max_objects=args.max_objects),
                     timeout=args.timeout)
             else:
                 detect = client.detect(color, depth, FX, FY, CX, CY,

@@ -9,7 +9,11 @@ modules are missing.
 """
 
 import argparse
+import importlib.util
 import os
+import struct
+import tempfile
+import zlib
 import signal
 import socket
 import subprocess
@@ -26,6 +30,26 @@ except ImportError as e:
     sys.exit(77)
 
 ARGS = None  # set in __main__
+
+
+def write_png(path, pixels, bit_depth, color_type):
+    """A PNG of `pixels` (rows of big-endian samples as bytes), no filter."""
+    height = len(pixels)
+    width = {(8, 2): 3, (16, 0): 2}[(bit_depth, color_type)]
+    width = len(pixels[0]) // width
+
+    def chunk(kind, data):
+        body = kind + data
+        return (struct.pack(">I", len(data)) + body +
+                struct.pack(">I", zlib.crc32(body) & 0xFFFFFFFF))
+
+    raw = b"".join(b"\x00" + row for row in pixels)
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n")
+        f.write(chunk(b"IHDR", struct.pack(">IIBBBBB", width, height,
+                                           bit_depth, color_type, 0, 0, 0)))
+        f.write(chunk(b"IDAT", zlib.compress(raw)))
+        f.write(chunk(b"IEND", b""))
 
 
 def free_port():
@@ -87,6 +111,34 @@ class ExampleTest(unittest.TestCase):
         self.assertGreaterEqual(len(objects), 1, run.stdout)
         self.assertNotIn("MISMATCH", run.stdout)
         self.assertIn("support plane", run.stdout)
+
+    def test_example_on_its_own_frame_files(self):
+        # The README's first path for a new user: --color C.png --depth D.png.
+        spec = importlib.util.spec_from_file_location("example", ARGS.example)
+        example = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(example)
+        color, depth = example.render_table_scene()
+        millimetres = numpy.where(numpy.isfinite(depth),
+                                  numpy.round(depth * 1000.0), 0)
+        millimetres = millimetres.astype(">u2")
+        with tempfile.TemporaryDirectory() as folder:
+            c = os.path.join(folder, "color.png")
+            d = os.path.join(folder, "depth.png")
+            write_png(c, [row.tobytes() for row in color], 8, 2)
+            write_png(d, [row.tobytes() for row in millimetres], 16, 0)
+            for method in ("COS", "EBS"):
+                run = subprocess.run(
+                    [sys.executable, ARGS.example, "--server", self.target,
+                     "--color", c, "--depth", d, "--method", method],
+                    capture_output=True, text=True, timeout=300,
+                    env=os.environ)
+                sys.stdout.write(run.stdout)
+                sys.stderr.write(run.stderr)
+                self.assertEqual(run.returncode, 0, run.stderr)
+                self.assertNotIn("MISMATCH", run.stdout)
+                self.assertTrue(any(line.startswith("object ")
+                                    for line in run.stdout.splitlines()),
+                                run.stdout)
 
     def test_replica_list_skips_one_that_is_down(self):
         # Port 1 on loopback has no listener: round robin skips it.
