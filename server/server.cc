@@ -22,6 +22,7 @@
 #include "absl/time/clock.h"
 #include "core/base/status_macros.h"
 #include "core/synth/synth_scene.h"
+#include "grpc/health/v1/health.pb.h"
 #include "server/accept_guard.h"
 #include "server/capabilities.h"
 #include "server/clock.h"
@@ -313,6 +314,11 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
                                                          server->work_.get());
 
   grpc::EnableDefaultHealthCheckService(true);
+  // gRPC's own health service carries no protobuf descriptor; reflection
+  // answers from the generated pool, so the contract's copy of
+  // grpc.health.v1 (built into fovea_proto) is linked in and registered
+  // here: grpcurl and `buf curl` can then call Health through reflection.
+  (void)grpc::health::v1::HealthCheckRequest::descriptor();
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
   // Refuse a port another process already serves (Linux would otherwise

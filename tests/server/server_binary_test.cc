@@ -258,6 +258,82 @@ grpc::StatusCode ReflectionCallStatus(const std::string& target) {
   return status.error_code();
 }
 
+// Reflection's answer to file_containing_symbol `symbol` (a request
+// written by hand: grpc++ ships no reflection client): true when it holds a
+// file descriptor, false when it holds an error (or the call fails).
+bool ReflectionKnows(const std::string& target, const std::string& symbol) {
+  grpc::GenericStub stub(
+      grpc::CreateChannel(target, grpc::InsecureChannelCredentials()));
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() +
+                       std::chrono::seconds(10));
+  grpc::CompletionQueue queue;
+  std::unique_ptr<grpc::GenericClientAsyncReaderWriter> call =
+      stub.PrepareCall(&context,
+                       "/grpc.reflection.v1alpha.ServerReflection/"
+                       "ServerReflectionInfo",
+                       &queue);
+  void* tag = nullptr;
+  bool ok = false;
+  call->StartCall(reinterpret_cast<void*>(1));
+  queue.Next(&tag, &ok);
+  // ServerReflectionRequest{file_containing_symbol (field 4) = symbol}.
+  std::string request = "\x22";
+  request += static_cast<char>(symbol.size());
+  request += symbol;
+  grpc::Slice slice(request);
+  grpc::ByteBuffer out(&slice, 1);
+  call->Write(out, reinterpret_cast<void*>(2));
+  queue.Next(&tag, &ok);
+  grpc::ByteBuffer in;
+  call->Read(&in, reinterpret_cast<void*>(3));
+  queue.Next(&tag, &ok);
+  const bool read = ok;
+  call->WritesDone(reinterpret_cast<void*>(4));
+  queue.Next(&tag, &ok);
+  grpc::Status status;
+  call->Finish(&status, reinterpret_cast<void*>(5));
+  queue.Next(&tag, &ok);
+  queue.Shutdown();
+  while (queue.Next(&tag, &ok)) {
+  }
+  if (!read) return false;
+  std::vector<grpc::Slice> slices;
+  if (!in.Dump(&slices).ok()) return false;
+  std::string bytes;
+  for (const grpc::Slice& s : slices) {
+    bytes.append(reinterpret_cast<const char*>(s.begin()), s.size());
+  }
+  // The response's top-level fields are all length-delimited: walk them
+  // to the oneof, file_descriptor_response (4) or error_response (7).
+  size_t at = 0;
+  while (at < bytes.size()) {
+    const int field = static_cast<uint8_t>(bytes[at]) >> 3;
+    ++at;
+    uint64_t length = 0;
+    for (int shift = 0; at < bytes.size(); shift += 7) {
+      const uint8_t b = static_cast<uint8_t>(bytes[at++]);
+      length |= static_cast<uint64_t>(b & 0x7f) << shift;
+      if ((b & 0x80) == 0) break;
+    }
+    if (field == 4) return true;
+    if (field == 7) return false;
+    at += length;
+  }
+  return false;
+}
+
+// Every service reflection lists can be called through it: the contract's
+// and grpc.health.v1 (whose descriptor gRPC's own health service lacks).
+TEST(ServerBinaryTest, ReflectionDescribesEveryServiceItLists) {
+  const ServerProcess server = StartServing({"--concurrency=1"});
+  ASSERT_GT(server.pid, 0);
+  EXPECT_TRUE(ReflectionKnows(server.target, "fovea.v1.Perception"));
+  EXPECT_TRUE(ReflectionKnows(server.target, "grpc.health.v1.Health"));
+  EXPECT_FALSE(ReflectionKnows(server.target, "no.such.Service"));
+  ExpectCleanExitOnSigterm(server.pid);
+}
+
 TEST(ServerBinaryTest, ReflectionIsOnUnlessTurnedOff) {
   for (const bool on : {true, false}) {
     const ServerProcess server = StartServing(
