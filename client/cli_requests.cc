@@ -2,8 +2,10 @@
 // (cli_requests.h).
 #include "client/cli_requests.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <utility>
@@ -11,6 +13,7 @@
 
 #include "absl/flags/flag.h"
 #include "absl/status/status.h"
+#include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
@@ -126,6 +129,12 @@ ABSL_FLAG(std::string, object_points, "",
 ABSL_FLAG(int32_t, max_points, 0,
           "segment: with --object_points, at most this many per object, "
           "evenly spread (0: all)");
+ABSL_FLAG(std::string, frames, "",
+          "track: a folder of frames <n>_color.png and <n>_depth.png (16-bit, "
+          "--depth_scale units), taken in the order of <n>");
+ABSL_FLAG(double, fps, 0.0,
+          "track: send the frames at this rate, as a camera would (the server "
+          "answers the freshest); 0: each after the previous answer");
 ABSL_FLAG(double, time_budget_ms, 0.0,
           "segment-incremental: time budget, milliseconds, 0 = none");
 
@@ -243,6 +252,56 @@ absl::StatusOr<LoadedFrame> FrameFromFlags() {
   source.frame_id = absl::GetFlag(FLAGS_frame_id);
   return LoadFrame(source);
 }
+
+absl::StatusOr<std::vector<FrameSource>> TrackFramesFromFlags() {
+  const std::string dir = absl::GetFlag(FLAGS_frames);
+  if (dir.empty()) {
+    return absl::InvalidArgumentError("--frames: a folder is required");
+  }
+  std::error_code error;
+  std::vector<std::pair<uint64_t, std::string>> numbered;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, error)) {
+    const std::string name = entry.path().filename().string();
+    constexpr absl::string_view kSuffix = "_color.png";
+    if (!absl::EndsWith(name, kSuffix)) continue;
+    uint64_t n = 0;
+    if (!absl::SimpleAtoi(name.substr(0, name.size() - kSuffix.size()), &n)) {
+      continue;
+    }
+    numbered.emplace_back(n, name.substr(0, name.size() - kSuffix.size()));
+  }
+  if (error) {
+    return absl::NotFoundError(
+        absl::StrCat("--frames: cannot read '", dir, "': ", error.message()));
+  }
+  if (numbered.empty()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--frames: no <n>_color.png in '", dir, "'"));
+  }
+  std::sort(numbered.begin(), numbered.end());
+  std::vector<FrameSource> sources;
+  for (const auto& [n, stem] : numbered) {
+    FrameSource source;
+    source.color_path =
+        (std::filesystem::path(dir) / (stem + "_color.png")).string();
+    source.depth_path =
+        (std::filesystem::path(dir) / (stem + "_depth.png")).string();
+    if (!std::filesystem::exists(source.depth_path)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "--frames: ", source.color_path, " has no ", stem, "_depth.png"));
+    }
+    source.fx = absl::GetFlag(FLAGS_fx);
+    source.fy = absl::GetFlag(FLAGS_fy);
+    source.cx = absl::GetFlag(FLAGS_cx);
+    source.cy = absl::GetFlag(FLAGS_cy);
+    source.depth_scale = absl::GetFlag(FLAGS_depth_scale);
+    source.frame_id = absl::GetFlag(FLAGS_frame_id);
+    sources.push_back(std::move(source));
+  }
+  return sources;
+}
+
+double TrackFpsFromFlags() { return absl::GetFlag(FLAGS_fps); }
 
 // Detect options from the flags; INVALID_ARGUMENT naming a bad one.
 absl::StatusOr<fovea::v1::DetectOptions> DetectOptionsFromFlags(

@@ -55,6 +55,13 @@ struct SegmentParameters {
 // that is not 'u,v').
 absl::StatusOr<SegmentParameters> SegmentParametersFromFlags();
 
+// track: the frames of --frames (<n>_color.png and <n>_depth.png, in the
+// order of <n>, with the intrinsics and depth scale flags);
+// INVALID_ARGUMENT naming --frames when it is empty, has none, or a colour
+// file lacks its depth.
+absl::StatusOr<std::vector<FrameSource>> TrackFramesFromFlags();
+double TrackFpsFromFlags();  // --fps
+
 }  // namespace fovea::client
 
 #endif  // FOVEA_CLIENT_CLI_REQUESTS_H_

@@ -1,8 +1,10 @@
 #include "client/fovea_client.h"
 
+#include <thread>
 #include <utility>
 
 #include "absl/memory/memory.h"
+#include "absl/time/clock.h"
 #include "core/base/status_macros.h"
 #include "grpcpp/client_context.h"
 
@@ -110,6 +112,51 @@ absl::Status FoveaClient::SegmentIncremental(
   std::unique_ptr<grpc::ClientReader<fovea::v1::SegmentResponse>> reader =
       perception_->SegmentIncremental(&context, request);
   return DrainStream(*reader, on_message);
+}
+
+absl::Status FoveaClient::Track(
+    const fovea::v1::TrackOptions& options,
+    const std::function<std::optional<fovea::v1::TrackFrame>()>& next_frame,
+    absl::Duration deadline,
+    const std::function<void(const fovea::v1::TrackResponse&)>& on_response,
+    double fps) {
+  grpc::ClientContext context;
+  PrepareContext(deadline, options_, context);
+  std::unique_ptr<grpc::ClientReaderWriter<fovea::v1::TrackRequest,
+                                           fovea::v1::TrackResponse>>
+      stream = perception_->Track(&context);
+  fovea::v1::TrackRequest first;
+  *first.mutable_options() = options;
+  fovea::v1::TrackResponse response;
+  if (!stream->Write(first)) return ToAbslStatus(stream->Finish());
+  if (fps <= 0.0) {
+    // Lockstep: a frame, its answer, the next frame.
+    while (std::optional<fovea::v1::TrackFrame> frame = next_frame()) {
+      fovea::v1::TrackRequest request;
+      *request.mutable_frame() = *std::move(frame);
+      if (!stream->Write(request) || !stream->Read(&response)) break;
+      on_response(response);
+    }
+    stream->WritesDone();
+    while (stream->Read(&response)) on_response(response);
+    return ToAbslStatus(stream->Finish());
+  }
+  // A camera: frames at `fps` whatever the answers do.
+  std::thread writer([&] {
+    const absl::Duration period = absl::Seconds(1.0 / fps);
+    absl::Time next = absl::Now();
+    while (std::optional<fovea::v1::TrackFrame> frame = next_frame()) {
+      absl::SleepFor(next - absl::Now());
+      next += period;
+      fovea::v1::TrackRequest request;
+      *request.mutable_frame() = *std::move(frame);
+      if (!stream->Write(request)) break;
+    }
+    stream->WritesDone();
+  });
+  while (stream->Read(&response)) on_response(response);
+  writer.join();
+  return ToAbslStatus(stream->Finish());
 }
 
 }  // namespace fovea::client

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "absl/status/status.h"
@@ -80,6 +81,21 @@ class FoveaClient {
   absl::Status SegmentIncremental(
       const fovea::v1::SegmentIncrementalRequest& request,
       absl::Duration deadline, const SegmentCallback& on_message);
+
+  // A Track stream (track.proto): sends `options`, then the frames
+  // `next_frame` gives until it returns nullopt, then half-closes;
+  // `on_response` runs once per processed frame, in order. With `fps` 0
+  // each frame is sent after the previous one's answer (none is skipped);
+  // with `fps` > 0 frames are sent at that rate from another thread, as a
+  // camera would, and the server answers the freshest (the others are
+  // skipped: TrackResponse.frames_skipped). `deadline` bounds the whole
+  // stream. Returns the stream's final status.
+  absl::Status Track(
+      const fovea::v1::TrackOptions& options,
+      const std::function<std::optional<fovea::v1::TrackFrame>()>& next_frame,
+      absl::Duration deadline,
+      const std::function<void(const fovea::v1::TrackResponse&)>& on_response,
+      double fps = 0.0);
 
  private:
   FoveaClient(std::shared_ptr<grpc::Channel> channel,

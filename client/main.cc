@@ -19,6 +19,7 @@
 #include <iostream>
 #include <iterator>
 #include <memory>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -39,6 +40,7 @@
 #include "client/cli_requests.h"
 #include "client/fovea_client.h"
 #include "core/base/status_macros.h"
+#include "proto/enum_names.h"
 
 // The connection and the output. The request flags (the frame, detect
 // options, scene, segmentation) are in cli_requests.cc.
@@ -90,6 +92,10 @@ commands:
 )";
 
 constexpr char kUsageTail[] = R"(
+DIR holds <n>_color.png and <n>_depth.png, sent in the order of <n> (with
+the intrinsics and scene flags as for FRAME; --fps F sends them as a
+camera would, the server answering the freshest).
+
 FRAME is one of
   --color C.png --depth D.png [--fx F --fy F --cx C --cy C] [--depth_scale S]
   --pcd scene.pcd        (OSD Kinect intrinsics unless given)
@@ -322,6 +328,77 @@ int RunSegment(bool incremental) {
   return kExitOk;
 }
 
+// track: the frames of --frames as one stream; one line per processed
+// frame (--json: the TrackResponse, each object with its track_id and
+// mask).
+int RunTrack() {
+  absl::StatusOr<fovea::v1::DetectOptions> options =
+      DetectOptionsFromFlags(/*return_saliency_map=*/false);
+  if (!options.ok()) return Fail(kExitUsage, options.status());
+  absl::StatusOr<SegmentParameters> segment = SegmentParametersFromFlags();
+  if (!segment.ok()) return Fail(kExitUsage, segment.status());
+  absl::StatusOr<std::vector<FrameSource>> sources = TrackFramesFromFlags();
+  if (!sources.ok()) return Fail(kExitUsage, sources.status());
+  absl::StatusOr<std::unique_ptr<FoveaClient>> client = MakeClient();
+  if (!client.ok()) return FailLocal(client.status());
+
+  fovea::v1::TrackOptions track;
+  track.set_request_id(RequestId());
+  *track.mutable_detect_options() = *std::move(options);
+  track.set_max_objects(static_cast<uint32_t>(segment->max_objects));
+  track.set_time_budget_seconds(segment->time_budget_ms / 1e3);
+  *track.mutable_object_points() = segment->object_points;
+
+  const bool json = absl::GetFlag(FLAGS_json);
+  size_t next = 0;
+  absl::Status local = absl::OkStatus();
+  auto next_frame = [&]() -> std::optional<fovea::v1::TrackFrame> {
+    if (next >= sources->size() || !local.ok()) return std::nullopt;
+    absl::StatusOr<LoadedFrame> loaded = LoadFrame((*sources)[next]);
+    if (!loaded.ok()) {
+      local = loaded.status();
+      return std::nullopt;
+    }
+    fovea::v1::TrackFrame frame;
+    *frame.mutable_frame() = std::move(loaded->frame);
+    frame.set_sequence(next++);
+    return frame;
+  };
+  int responses = 0;
+  auto on_response = [&](const fovea::v1::TrackResponse& response) {
+    ++responses;
+    if (json) {
+      std::cout << ToJson(response) << std::endl;
+      return;
+    }
+    std::string line = absl::StrFormat(
+        "frame %d: %d objects, %s, %.1f ms", response.sequence(),
+        response.objects_size(), response.reused() ? "reused" : "segmented",
+        response.seconds() * 1e3);
+    for (const fovea::v1::TrackedObject& o : response.objects()) {
+      absl::StrAppend(
+          &line, absl::StrFormat(
+                     "  #%d %s", o.track_id(),
+                     fovea::v1::ShortEnumName(
+                         *fovea::v1::TrackState_descriptor()->FindValueByNumber(
+                             o.state()))));
+    }
+    if (response.frames_skipped() > 0) {
+      absl::StrAppend(&line, " (", response.frames_skipped(), " skipped)");
+    }
+    std::cout << line << std::endl;
+  };
+  const absl::Status status = (*client)->Track(
+      track, next_frame, Deadline(), on_response, TrackFpsFromFlags());
+  if (!local.ok()) return FailLocal(local);
+  if (!status.ok()) return Fail(kExitCallFailed, status);
+  if (!json) {
+    std::cout << responses << " of " << sources->size() << " frames answered"
+              << std::endl;
+  }
+  return kExitOk;
+}
+
 bool IsClientFlagFile(absl::string_view file) {
   return absl::StrContains(file, "client/");
 }
@@ -347,6 +424,8 @@ const std::vector<Command>& Commands() {
       {"segment-incremental", "FRAME",
        "anytime incremental segmentation, streamed",
        [] { return RunSegment(/*incremental=*/true); }},
+      {"track", "--frames DIR",
+       "a stream of frames: objects with identities that persist", &RunTrack},
   };
   return *kCommands;
 }

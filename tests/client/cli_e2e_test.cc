@@ -4,6 +4,8 @@
 
 #include <filesystem>
 #include <memory>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
 
@@ -14,6 +16,7 @@
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
 #include "client/fovea_client.h"
+#include "core/synth/sequence.h"
 #include "fovea/v1/detect.pb.h"
 #include "gmock/gmock.h"
 #include "google/protobuf/util/json_util.h"
@@ -197,6 +200,55 @@ TEST_F(FoveaClientCliE2eTest, SegmentStreamsObjectsAndWritesEachMask) {
   EXPECT_TRUE(std::filesystem::exists(out + "/overlay.png"));
   EXPECT_TRUE(std::filesystem::exists(out + "/responses.jsonl"));
   std::filesystem::remove_all(out);
+}
+
+// track --frames DIR: one's own frames in a folder, in numeric order (2
+// before 10), one JSON line per processed frame with each object's
+// track_id and mask; a still scene keeps its identities.
+TEST_F(FoveaClientCliE2eTest, TrackSendsAFolderOfFramesAndKeepsIdentities) {
+  const std::string dir =
+      ::testing::TempDir() + "/track_cli_" + std::to_string(::getpid());
+  std::filesystem::create_directories(dir);
+  const synth::Sequence sequence =
+      synth::GenerateSequence(synth::SequenceKind::kStatic, 3, 3);
+  const int numbers[] = {2, 10, 31};
+  for (int i = 0; i < 3; ++i) {
+    const RgbdFrame& frame = sequence.frames[i].frame.frame;
+    cv::Mat bgr;
+    cv::cvtColor(frame.color, bgr, cv::COLOR_RGB2BGR);
+    cv::Mat millimetres;
+    frame.depth.convertTo(millimetres, CV_16UC1, 1000.0);  // NaN -> 0
+    ASSERT_TRUE(
+        cv::imwrite(absl::StrCat(dir, "/", numbers[i], "_color.png"), bgr));
+    ASSERT_TRUE(cv::imwrite(absl::StrCat(dir, "/", numbers[i], "_depth.png"),
+                            millimetres));
+  }
+  const CliRun run = RunCli(
+      absl::StrCat("--server ", address_, " track --frames ", dir, " --json"));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const std::vector<std::string> lines =
+      absl::StrSplit(run.out, '\n', absl::SkipEmpty());
+  ASSERT_EQ(lines.size(), 3u) << run.out;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    EXPECT_THAT(lines[i], HasSubstr(absl::StrCat("\"sequence\":\"", i, "\"")));
+    EXPECT_THAT(lines[i], HasSubstr("\"trackId\":\"1\""));
+    EXPECT_THAT(lines[i], HasSubstr("\"counts\""));  // the RLE mask
+  }
+  EXPECT_THAT(lines[0], HasSubstr("TRACK_STATE_APPEARED"));
+  EXPECT_THAT(lines[2], HasSubstr("TRACK_STATE_KEPT"));
+  EXPECT_THAT(lines[2], HasSubstr("\"reused\":true"));
+
+  const CliRun text =
+      RunCli(absl::StrCat("--server ", address_, " track --frames ", dir));
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_THAT(text.out, HasSubstr("#1 appeared"));
+  EXPECT_THAT(text.out, HasSubstr("3 of 3 frames answered"));
+
+  const CliRun empty = RunCli(
+      absl::StrCat("--server ", address_, " track --frames ", dir, "/none"));
+  EXPECT_EQ(empty.exit_code, 64);
+  EXPECT_THAT(empty.err, HasSubstr("--frames"));
+  std::filesystem::remove_all(dir);
 }
 
 TEST_F(FoveaClientCliE2eTest,
