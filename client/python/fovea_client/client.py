@@ -1,12 +1,13 @@
 """A small blocking client for fovea.v1.Perception (perception.proto)."""
 
-from typing import Any, Iterator, Optional, Sequence, Tuple
+from typing import Any, Iterable, Iterator, Optional, Sequence, Tuple
 
 import grpc
 import numpy as np
 
 from fovea.health.v1 import health_pb2
-from fovea.v1 import detect_pb2, perception_pb2, perception_pb2_grpc, segment_pb2
+from fovea.v1 import (detect_pb2, perception_pb2, perception_pb2_grpc,
+                      segment_pb2, track_pb2)
 
 from fovea_client.channel import channel_options, channel_target
 from fovea_client.frame import frame_from_numpy
@@ -251,6 +252,51 @@ class FoveaClient:
             object_points=_points_options(object_points, max_points))
         return self._stream(
             self._stub.SegmentIncremental(request, timeout=timeout))
+
+    def track(self, frames: Iterable[Tuple[np.ndarray, np.ndarray]],
+              fx: float, fy: float, cx: float, cy: float,
+              poses: Optional[Iterable[Optional[Tuple[Sequence[float],
+                                                      Sequence[float]]]]] = None,
+              max_objects: int = 0, time_budget_seconds: float = 0.0,
+              timeout: Optional[float] = None, request_id: str = "",
+              **options: Any) -> Iterator[track_pb2.TrackResponse]:
+        """A Track stream: objects with identities that persist.
+
+        frames: an iterable of (colour RGB uint8 HxWx3, depth float32
+        metres HxW), consumed as the stream sends them (a generator reading
+        a camera works: the server answers the freshest frame and skips the
+        ones that came while it was busy). poses: optional, one per frame,
+        (position xyz in metres, quaternion xyzw) camera-to-world, or None
+        for a frame without one. Yields one TrackResponse per processed
+        frame: response.objects, each with track_id, state (APPEARED, KEPT,
+        MOVED, GONE), object (mask as COCO RLE, see decode_rle) and
+        world_centroid. `options` are DetectOptions fields. Breaking out of
+        the loop early cancels the stream.
+        """
+        pose_iter = iter(poses) if poses is not None else None
+
+        def requests():
+            yield track_pb2.TrackRequest(options=track_pb2.TrackOptions(
+                request_id=request_id, max_objects=max_objects,
+                time_budget_seconds=time_budget_seconds,
+                detect_options=detect_options(**options)))
+            for n, (color_rgb, depth_m) in enumerate(frames):
+                message = track_pb2.TrackFrame(
+                    frame=frame_from_numpy(color_rgb, depth_m, fx, fy, cx, cy),
+                    sequence=n)
+                pose = next(pose_iter, None) if pose_iter is not None else None
+                if pose is not None:
+                    (px, py, pz), (qx, qy, qz, qw) = pose
+                    message.camera_to_world.position.x = px
+                    message.camera_to_world.position.y = py
+                    message.camera_to_world.position.z = pz
+                    message.camera_to_world.orientation.x = qx
+                    message.camera_to_world.orientation.y = qy
+                    message.camera_to_world.orientation.z = qz
+                    message.camera_to_world.orientation.w = qw
+                yield track_pb2.TrackRequest(frame=message)
+
+        return self._stream(self._stub.Track(requests(), timeout=timeout))
 
     @staticmethod
     def _stream(call: Any) -> Iterator[segment_pb2.SegmentResponse]:

@@ -140,6 +140,33 @@ class ExampleTest(unittest.TestCase):
                                     for line in run.stdout.splitlines()),
                                 run.stdout)
 
+    def test_track_yields_one_response_per_frame_with_lasting_ids(self):
+        spec = importlib.util.spec_from_file_location("example", ARGS.example)
+        example = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(example)
+        color, depth = example.render_table_scene()
+        # Lockstep: each frame only after the last answer, so none is
+        # skipped; the same still frame three times.
+        answered = []
+
+        def frames():
+            for _ in range(3):
+                yield color, depth
+                while len(answered) < _ + 1:
+                    time.sleep(0.01)
+
+        with FoveaClient(self.target) as client:
+            for response in client.track(frames(), example.FX, example.FY,
+                                         example.CX, example.CY, timeout=120,
+                                         request_id="py"):
+                answered.append(response)
+        self.assertEqual(len(answered), 3)
+        first = [o.track_id for o in answered[0].objects]
+        self.assertGreaterEqual(len(first), 1)
+        self.assertEqual([o.track_id for o in answered[2].objects], first)
+        self.assertTrue(answered[2].reused)
+        self.assertEqual(answered[2].request_id, "py")
+
     def test_replica_list_skips_one_that_is_down(self):
         # Port 1 on loopback has no listener: round robin skips it.
         with FoveaClient(f"127.0.0.1:1,{self.target}") as client:
