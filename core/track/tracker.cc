@@ -198,6 +198,17 @@ bool Tracker::CameraStill(const std::optional<Eigen::Isometry3f>& pose) const {
          std::abs(angle) <= options_.still_rad;
 }
 
+TrackedObject Tracker::Gone(const Track& track) {
+  TrackedObject gone;
+  gone.track_id = track.id;
+  gone.state = TrackState::kGone;
+  gone.world_centroid = track.world_centroid;
+  gone.frames_seen = track.frames_seen;
+  gone.object.index = -1;  // no mask: only the last centroid
+  gone.object.centroid = track.object.centroid;
+  return gone;
+}
+
 absl::StatusOr<TrackedFrame> Tracker::Process(
     const RgbdFrame& frame,
     const std::optional<Eigen::Isometry3f>& camera_to_world,
@@ -216,14 +227,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
     // A new camera (or the first frame): what was in view is gone.
     for (const Track& t : tracks) {
       if (t.last_seen_frame != frame_index_ - 1) continue;
-      TrackedObject gone;
-      gone.track_id = t.id;
-      gone.state = TrackState::kGone;
-      gone.world_centroid = t.world_centroid;
-      gone.frames_seen = t.frames_seen;
-      gone.object.index = -1;
-      gone.object.centroid = t.object.centroid;
-      out.objects.push_back(std::move(gone));
+      out.objects.push_back(Gone(t));
     }
     tracks.clear();
   }
@@ -463,14 +467,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
       if (seen[i] || t.id == 0 || t.last_seen_frame != frame_index_ - 1) {
         continue;
       }
-      TrackedObject gone;
-      gone.track_id = t.id;
-      gone.state = TrackState::kGone;
-      gone.world_centroid = t.world_centroid;
-      gone.frames_seen = t.frames_seen;
-      gone.object.index = -1;
-      gone.object.centroid = t.object.centroid;
-      out.objects.push_back(std::move(gone));
+      out.objects.push_back(Gone(t));
     }
     // Forget what has been gone too long, and joined tracks.
     tracks.erase(std::remove_if(tracks.begin(), tracks.end(),

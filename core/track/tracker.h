@@ -130,6 +130,8 @@ class Tracker {
     bool composite = false;  // pieces were joined into it
   };
 
+  // The report of `track` leaving view.
+  static TrackedObject Gone(const Track& track);
   // The fraction of pixels that changed from the reference frame.
   double ChangedFraction(const RgbdFrame& frame) const;
   bool CameraStill(const std::optional<Eigen::Isometry3f>& pose) const;

@@ -229,9 +229,12 @@ TEST(ServerBinaryTest, FloodOfSilentConnectionsLeavesTheListenerAlive) {
   ExpectCleanExitOnSigterm(server.pid);
 }
 
-// The reflection service's one method, called with an empty request
-// stream: its status.
-grpc::StatusCode ReflectionCallStatus(const std::string& target) {
+// The reflection service's one method: `request` (serialized; none when
+// empty) sent, the first answer read into `answer` (when one came), the
+// stream half-closed; its status.
+grpc::StatusCode ReflectionExchange(const std::string& target,
+                                    const std::string& request,
+                                    std::string* answer) {
   grpc::GenericStub stub(
       grpc::CreateChannel(target, grpc::InsecureChannelCredentials()));
   grpc::ClientContext context;
@@ -246,49 +249,18 @@ grpc::StatusCode ReflectionCallStatus(const std::string& target) {
   void* tag = nullptr;
   bool ok = false;
   call->StartCall(reinterpret_cast<void*>(1));
-  queue.Next(&tag, &ok);
-  call->WritesDone(reinterpret_cast<void*>(2));
-  queue.Next(&tag, &ok);
-  grpc::Status status;
-  call->Finish(&status, reinterpret_cast<void*>(3));
-  queue.Next(&tag, &ok);
-  queue.Shutdown();
-  while (queue.Next(&tag, &ok)) {
-  }
-  return status.error_code();
-}
-
-// Reflection's answer to file_containing_symbol `symbol` (a request
-// written by hand: grpc++ ships no reflection client): true when it holds a
-// file descriptor, false when it holds an error (or the call fails).
-bool ReflectionKnows(const std::string& target, const std::string& symbol) {
-  grpc::GenericStub stub(
-      grpc::CreateChannel(target, grpc::InsecureChannelCredentials()));
-  grpc::ClientContext context;
-  context.set_deadline(std::chrono::system_clock::now() +
-                       std::chrono::seconds(10));
-  grpc::CompletionQueue queue;
-  std::unique_ptr<grpc::GenericClientAsyncReaderWriter> call =
-      stub.PrepareCall(&context,
-                       "/grpc.reflection.v1alpha.ServerReflection/"
-                       "ServerReflectionInfo",
-                       &queue);
-  void* tag = nullptr;
-  bool ok = false;
-  call->StartCall(reinterpret_cast<void*>(1));
-  queue.Next(&tag, &ok);
-  // ServerReflectionRequest{file_containing_symbol (field 4) = symbol}.
-  std::string request = "\x22";
-  request += static_cast<char>(symbol.size());
-  request += symbol;
-  grpc::Slice slice(request);
-  grpc::ByteBuffer out(&slice, 1);
-  call->Write(out, reinterpret_cast<void*>(2));
   queue.Next(&tag, &ok);
   grpc::ByteBuffer in;
-  call->Read(&in, reinterpret_cast<void*>(3));
-  queue.Next(&tag, &ok);
-  const bool read = ok;
+  bool read = false;
+  if (!request.empty()) {
+    grpc::Slice slice(request);
+    grpc::ByteBuffer out(&slice, 1);
+    call->Write(out, reinterpret_cast<void*>(2));
+    queue.Next(&tag, &ok);
+    call->Read(&in, reinterpret_cast<void*>(3));
+    queue.Next(&tag, &ok);
+    read = ok;
+  }
   call->WritesDone(reinterpret_cast<void*>(4));
   queue.Next(&tag, &ok);
   grpc::Status status;
@@ -297,13 +269,30 @@ bool ReflectionKnows(const std::string& target, const std::string& symbol) {
   queue.Shutdown();
   while (queue.Next(&tag, &ok)) {
   }
-  if (!read) return false;
   std::vector<grpc::Slice> slices;
-  if (!in.Dump(&slices).ok()) return false;
-  std::string bytes;
-  for (const grpc::Slice& s : slices) {
-    bytes.append(reinterpret_cast<const char*>(s.begin()), s.size());
+  if (read && answer != nullptr && in.Dump(&slices).ok()) {
+    for (const grpc::Slice& slice : slices) {
+      answer->append(reinterpret_cast<const char*>(slice.begin()),
+                     slice.size());
+    }
   }
+  return status.error_code();
+}
+
+grpc::StatusCode ReflectionCallStatus(const std::string& target) {
+  return ReflectionExchange(target, "", nullptr);
+}
+
+// Reflection's answer to file_containing_symbol `symbol` (a request
+// written by hand: grpc++ ships no reflection client): true when it holds a
+// file descriptor, false when it holds an error (or nothing came).
+bool ReflectionKnows(const std::string& target, const std::string& symbol) {
+  // ServerReflectionRequest{file_containing_symbol (field 4) = symbol}.
+  std::string request = "\x22";
+  request += static_cast<char>(symbol.size());
+  request += symbol;
+  std::string bytes;
+  ReflectionExchange(target, request, &bytes);
   // The response's top-level fields are all length-delimited: walk them
   // to the oneof, file_descriptor_response (4) or error_response (7).
   size_t at = 0;

@@ -17,19 +17,12 @@
 #include "core/pipeline/models.h"
 #include "core/pipeline/segment.h"
 #include "core/synth/synth_scene.h"
+#include "tests/core/testing/models.h"
 
 namespace fovea {
 namespace {
 
-const LoadedModels* Models() {
-  static const LoadedModels* models = [] {
-    const char* source = std::getenv("FOVEA_SOURCE_DIR");
-    absl::StatusOr<LoadedModels> loaded = LoadModels(
-        (std::filesystem::path(source ? source : ".") / "models").string());
-    return loaded.ok() ? new LoadedModels(*std::move(loaded)) : nullptr;
-  }();
-  return models;
-}
+const LoadedModels* Models() { return testing::ShippedModels(); }
 
 bool SameMat(const cv::Mat& a, const cv::Mat& b) {
   if (a.size() != b.size() || a.type() != b.type()) return false;
@@ -95,7 +88,7 @@ TEST(ParallelResultsTest, TwoThreadsGiveTheResultsOfOne) {
     for (const uint64_t seed : {1u, 2u}) {
       const synth::SynthScene scene =
           pile ? synth::GeneratePile(seed) : synth::GenerateScene(seed);
-      SCOPED_TRACE(testing::Message() << (pile ? "pile " : "scene ") << seed);
+      SCOPED_TRACE(::testing::Message() << (pile ? "pile " : "scene ") << seed);
       const Results one = RunAll(scene.frame.frame, *models);
       EXPECT_FALSE(one.inc_masks.empty());
       Results two;

@@ -18,20 +18,13 @@
 #include "core/pipeline/incremental.h"
 #include "core/pipeline/models.h"
 #include "core/pipeline/segment.h"
+#include "tests/core/testing/models.h"
 #include "tools/eval/realsense_frames.h"
 
 namespace fovea {
 namespace {
 
-const LoadedModels& Models() {
-  static const LoadedModels* models = [] {
-    const char* source = std::getenv("FOVEA_SOURCE_DIR");
-    absl::StatusOr<LoadedModels> loaded = LoadModels(
-        (std::filesystem::path(source ? source : ".") / "models").string());
-    return loaded.ok() ? new LoadedModels(*std::move(loaded)) : nullptr;
-  }();
-  return *models;
-}
+const LoadedModels& Models() { return *testing::ShippedModels(); }
 
 struct FrameRun {
   SupportPlane plane;

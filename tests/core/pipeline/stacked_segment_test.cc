@@ -13,19 +13,12 @@
 #include "core/pipeline/incremental.h"
 #include "core/pipeline/models.h"
 #include "core/synth/stacked_scene.h"
+#include "tests/core/testing/models.h"
 
 namespace fovea {
 namespace {
 
-const LoadedModels* Models() {
-  static const LoadedModels* models = [] {
-    const char* source = std::getenv("FOVEA_SOURCE_DIR");
-    absl::StatusOr<LoadedModels> loaded = LoadModels(
-        (std::filesystem::path(source ? source : ".") / "models").string());
-    return loaded.ok() ? new LoadedModels(*std::move(loaded)) : nullptr;
-  }();
-  return models;
-}
+const LoadedModels* Models() { return testing::ShippedModels(); }
 
 // The best F of any mask against `object` (CV_8UC1, non-zero on it).
 double BestF(const std::vector<cv::Mat>& masks, const cv::Mat& object) {

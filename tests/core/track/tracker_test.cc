@@ -15,6 +15,7 @@
 
 #include "core/pipeline/models.h"
 #include "core/synth/sequence.h"
+#include "tests/core/testing/models.h"
 
 namespace fovea {
 namespace {
@@ -23,15 +24,7 @@ using synth::GenerateSequence;
 using synth::Sequence;
 using synth::SequenceKind;
 
-const LoadedModels* Models() {
-  static const LoadedModels* models = [] {
-    const char* source = std::getenv("FOVEA_SOURCE_DIR");
-    absl::StatusOr<LoadedModels> loaded = LoadModels(
-        (std::filesystem::path(source ? source : ".") / "models").string());
-    return loaded.ok() ? new LoadedModels(*std::move(loaded)) : nullptr;
-  }();
-  return models;
-}
+const LoadedModels* Models() { return testing::ShippedModels(); }
 
 // The ground-truth identity of at least 80 % of `mask`'s pixels (-1:
 // none: the table, or a mask holding two objects, whose identity is
