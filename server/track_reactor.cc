@@ -275,6 +275,9 @@ class TrackReactor final
       broken_ = true;
       lock.unlock();
       RecordStalledStream();
+      // Ends the write in flight (OnWriteDone(false)), so the stream
+      // finishes; the job holds the reactor alive meanwhile.
+      context_->TryCancel();
       return absl::CancelledError(absl::StrCat(
           "Track: the client read nothing for ",
           config_.stream_stall_timeout.count(), " ms; stream cancelled"));

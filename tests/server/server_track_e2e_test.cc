@@ -250,5 +250,59 @@ TEST_F(ServerTest, TrackStreamsAreLimitedPerPeerAndClosedWhenIdle) {
       std::chrono::seconds(10)));
 }
 
+// A stream whose client sends frames but never reads its answers holds no
+// worker: once a write waits longer than the stall timeout the stream is
+// cancelled, and another client's Detect goes through.
+TEST_F(ServerTest, TrackWhoseClientNeverReadsIsCancelledAndOthersGoOn) {
+  ServerConfig config = DefaultConfig();
+  config.concurrency = 1;
+  config.stream_stall_timeout_s = 0.3;
+  StartServer(config);
+  grpc::ChannelArguments args;
+  args.SetInt(GRPC_ARG_HTTP2_STREAM_LOOKAHEAD_BYTES, 1);
+  args.SetInt(GRPC_ARG_HTTP2_BDP_PROBE, 0);
+  const std::shared_ptr<grpc::Channel> channel =
+      grpc::CreateCustomChannel("127.0.0.1:" + std::to_string(server_->port()),
+                                grpc::InsecureChannelCredentials(), args);
+  std::unique_ptr<v1::Perception::Stub> lazy = v1::Perception::NewStub(channel);
+  const synth::Sequence sequence =
+      synth::GenerateSequence(synth::SequenceKind::kStatic, 3, 2);
+  auto context = Context();
+  std::unique_ptr<Stream> stream = lazy->Track(context.get());
+  ASSERT_TRUE(stream->Write(Options("never-reads")));
+  // Still frames are answered from the last segmentation in a few ms, each
+  // answer several kB of masks: the client's window fills quickly.
+  for (uint64_t t = 0; t < 400; ++t) {
+    if (!stream->Write(FrameMessage(sequence.frames[t % 2], t))) break;
+    if (MetricValue(Scrape(), "fovea_calls_shed_total",
+                    {"reason=\"stalled_stream\""})
+            .value_or(0) >= 1) {
+      break;
+    }
+  }
+  ASSERT_TRUE(WaitFor(
+      [&] {
+        return MetricValue(Scrape(), "fovea_calls_shed_total",
+                           {"reason=\"stalled_stream\""})
+                   .value_or(0) >= 1;
+      },
+      std::chrono::seconds(30)));
+  v1::DetectResponse response;
+  EXPECT_TRUE(
+      Detect(::fovea::server::testing::MakeSyntheticRequest(1, false).request,
+             &response, std::chrono::milliseconds(20000))
+          .ok());
+  // The server ended the stream itself.
+  v1::TrackResponse ignored;
+  while (stream->Read(&ignored)) {
+  }
+  EXPECT_EQ(stream->Finish().error_code(), grpc::StatusCode::CANCELLED);
+  EXPECT_TRUE(WaitFor(
+      [&] {
+        return MetricValue(Scrape(), "fovea_track_open_streams", {}) == 0;
+      },
+      std::chrono::seconds(10)));
+}
+
 }  // namespace
 }  // namespace fovea::server
