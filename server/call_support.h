@@ -49,6 +49,14 @@ class CallRecord {
     IncrementInflight();
   }
 
+  // The call is over for gRPC too (the reactor is deleted after OnDone):
+  // only now does it stop counting in ServiceState::calls, so a shutdown
+  // that waits for calls to reach 0 never cancels an answer still being
+  // sent.
+  ~CallRecord() { state_.calls.fetch_sub(1); }
+  CallRecord(const CallRecord&) = delete;
+  CallRecord& operator=(const CallRecord&) = delete;
+
   // A unary call: one message sent when OK.
   grpc::Status EndUnary(const absl::Status& status) {
     if (status.ok()) RecordMessageSent(method_);
@@ -63,7 +71,6 @@ class CallRecord {
     const double seconds = SecondsSince(start_);
     RecordCallHandled(method_, status.code(), seconds);
     DecrementInflight();
-    state_.calls.fetch_sub(1);
     std::string line = absl::StrFormat(
         "call method=%s request_id=\"%s\" code=%s ms=%.1f", method_,
         absl::CEscape(request_id_), GrpcCodeName(status.code()), seconds * 1e3);
