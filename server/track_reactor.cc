@@ -172,15 +172,19 @@ class TrackReactor final
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (broken_ || final_status_) return absl::OkStatus();
-      if (pending_) {  // the freshest frame wins
-        ++skipped_;
-        RecordTrackFrame("skipped", 0.0);
-      }
+      if (pending_) SkipPendingLocked();  // the freshest frame wins
       pending_ = Pending{std::move(request), Clock::now()};
       if (!job_active_) submit = job_active_ = true;
     }
     if (submit) Submit();
     return absl::OkStatus();
+  }
+
+  // The waiting frame is dropped unprocessed, and counted.
+  void SkipPendingLocked() {
+    pending_.reset();
+    ++skipped_;
+    RecordTrackFrame("skipped", 0.0);
   }
 
   // Hands the next frame to a worker; a full queue skips it.
@@ -189,11 +193,7 @@ class TrackReactor final
     std::optional<absl::Status> finish;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      if (pending_) {
-        pending_.reset();
-        ++skipped_;
-        RecordTrackFrame("skipped", 0.0);
-      }
+      if (pending_) SkipPendingLocked();
       job_active_ = false;
       finish = ReadyToFinishLocked();
     }

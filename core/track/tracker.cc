@@ -143,7 +143,9 @@ absl::Status Validate(const TrackerOptions& options) {
 }
 
 Tracker::Tracker(const TrackerOptions& options, const RbfSvm* relation_svm)
-    : options_(options), relation_svm_(relation_svm) {}
+    : options_(options),
+      valid_(Validate(options)),
+      relation_svm_(relation_svm) {}
 
 double Tracker::ChangedFraction(const RgbdFrame& frame) const {
   const bool colors = !frame.color.empty() && !reference_.color.empty() &&
@@ -213,7 +215,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
     const RgbdFrame& frame,
     const std::optional<Eigen::Isometry3f>& camera_to_world,
     const InterruptCheck& interrupt) {
-  FOVEA_RETURN_IF_ERROR(Validate(options_));
+  FOVEA_RETURN_IF_ERROR(valid_);
   const SteadyClock::time_point start = SteadyClock::now();
   TrackedFrame out;
   out.frame_index = frame_index_;
@@ -275,24 +277,25 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
     for (size_t j = 0; j < found.size(); ++j) {
       world[j] = ToWorld(camera_to_world, found[j].centroid);
     }
+    // The gate of each (track, object) pair, and the largest.
+    std::vector<std::vector<double>> gate(
+        candidates.size(), std::vector<double>(found.size(), 0.0));
+    double big = 0.0;
+    for (size_t i = 0; i < candidates.size(); ++i) {
+      const Track& t = tracks[candidates[i]];
+      for (size_t j = 0; j < found.size(); ++j) {
+        gate[i][j] = std::max(
+            options_.match_m,
+            options_.match_extent_fraction *
+                std::max(LargestExtent(t.object), LargestExtent(found[j])));
+        big = std::max(big, gate[i][j]);
+      }
+    }
     // Assigns found objects to candidate tracks, distances taken after
     // subtracting `shift` from the new centroids.
     const auto assign = [&](const Eigen::Vector3f& shift) {
       std::vector<std::vector<double>> score(
           candidates.size(), std::vector<double>(found.size(), 0.0));
-      std::vector<std::vector<double>> gate(
-          candidates.size(), std::vector<double>(found.size(), 0.0));
-      double big = 0.0;
-      for (size_t i = 0; i < candidates.size(); ++i) {
-        const Track& t = tracks[candidates[i]];
-        for (size_t j = 0; j < found.size(); ++j) {
-          gate[i][j] = std::max(
-              options_.match_m,
-              options_.match_extent_fraction *
-                  std::max(LargestExtent(t.object), LargestExtent(found[j])));
-          big = std::max(big, gate[i][j]);
-        }
-      }
       for (size_t i = 0; i < candidates.size(); ++i) {
         const Track& t = tracks[candidates[i]];
         for (size_t j = 0; j < found.size(); ++j) {
@@ -341,6 +344,13 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
     // Pieces that moved together: join the younger into the older.
     std::vector<bool> absorbed(found.size(), false);
     std::vector<bool> composite(found.size(), false);
+    // Object `piece` joins object `into` of this frame.
+    const auto join = [&](size_t piece, size_t into) {
+      Join(found[piece], found[into]);
+      composite[into] = true;
+      world[into] = ToWorld(camera_to_world, found[into].centroid);
+      absorbed[piece] = true;
+    };
     for (size_t a = 0; a < found.size(); ++a) {
       if (state[a] != TrackState::kMoved || absorbed[a]) continue;
       for (size_t b = 0; b < found.size(); ++b) {
@@ -356,12 +366,9 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
         const bool a_older = tracks[track_of[a]].id < tracks[track_of[b]].id;
         const size_t keep = a_older ? a : b;
         const size_t drop = a_older ? b : a;
-        Join(found[drop], found[keep]);
-        composite[keep] = true;
-        world[keep] = ToWorld(camera_to_world, found[keep].centroid);
+        join(drop, keep);
         tracks[track_of[drop]].last_seen_frame = -1;  // forgotten
         tracks[track_of[drop]].id = 0;
-        absorbed[drop] = true;
         ++out.joined;
         if (drop == a) break;
       }
@@ -378,10 +385,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
           cv::Mat inside;
           cv::bitwise_and(found[j].mask, t.object.mask, inside);
           if (cv::countNonZero(inside) * 2 > found[j].area) {
-            Join(found[j], found[k]);
-            composite[k] = true;
-            world[k] = ToWorld(camera_to_world, found[k].centroid);
-            absorbed[j] = true;
+            join(j, k);
             break;
           }
         }

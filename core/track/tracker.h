@@ -137,6 +137,7 @@ class Tracker {
   bool CameraStill(const std::optional<Eigen::Isometry3f>& pose) const;
 
   TrackerOptions options_;
+  absl::Status valid_;  // Validate(options_), once
   const RbfSvm* relation_svm_;
   SensorModel sensor_;
   // The frame last segmented and its pose.

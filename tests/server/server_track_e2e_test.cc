@@ -258,13 +258,8 @@ TEST_F(ServerTest, TrackWhoseClientNeverReadsIsCancelledAndOthersGoOn) {
   config.concurrency = 1;
   config.stream_stall_timeout_s = 0.3;
   StartServer(config);
-  grpc::ChannelArguments args;
-  args.SetInt(GRPC_ARG_HTTP2_STREAM_LOOKAHEAD_BYTES, 1);
-  args.SetInt(GRPC_ARG_HTTP2_BDP_PROBE, 0);
-  const std::shared_ptr<grpc::Channel> channel =
-      grpc::CreateCustomChannel("127.0.0.1:" + std::to_string(server_->port()),
-                                grpc::InsecureChannelCredentials(), args);
-  std::unique_ptr<v1::Perception::Stub> lazy = v1::Perception::NewStub(channel);
+  std::unique_ptr<v1::Perception::Stub> lazy =
+      ::fovea::server::testing::SlowReaderStub(server_->port());
   const synth::Sequence sequence =
       synth::GenerateSequence(synth::SequenceKind::kStatic, 3, 2);
   auto context = Context();

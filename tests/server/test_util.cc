@@ -31,6 +31,15 @@ int FreePort() {
   return port;
 }
 
+std::unique_ptr<v1::Perception::Stub> SlowReaderStub(int port) {
+  grpc::ChannelArguments args;
+  args.SetInt(GRPC_ARG_HTTP2_STREAM_LOOKAHEAD_BYTES, 1);
+  args.SetInt(GRPC_ARG_HTTP2_BDP_PROBE, 0);
+  return v1::Perception::NewStub(
+      grpc::CreateCustomChannel("127.0.0.1:" + std::to_string(port),
+                                grpc::InsecureChannelCredentials(), args));
+}
+
 bool WaitFor(const std::function<bool()>& condition,
              std::chrono::milliseconds timeout) {
   const auto end = std::chrono::steady_clock::now() + timeout;

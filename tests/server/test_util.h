@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "fovea/v1/detect.pb.h"
+#include "fovea/v1/perception.grpc.pb.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 
 namespace fovea::server::testing {
@@ -18,6 +19,10 @@ namespace fovea::server::testing {
 // A TCP port on 127.0.0.1 that was free a moment ago (bind to port 0,
 // read it, close). The server is then told to listen on it explicitly.
 int FreePort();
+
+// A stub on a channel to 127.0.0.1:`port` whose transport window is about
+// one byte and never grows: a client that (almost) never reads.
+std::unique_ptr<v1::Perception::Stub> SlowReaderStub(int port);
 
 // Polls `condition` every few milliseconds until it holds or `timeout`
 // passes; returns its last value.
