@@ -96,8 +96,10 @@ class TrackReactor final
       FinishWith(parsed);
       return;
     }
-    StartRead(&in_);
+    // Before StartRead: the next OnReadDone may run on another thread at
+    // once, and libgrpc's ordering of the two is invisible to TSan.
     TsanHappensBefore(this);
+    StartRead(&in_);
   }
 
   void OnWriteDone(bool ok) override {

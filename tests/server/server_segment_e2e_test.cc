@@ -362,9 +362,28 @@ TEST_F(ServerTest, SegmentDeadlineMidStreamKeepsWhatWasSentAndEndsDeadline) {
   // 3 after the support plane; the seeds message is sent; 4 is the check
   // after it. Hold there until the deadline has passed.
   constexpr int kAfterSeedsMessage = 4;
-  stage_gate_.CloseAtPass(kAfterSeedsMessage);
+  // Reaching that stage takes seconds under a sanitizer on a loaded
+  // machine: one whole call first, undisturbed, and the deadline leaves
+  // twice its time (2 s at least) for the held call to get there.
+  const auto first_start = std::chrono::steady_clock::now();
+  {
+    grpc::ClientContext context;
+    auto reader = stub_->Segment(&context, request);
+    v1::SegmentResponse response;
+    while (reader->Read(&response)) {
+    }
+    ASSERT_TRUE(reader->Finish().ok());
+  }
+  const auto whole_call = std::chrono::steady_clock::now() - first_start;
+  const int passes_before = stage_gate_.entered();
+  const int held_pass = passes_before + kAfterSeedsMessage;
+  stage_gate_.CloseAtPass(held_pass);
   const auto deadline =
-      std::chrono::system_clock::now() + std::chrono::seconds(2);
+      std::chrono::system_clock::now() +
+      std::max<std::chrono::system_clock::duration>(
+          std::chrono::seconds(2),
+          std::chrono::duration_cast<std::chrono::system_clock::duration>(
+              2 * whole_call));
   std::future<SegmentCall> call = std::async(std::launch::async, [&] {
     grpc::ClientContext context;
     context.set_deadline(deadline);
@@ -375,9 +394,8 @@ TEST_F(ServerTest, SegmentDeadlineMidStreamKeepsWhatWasSentAndEndsDeadline) {
     result.status = reader->Finish();
     return result;
   });
-  ASSERT_TRUE(
-      WaitFor([this] { return stage_gate_.entered() == kAfterSeedsMessage; },
-              kCallTimeout));
+  ASSERT_TRUE(WaitFor([&] { return stage_gate_.entered() == held_pass; },
+                      kCallTimeout));
   const SegmentCall ended = call.get();  // returns once the deadline passed
   // The server's copy of the deadline is re-based on the request's arrival,
   // a loopback transit later than the client's: release the worker only
@@ -400,7 +418,7 @@ TEST_F(ServerTest, SegmentDeadlineMidStreamKeepsWhatWasSentAndEndsDeadline) {
                             "grpc_code=\"DeadlineExceeded\""}) == 1;
       },
       std::chrono::seconds(10)));
-  EXPECT_EQ(stage_gate_.entered(), kAfterSeedsMessage);  // stopped there
+  EXPECT_EQ(stage_gate_.entered(), held_pass);  // stopped there
 }
 
 TEST_F(ServerTest, SegmentCancelledAfterTheFirstMessageEndsCancelled) {
