@@ -87,10 +87,12 @@ cv::Mat RawView(const v1::Image& image, int type, size_t pixel_bytes) {
 
 // The colour image as a file: the compressed one as sent, a raw one as
 // an RGB PNG.
-absl::Status ColourFile(const v1::Image& color, Files& out) {
+absl::Status ColourFile(const v1::Image& color, const std::string& prefix,
+                        Files& out) {
   if (!color.compressed().empty()) {
     const std::string& file = color.compressed();
-    out.files.emplace_back(IsJpegFile(file) ? "color.jpg" : "color.png", file);
+    out.files.emplace_back(
+        prefix + (IsJpegFile(file) ? "color.jpg" : "color.png"), file);
     return absl::OkStatus();
   }
   const bool rgb = color.encoding() == "rgb8";
@@ -108,17 +110,18 @@ absl::Status ColourFile(const v1::Image& color, Files& out) {
   }
   absl::StatusOr<std::string> png = EncodePng(bgr);
   if (!png.ok()) return png.status();
-  out.files.emplace_back("color.png", *std::move(png));
+  out.files.emplace_back(prefix + "color.png", *std::move(png));
   return absl::OkStatus();
 }
 
 // The depth image as a 16-bit PNG file and the scale it is in.
-absl::StatusOr<double> DepthFile(const v1::Frame& frame, Files& out) {
+absl::StatusOr<double> DepthFile(const v1::Frame& frame,
+                                 const std::string& prefix, Files& out) {
   const v1::Image& depth = frame.depth();
   const double scale =
       frame.depth_scale() > 0.0 ? frame.depth_scale() : kDefaultDepthScale;
   if (!depth.compressed().empty()) {
-    out.files.emplace_back("depth.png", depth.compressed());
+    out.files.emplace_back(prefix + "depth.png", depth.compressed());
     return scale;
   }
   if (depth.is_bigendian()) return absl::InvalidArgumentError("big-endian");
@@ -146,39 +149,63 @@ absl::StatusOr<double> DepthFile(const v1::Frame& frame, Files& out) {
   if (units.empty()) return absl::InvalidArgumentError("depth image size");
   absl::StatusOr<std::string> png = EncodePng(units);
   if (!png.ok()) return png.status();
-  out.files.emplace_back("depth.png", *std::move(png));
+  out.files.emplace_back(prefix + "depth.png", *std::move(png));
   return units_scale;
 }
 
-// Everything a record holds, in memory. The frame's pixels go into the
-// image files and out of the request (which is the recorder's).
-Files MakeFiles(RecordedCall& call, int64_t sequence) {
-  Files out;
-  google::protobuf::Message* request = call.request.get();
-  const google::protobuf::FieldDescriptor* field =
-      request->GetDescriptor()->FindFieldByName("frame");
-  if (field != nullptr &&
-      field->type() == google::protobuf::FieldDescriptor::TYPE_MESSAGE) {
-    auto* frame = static_cast<v1::Frame*>(
-        request->GetReflection()->MutableMessage(request, field));
-    absl::Status colour = ColourFile(frame->color(), out);
-    absl::StatusOr<double> scale =
-        colour.ok() ? DepthFile(*frame, out) : absl::StatusOr<double>(colour);
-    if (scale.ok()) {
-      // The request as replay sends it: the images as the files above.
-      frame->mutable_color()->Clear();
-      frame->mutable_depth()->Clear();
-      frame->set_depth_scale(*scale);
-    } else {
-      out.frame_problem = std::string(scale.status().message());
-      out.files.clear();
-      frame->mutable_color()->clear_data();
-      frame->mutable_color()->clear_compressed();
-      frame->mutable_depth()->clear_data();
-      frame->mutable_depth()->clear_compressed();
+// The frame a request carries: its `frame` field when that is a Frame,
+// or the Frame inside it (a TrackRequest's frame.frame); null when none.
+v1::Frame* FrameIn(google::protobuf::Message* message) {
+  for (int depth = 0; depth < 2 && message != nullptr; ++depth) {
+    const google::protobuf::FieldDescriptor* field =
+        message->GetDescriptor()->FindFieldByName("frame");
+    if (field == nullptr ||
+        field->type() != google::protobuf::FieldDescriptor::TYPE_MESSAGE ||
+        field->is_repeated()) {
+      return nullptr;
+    }
+    if (!message->GetReflection()->HasField(*message, field)) return nullptr;
+    message = message->GetReflection()->MutableMessage(message, field);
+    if (message->GetDescriptor() == v1::Frame::descriptor()) {
+      return static_cast<v1::Frame*>(message);
     }
   }
-  out.files.emplace_back("request.json", ToJson(*request) + "\n");
+  return nullptr;
+}
+
+// The image files of the frame `request` carries (named with `prefix`),
+// whose pixels go out of the request (the recorder's) into them; false,
+// with out.frame_problem set and the pixels dropped, when they cannot be
+// kept.
+bool FrameFiles(google::protobuf::Message& request, const std::string& prefix,
+                Files& out) {
+  v1::Frame* frame = FrameIn(&request);
+  if (frame == nullptr) return true;
+  const size_t before = out.files.size();
+  absl::Status colour = ColourFile(frame->color(), prefix, out);
+  absl::StatusOr<double> scale = colour.ok() ? DepthFile(*frame, prefix, out)
+                                             : absl::StatusOr<double>(colour);
+  if (scale.ok()) {
+    // The request as replay sends it: the images as the files above.
+    frame->mutable_color()->Clear();
+    frame->mutable_depth()->Clear();
+    frame->set_depth_scale(*scale);
+    return true;
+  }
+  out.frame_problem = std::string(scale.status().message());
+  out.files.resize(before);
+  frame->mutable_color()->clear_data();
+  frame->mutable_color()->clear_compressed();
+  frame->mutable_depth()->clear_data();
+  frame->mutable_depth()->clear_compressed();
+  return false;
+}
+
+// Everything a whole call's record holds, in memory.
+Files MakeFiles(RecordedCall& call, int64_t sequence) {
+  Files out;
+  FrameFiles(*call.request, "", out);
+  out.files.emplace_back("request.json", ToJson(*call.request) + "\n");
   std::string responses;
   for (const auto& response : call.responses) {
     absl::StrAppend(&responses, ToJson(*response), "\n");
@@ -194,6 +221,14 @@ Files MakeFiles(RecordedCall& call, int64_t sequence) {
   return out;
 }
 
+// Writes `data` to `path` (appending with `append`); false on failure.
+bool WriteFile(const fs::path& path, const std::string& data, bool append) {
+  std::ofstream out(
+      path, std::ios::binary | (append ? std::ios::app : std::ios::trunc));
+  out.write(data.data(), static_cast<std::streamsize>(data.size()));
+  return static_cast<bool>(out);
+}
+
 // Bytes of the files in a folder (not recursing).
 int64_t FolderBytes(const fs::path& folder) {
   int64_t total = 0;
@@ -206,7 +241,8 @@ int64_t FolderBytes(const fs::path& folder) {
 }
 
 int64_t ApproximateBytes(const RecordedCall& call) {
-  int64_t bytes = call.request->ByteSizeLong();
+  int64_t bytes = call.request ? call.request->ByteSizeLong() : 0;
+  if (call.frame) bytes += call.frame->ByteSizeLong();
   for (const auto& response : call.responses) bytes += response->ByteSizeLong();
   return bytes;
 }
@@ -224,6 +260,9 @@ absl::Status Validate(const RecorderConfig& config) {
   if (!(config.sample > 0.0 && config.sample <= 1.0)) {
     return absl::InvalidArgumentError(
         absl::StrCat("record_sample: must be in (0, 1], got ", config.sample));
+  }
+  if (config.track_part_frames < 1) {
+    return absl::InvalidArgumentError("record: track_part_frames must be >= 1");
   }
   if (config.max_pending < 1 || config.max_pending_bytes < 1) {
     return absl::InvalidArgumentError(
@@ -320,18 +359,26 @@ RecordedCall EndedCall(
 
 void FlightRecorder::Submit(RecordedCall call) {
   const int64_t bytes = ApproximateBytes(call);
+  // A stream's opening and end are small, and the part needs both.
+  const bool always = call.stream != 0 && call.frame == nullptr;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (stopping_ || static_cast<int>(queue_.size()) >= config_.max_pending ||
-        (!queue_.empty() &&
-         queued_bytes_ + bytes > config_.max_pending_bytes)) {
+    if (stopping_ ||
+        (!always && (static_cast<int>(queue_.size()) >= config_.max_pending ||
+                     (!queue_.empty() &&
+                      queued_bytes_ + bytes > config_.max_pending_bytes)))) {
       RecordRecorderOutcome("queue_full");
+      if (call.stream != 0) ++dropped_frames_[call.stream];
       return;
     }
     queued_bytes_ += bytes;
     queue_.push_back(std::move(call));
   }
   changed_.notify_all();
+}
+
+uint64_t FlightRecorder::NewStream() {
+  return next_stream_.fetch_add(1, std::memory_order_relaxed);
 }
 
 void FlightRecorder::Flush() {
@@ -382,28 +429,35 @@ void FlightRecorder::Write() {
   }
 }
 
-void FlightRecorder::WriteOne(RecordedCall call) {
-  const int64_t sequence = next_sequence_;
-  const Files files = MakeFiles(call, sequence);
-  const int64_t bytes = files.bytes();
-  if (bytes > config_.max_bytes) {
-    RecordRecorderOutcome("too_large");
-    return;
-  }
+bool FlightRecorder::MakeRoom(int64_t bytes) {
   std::error_code error;
-  // Room first: the oldest records go until this one fits.
-  while (!records_.empty()) {
-    int64_t total;
+  while (true) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      total = total_bytes_;
+      if (total_bytes_ + bytes <= config_.max_bytes) return true;
     }
-    if (total + bytes <= config_.max_bytes) break;
+    if (records_.empty()) return false;  // only open parts hold the rest
     fs::remove_all(records_.front().path, error);
     std::lock_guard<std::mutex> lock(mutex_);
     total_bytes_ -= records_.front().bytes;
     records_.pop_front();
+    SetRecorderBytes(total_bytes_);
   }
+}
+
+void FlightRecorder::WriteOne(RecordedCall call) {
+  if (call.stream != 0) {
+    WriteStreamMessage(std::move(call));
+    return;
+  }
+  const int64_t sequence = next_sequence_;
+  const Files files = MakeFiles(call, sequence);
+  const int64_t bytes = files.bytes();
+  if (bytes > config_.max_bytes || !MakeRoom(bytes)) {
+    RecordRecorderOutcome("too_large");
+    return;
+  }
+  std::error_code error;
   const std::string name = absl::StrFormat("%08d-%s", sequence, call.method);
   const fs::path temporary = fs::path(config_.dir) / (".tmp-" + name);
   const fs::path final_path = fs::path(config_.dir) / name;
@@ -411,9 +465,7 @@ void FlightRecorder::WriteOne(RecordedCall call) {
   bool ok = !error;
   for (const auto& [file, data] : files.files) {
     if (!ok) break;
-    std::ofstream out(temporary / file, std::ios::binary);
-    out.write(data.data(), static_cast<std::streamsize>(data.size()));
-    ok = static_cast<bool>(out);
+    ok = WriteFile(temporary / file, data, false);
   }
   if (ok) fs::rename(temporary, final_path, error);
   if (!ok || error) {
@@ -432,6 +484,135 @@ void FlightRecorder::WriteOne(RecordedCall call) {
   }
   RecordRecorderOutcome(files.frame_problem.empty() ? "written"
                                                     : "written_without_frame");
+}
+
+bool FlightRecorder::OpenNextPart(OpenPart& part) {
+  part.sequence = next_sequence_++;
+  part.frames = 0;
+  part.dropped = 0;
+  part.bytes = 0;
+  part.path = (fs::path(config_.dir) /
+               absl::StrFormat(".tmp-%08d-%s", part.sequence, part.method))
+                  .string();
+  std::error_code error;
+  fs::create_directories(part.path, error);
+  const std::string request = part.request_json + "\n";
+  if (error || !MakeRoom(static_cast<int64_t>(request.size())) ||
+      !WriteFile(fs::path(part.path) / "request.json", request, false)) {
+    fs::remove_all(part.path, error);
+    return false;
+  }
+  part.bytes = static_cast<int64_t>(request.size());
+  std::lock_guard<std::mutex> lock(mutex_);
+  total_bytes_ += part.bytes;
+  SetRecorderBytes(total_bytes_);
+  return true;
+}
+
+void FlightRecorder::ClosePart(OpenPart& part, const std::string& code,
+                               double seconds, bool continues) {
+  const std::string meta = absl::StrFormat(
+      "{\"method\":\"%s\",\"sequence\":%d,\"unix_micros\":%d,"
+      "\"code\":\"%s\",\"seconds\":%.6f,\"frame\":\"recorded\","
+      "\"part\":%d,\"frames\":%d,\"frames_dropped\":%d,"
+      "\"continues\":%s}\n",
+      part.method, part.sequence, absl::ToUnixMicros(absl::Now()), code,
+      seconds, part.part, part.frames, part.dropped,
+      continues ? "true" : "false");
+  const fs::path temporary(part.path);
+  const fs::path final_path =
+      fs::path(config_.dir) /
+      absl::StrFormat("%08d-%s", part.sequence, part.method);
+  std::error_code error;
+  bool ok = WriteFile(temporary / "meta.json", meta, false);
+  // Both .jsonl files exist even when no frame was answered.
+  ok = ok && WriteFile(temporary / "frames.jsonl", "", true) &&
+       WriteFile(temporary / "responses.jsonl", "", true);
+  if (ok) fs::rename(temporary, final_path, error);
+  const int64_t written = part.bytes + static_cast<int64_t>(meta.size());
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!ok || error) {
+    fs::remove_all(temporary, error);
+    total_bytes_ -= part.bytes;
+    SetRecorderBytes(total_bytes_);
+    RecordRecorderOutcome("error");
+    return;
+  }
+  total_bytes_ += static_cast<int64_t>(meta.size());
+  SetRecorderBytes(total_bytes_);
+  records_.push_back({part.sequence, final_path.string(), written});
+  RecordRecorderOutcome("written");
+}
+
+void FlightRecorder::WriteStreamMessage(RecordedCall call) {
+  auto found = open_parts_.find(call.stream);
+  if (call.request) {  // the opening
+    OpenPart part;
+    part.method = call.method;
+    part.request_json = ToJson(*call.request);
+    if (OpenNextPart(part)) open_parts_[call.stream] = std::move(part);
+    return;
+  }
+  if (found == open_parts_.end()) return;  // its opening was not written
+  OpenPart& part = found->second;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto dropped = dropped_frames_.find(call.stream);
+    if (dropped != dropped_frames_.end()) {
+      part.dropped += dropped->second;
+      dropped_frames_.erase(dropped);
+    }
+  }
+  if (call.stream_end) {
+    ClosePart(part, call.code, call.seconds, false);
+    open_parts_.erase(found);
+    return;
+  }
+  if (!call.frame) return;
+  if (part.frames >= config_.track_part_frames) {
+    ClosePart(part, "OK", 0.0, true);
+    ++part.part;
+    if (!OpenNextPart(part)) {
+      open_parts_.erase(found);
+      RecordRecorderOutcome("error");
+      return;
+    }
+  }
+  Files files;
+  const int n = part.frames + 1;
+  if (!FrameFiles(*call.frame, absl::StrCat(n, "_"), files)) {
+    ++part.dropped;
+    RecordRecorderOutcome("written_without_frame");
+    return;
+  }
+  const std::string frame_line = ToJson(*call.frame) + "\n";
+  const std::string response_line =
+      call.responses.empty() ? "{}\n" : ToJson(*call.responses[0]) + "\n";
+  const int64_t bytes = files.bytes() +
+                        static_cast<int64_t>(frame_line.size()) +
+                        static_cast<int64_t>(response_line.size());
+  if (!MakeRoom(bytes)) {
+    ++part.dropped;
+    RecordRecorderOutcome("too_large");
+    return;
+  }
+  const fs::path folder(part.path);
+  bool ok = true;
+  for (const auto& [file, data] : files.files) {
+    ok = ok && WriteFile(folder / file, data, false);
+  }
+  ok = ok && WriteFile(folder / "frames.jsonl", frame_line, true) &&
+       WriteFile(folder / "responses.jsonl", response_line, true);
+  if (!ok) {
+    ++part.dropped;
+    RecordRecorderOutcome("error");
+    return;
+  }
+  ++part.frames;
+  part.bytes += bytes;
+  std::lock_guard<std::mutex> lock(mutex_);
+  total_bytes_ += bytes;
+  SetRecorderBytes(total_bytes_);
 }
 
 }  // namespace fovea::server

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -35,6 +36,18 @@ namespace fovea::server {
 //                    0.1 mm)
 //   responses.jsonl  what the server sent, one proto JSON message a line
 //
+// A Track stream is handed over a message at a time (its opening, each
+// frame answered, its end) and written as it goes, in parts of at most
+// config.track_part_frames frames, so that no stream is ever held whole: each
+// part is a folder <sequence>-Track/ whose request.json is the stream's
+// options message, frames.jsonl the frames answered (TrackRequest, one a
+// line, without their image bytes), <n>_color.png and <n>_depth.png their
+// images, n counted from 1 in each part (the layout `fovea-client track
+// --frames` reads), and responses.jsonl the answer to each frame, line for
+// line. meta.json adds "part" (from 0), "frames", "frames_dropped" (frames
+// answered but not recorded: the queue was full) and "continues" (the
+// stream went on in the next part). A part appears when it is complete.
+//
 // Calls are handed over when they end (Submit) and written by one thread
 // of the recorder's own: never on a call's path, and never blocking one (a
 // call that finds the queue full is not recorded, and counted). The
@@ -53,6 +66,9 @@ struct RecorderConfig {
   // dropped (fovea_recorder_records_total{outcome="queue_full"}).
   int max_pending = 8;
   int64_t max_pending_bytes = int64_t{128} << 20;
+  // A stream's record holds at most this many frames; the stream goes on
+  // in a new record (its next part).
+  int track_part_frames = 64;
 };
 
 // INVALID_ARGUMENT naming the flag (record_dir, record_max_mb,
@@ -61,13 +77,21 @@ absl::Status Validate(const RecorderConfig& config);
 
 // One finished call, as handed to the recorder.
 struct RecordedCall {
-  std::string method;  // "Detect", "Segment", "SegmentIncremental"
+  // "Detect", "Segment", "SegmentIncremental", "Track"
+  std::string method;
   // The request (a DetectRequest, SegmentRequest or
-  // SegmentIncrementalRequest) and the messages sent, in order. The
-  // recorder owns the request: it moves the frame's pixels out of it into
-  // the record's image files instead of copying them.
+  // SegmentIncrementalRequest; a Track stream's options message) and the
+  // messages sent, in order. The recorder owns the requests: it moves the
+  // frames' pixels out of them into the record's image files instead of
+  // copying them.
   std::unique_ptr<google::protobuf::Message> request;
   std::vector<std::unique_ptr<const google::protobuf::Message>> responses;
+  // A stream's message (FlightRecorder::NewStream's id; 0 for a whole
+  // call): its opening carries `request`; a frame carries `frame` and its
+  // answer in `responses`; the end (stream_end) carries code and seconds.
+  uint64_t stream = 0;
+  std::unique_ptr<google::protobuf::Message> frame;
+  bool stream_end = false;
   std::string code;         // the gRPC status code's name, "OK", ...
   double seconds = 0.0;     // the call's time on the server
   int64_t unix_micros = 0;  // when it ended
@@ -96,9 +120,13 @@ class FlightRecorder {
   // them, evenly). Thread-safe and lock-free.
   bool ShouldRecord();
 
-  // Hands a finished call over; returns at once. Dropped (and counted)
-  // when the queue is full.
+  // Hands a finished call, or a stream's message, over; returns at once.
+  // Dropped (and counted) when the queue is full; a stream's opening and
+  // end, which carry no frame, never are.
   void Submit(RecordedCall call);
+
+  // An id for a stream to be recorded (RecordedCall::stream), > 0.
+  uint64_t NewStream();
 
   // Blocks until every call submitted so far has been written or dropped
   // (tests, and shutdown).
@@ -119,7 +147,23 @@ class FlightRecorder {
   explicit FlightRecorder(const RecorderConfig& config);
   absl::Status TakeStock();
   void Write();
+  // A stream's part being written, in a temporary folder.
+  struct OpenPart {
+    int64_t sequence = 0;
+    std::string method, path, request_json;
+    int part = 0, frames = 0, dropped = 0;
+    int64_t bytes = 0;
+  };
   void WriteOne(RecordedCall call);
+  void WriteStreamMessage(RecordedCall call);
+  // Deletes the oldest records until `bytes` more fit; false when they
+  // cannot.
+  bool MakeRoom(int64_t bytes);
+  // Opens the next part of `stream` (its folder and request.json).
+  bool OpenNextPart(OpenPart& part);
+  // Writes meta.json and publishes the part under its final name.
+  void ClosePart(OpenPart& part, const std::string& code, double seconds,
+                 bool continues);
 
   const RecorderConfig config_;
   std::atomic<uint64_t> calls_seen_{0};
@@ -134,6 +178,9 @@ class FlightRecorder {
   std::deque<Record> records_;
   int64_t total_bytes_ = 0;  // guarded by mutex_ (written by the writer)
   int64_t next_sequence_ = 1;
+  std::atomic<uint64_t> next_stream_{1};
+  std::map<uint64_t, OpenPart> open_parts_;  // the writer's own
+  std::map<uint64_t, int> dropped_frames_;   // guarded by mutex_
   std::thread writer_;
 };
 

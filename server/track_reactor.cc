@@ -126,6 +126,15 @@ class TrackReactor final
 
   void OnDone() override {
     TsanHappensAfter(this);
+    if (record_stream_ != 0) {
+      RecordedCall end;
+      end.method = std::string(kMethod);
+      end.stream = record_stream_;
+      end.stream_end = true;
+      end.code = absl::StatusCodeToString(end_code_);
+      end.seconds = SecondsSince(start_);
+      config_.recorder->Submit(std::move(end));
+    }
     if (handle_ != nullptr) {
       config_.streams->Close(handle_);
       AddTrackStreams(-1);
@@ -160,6 +169,14 @@ class TrackReactor final
                              ToTrackerOptions(request->options()));
       request_id_ = request->options().request_id();
       tracker_ = std::make_unique<Tracker>(options, config_.segment_models.inc);
+      if (config_.recorder != nullptr && config_.recorder->ShouldRecord()) {
+        record_stream_ = config_.recorder->NewStream();
+        RecordedCall opening;
+        opening.method = std::string(kMethod);
+        opening.stream = record_stream_;
+        opening.request = std::move(request);
+        config_.recorder->Submit(std::move(opening));
+      }
       return absl::OkStatus();
     }
     if (!request->has_frame()) {
@@ -233,7 +250,7 @@ class TrackReactor final
     Conclude(finish);
   }
 
-  absl::Status Process(const Pending& pending) {
+  absl::Status Process(Pending& pending) {
     const v1::TrackFrame& wire = pending.request->frame();
     const InterruptCheck interrupt = [this] {
       if (config_.at_stage_boundary) config_.at_stage_boundary();
@@ -264,7 +281,21 @@ class TrackReactor final
         ToTrackResponse(tracked, request_id_, wire.sequence(), skipped);
     RecordTrackFrame(tracked.reused ? "reused" : "segmented",
                      SecondsSince(pending.arrived));
-    return Send(std::move(response));
+    std::unique_ptr<v1::TrackResponse> recorded;
+    if (record_stream_ != 0) {
+      recorded = std::make_unique<v1::TrackResponse>(response);
+    }
+    FOVEA_RETURN_IF_ERROR(Send(std::move(response)));
+    if (recorded) {
+      // The frame, done with, and its answer go to the recorder.
+      RecordedCall frame;
+      frame.method = std::string(kMethod);
+      frame.stream = record_stream_;
+      frame.frame = std::move(pending.request);
+      frame.responses.push_back(std::move(recorded));
+      config_.recorder->Submit(std::move(frame));
+    }
+    return absl::OkStatus();
   }
 
   // Writes `response` once the previous write is done; CANCELLED when the
@@ -328,6 +359,7 @@ class TrackReactor final
       TsanHappensBefore(this);
       return;
     }
+    end_code_ = finish->code();
     const grpc::Status end = call_.EndStream(*finish);
     TsanHappensBefore(this);
     Finish(end);
@@ -343,6 +375,11 @@ class TrackReactor final
   // are submitted after it.
   std::unique_ptr<Tracker> tracker_;
   std::string request_id_;
+  // The stream's id at the flight recorder, 0 when not recorded; set with
+  // tracker_.
+  uint64_t record_stream_ = 0;
+  const Clock::time_point start_ = Clock::now();
+  absl::StatusCode end_code_ = absl::StatusCode::kOk;  // set by Conclude
 
   std::mutex mutex_;
   std::condition_variable changed_;

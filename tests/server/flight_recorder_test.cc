@@ -14,6 +14,7 @@
 
 #include "core/synth/synth_scene.h"
 #include "fovea/v1/detect.pb.h"
+#include "fovea/v1/track.pb.h"
 #include "server/convert.h"
 #include "tests/core/testing/files.h"
 
@@ -159,6 +160,85 @@ TEST(FlightRecorderTest, SubmitNeverBlocksAndDropsWhatTheQueueCannotHold) {
   // One being written when the others came, two queued, three dropped.
   EXPECT_LE(Records(dir).size(), 3u);
   EXPECT_GE(Records(dir).size(), 2u);
+}
+
+// A Track stream is written as it goes, in parts of track_part_frames
+// frames, each in the layout `fovea-client track --frames` reads; a part
+// appears when complete, and frames the queue could not hold are counted.
+TEST(FlightRecorderTest, AStreamIsWrittenInPartsAsItGoes) {
+  const fs::path dir = testing::FreshTestDir("recorder_stream_");
+  RecorderConfig config;
+  config.dir = dir.string();
+  config.track_part_frames = 2;
+  absl::StatusOr<std::unique_ptr<FlightRecorder>> recorder =
+      FlightRecorder::Start(config);
+  ASSERT_TRUE(recorder.ok()) << recorder.status();
+  const uint64_t stream = (*recorder)->NewStream();
+  EXPECT_NE(stream, 0u);
+  EXPECT_NE((*recorder)->NewStream(), stream);
+  RecordedCall opening;
+  opening.method = "Track";
+  opening.stream = stream;
+  auto options = std::make_unique<v1::TrackRequest>();
+  options->mutable_options()->set_request_id("arm-camera");
+  opening.request = std::move(options);
+  (*recorder)->Submit(std::move(opening));
+  for (int i = 1; i <= 3; ++i) {
+    const synth::SynthScene scene = synth::GenerateScene(i);
+    auto frame = std::make_unique<v1::TrackRequest>();
+    frame->mutable_frame()->set_sequence(static_cast<uint64_t>(10 * i));
+    *frame->mutable_frame()->mutable_frame() =
+        ToProtoFrame(scene.frame.frame, DepthEncoding::k16UC1, 0.001);
+    auto response = std::make_unique<v1::TrackResponse>();
+    response->set_sequence(static_cast<uint64_t>(10 * i));
+    response->add_objects()->set_track_id(7);
+    RecordedCall message;
+    message.method = "Track";
+    message.stream = stream;
+    message.frame = std::move(frame);
+    message.responses.push_back(std::move(response));
+    (*recorder)->Submit(std::move(message));
+  }
+  (*recorder)->Flush();
+  // The first part is complete; the second is being written.
+  EXPECT_THAT(Records(dir),
+              ::testing::ElementsAre(".tmp-00000002-Track", "00000001-Track"));
+  RecordedCall end;
+  end.method = "Track";
+  end.stream = stream;
+  end.stream_end = true;
+  end.code = "CANCELLED";
+  end.seconds = 1.5;
+  (*recorder)->Submit(std::move(end));
+  (*recorder)->Flush();
+  ASSERT_THAT(Records(dir),
+              ::testing::ElementsAre("00000001-Track", "00000002-Track"));
+  const fs::path first = dir / "00000001-Track";
+  const fs::path second = dir / "00000002-Track";
+  for (const char* file : {"1_color.png", "1_depth.png", "2_color.png",
+                           "2_depth.png", "request.json"}) {
+    EXPECT_TRUE(fs::exists(first / file)) << file;
+  }
+  EXPECT_FALSE(fs::exists(first / "3_color.png"));
+  EXPECT_TRUE(fs::exists(second / "1_depth.png"));
+  EXPECT_FALSE(fs::exists(second / "2_depth.png"));
+  EXPECT_THAT(Read(first / "request.json"), HasSubstr("arm-camera"));
+  EXPECT_THAT(Read(second / "request.json"), HasSubstr("arm-camera"));
+  // Frames without their pixels, answers line for line.
+  const std::string frames = Read(first / "frames.jsonl");
+  EXPECT_EQ(std::count(frames.begin(), frames.end(), '\n'), 2);
+  EXPECT_THAT(frames, HasSubstr("\"sequence\":\"20\""));
+  EXPECT_THAT(frames, ::testing::Not(HasSubstr("\"data\"")));
+  const std::string responses = Read(first / "responses.jsonl");
+  EXPECT_EQ(std::count(responses.begin(), responses.end(), '\n'), 2);
+  EXPECT_THAT(Read(first / "meta.json"),
+              HasSubstr("\"part\":0,\"frames\":2,\"frames_dropped\":0,"
+                        "\"continues\":true"));
+  const std::string last = Read(second / "meta.json");
+  EXPECT_THAT(last, HasSubstr("\"code\":\"CANCELLED\""));
+  EXPECT_THAT(last, HasSubstr("\"part\":1,\"frames\":1,"));
+  EXPECT_THAT(last, HasSubstr("\"continues\":false"));
+  EXPECT_EQ((*recorder)->bytes(), FileBytes(dir));
 }
 
 TEST(FlightRecorderTest, SampleKeepsThatShareEvenlyAndBadConfigIsNamed) {

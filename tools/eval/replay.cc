@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <sstream>
@@ -17,8 +18,10 @@
 #include "absl/strings/str_format.h"
 #include "client/fovea_client.h"
 #include "client/rle.h"
+#include "core/base/status_macros.h"
 #include "core/eval/hungarian.h"
 #include "fovea/v1/perception.pb.h"
+#include "fovea/v1/track.pb.h"
 
 namespace fovea::eval {
 namespace {
@@ -129,32 +132,147 @@ std::vector<client::ByteMask> Masks(
   return masks;
 }
 
+// Masks, recorded and now, matched one to one on IoU (at least
+// same_object_iou) over one or more frames.
+struct MaskTally {
+  int recorded = 0, now = 0, matched = 0;
+  double sum_iou = 0.0, min_iou = 1.0;
+
+  // Adds one frame's masks; returns, for each of `a`, its match in `b`
+  // (-1: none).
+  std::vector<int> Add(const std::vector<client::ByteMask>& a,
+                       const std::vector<client::ByteMask>& b,
+                       const ReplayOptions& options) {
+    recorded += static_cast<int>(a.size());
+    now += static_cast<int>(b.size());
+    std::vector<std::vector<double>> iou(a.size(),
+                                         std::vector<double>(b.size()));
+    for (size_t i = 0; i < a.size(); ++i) {
+      for (size_t j = 0; j < b.size(); ++j) iou[i][j] = Iou(a[i], b[j]);
+    }
+    const std::vector<int> match = MaxWeightAssignment(iou);
+    std::vector<int> out(a.size(), -1);
+    for (size_t i = 0; i < a.size(); ++i) {
+      const int j = match.empty() ? -1 : match[i];
+      if (j < 0 || iou[i][j] < options.same_object_iou) continue;
+      out[i] = j;
+      ++matched;
+      sum_iou += iou[i][j];
+      min_iou = std::min(min_iou, iou[i][j]);
+    }
+    return out;
+  }
+
+  void Into(ReplayResult& r) const {
+    r.recorded = recorded;
+    r.now = now;
+    r.matched = matched;
+    r.mean_iou = matched > 0 ? sum_iou / matched : (recorded == 0 ? 1.0 : 0.0);
+    r.min_iou = matched > 0 ? min_iou : r.mean_iou;
+    r.lost = recorded - matched;
+    r.found = now - matched;
+  }
+};
+
 // Objects, recorded and now: matched one to one on IoU (at least
 // same_object_iou).
 void CompareObjects(const std::vector<v1::SegmentResponse>& before,
                     const std::vector<v1::SegmentResponse>& after,
                     const ReplayOptions& options, ReplayResult& r) {
-  const std::vector<client::ByteMask> a = Masks(before), b = Masks(after);
-  r.recorded = static_cast<int>(a.size());
-  r.now = static_cast<int>(b.size());
-  std::vector<std::vector<double>> iou(a.size(), std::vector<double>(b.size()));
-  for (size_t i = 0; i < a.size(); ++i) {
-    for (size_t j = 0; j < b.size(); ++j) iou[i][j] = Iou(a[i], b[j]);
+  MaskTally tally;
+  tally.Add(Masks(before), Masks(after), options);
+  tally.Into(r);
+}
+
+// A Track answer's objects in view (not gone): their masks and ids.
+void TrackMasks(const v1::TrackResponse& response,
+                std::vector<client::ByteMask>& masks,
+                std::vector<uint64_t>& ids) {
+  for (const v1::TrackedObject& o : response.objects()) {
+    if (o.state() == v1::TRACK_STATE_GONE || !o.object().has_mask()) continue;
+    absl::StatusOr<client::ByteMask> mask =
+        client::DecodeRle(o.object().mask());
+    masks.push_back(mask.ok() ? *std::move(mask) : client::ByteMask{});
+    ids.push_back(o.track_id());
   }
-  const std::vector<int> match = MaxWeightAssignment(iou);
-  double sum = 0.0;
-  r.min_iou = 1.0;
-  for (size_t i = 0; i < a.size(); ++i) {
-    const int j = match.empty() ? -1 : match[i];
-    if (j < 0 || iou[i][j] < options.same_object_iou) continue;
-    ++r.matched;
-    sum += iou[i][j];
-    r.min_iou = std::min(r.min_iou, iou[i][j]);
+}
+
+// A recorded Track stream part sent again, lockstep, frame by frame: its
+// objects compared frame by frame, and its identities (a matched pair of
+// recorded and new track ids that differs from the pair seen before, on
+// either side, counts a switch).
+absl::Status ReplayTrack(const fs::path& record,
+                         const std::string& options_json,
+                         const std::vector<std::string>& response_lines,
+                         client::FoveaClient& client, absl::Duration deadline,
+                         const ReplayOptions& options, ReplayResult& r) {
+  v1::TrackRequest opening;
+  FOVEA_RETURN_IF_ERROR(FromJson(options_json, &opening));
+  absl::StatusOr<std::string> frames_text = ReadFile(record / "frames.jsonl");
+  if (!frames_text.ok()) return frames_text.status();
+  const std::vector<std::string> frame_lines = Lines(*frames_text);
+  if (frame_lines.size() != response_lines.size()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(frame_lines.size(), " frames but ", response_lines.size(),
+                     " answers recorded"));
   }
-  r.mean_iou = r.matched > 0 ? sum / r.matched : (a.empty() ? 1.0 : 0.0);
-  if (r.matched == 0) r.min_iou = r.mean_iou;
-  r.lost = r.recorded - r.matched;
-  r.found = r.now - r.matched;
+  std::vector<v1::TrackFrame> frames(frame_lines.size());
+  std::vector<v1::TrackResponse> before(frame_lines.size());
+  for (size_t i = 0; i < frame_lines.size(); ++i) {
+    v1::TrackRequest message;
+    FOVEA_RETURN_IF_ERROR(FromJson(frame_lines[i], &message));
+    FOVEA_RETURN_IF_ERROR(FromJson(response_lines[i], &before[i]));
+    frames[i] = message.frame();
+    const std::string n = std::to_string(i + 1);
+    const fs::path jpeg = record / (n + "_color.jpg");
+    absl::StatusOr<std::string> color =
+        ReadFile(fs::exists(jpeg) ? jpeg : record / (n + "_color.png"));
+    if (!color.ok()) return color.status();
+    absl::StatusOr<std::string> depth = ReadFile(record / (n + "_depth.png"));
+    if (!depth.ok()) return depth.status();
+    v1::Frame& frame = *frames[i].mutable_frame();
+    frame.mutable_color()->set_compressed(*std::move(color));
+    frame.mutable_depth()->set_compressed(*std::move(depth));
+  }
+  std::vector<v1::TrackResponse> after;
+  size_t next = 0;
+  const absl::Status status = client.Track(
+      opening.options(),
+      [&]() -> std::optional<v1::TrackFrame> {
+        if (next == frames.size()) return std::nullopt;
+        return std::move(frames[next++]);
+      },
+      deadline,
+      [&after](const v1::TrackResponse& response) {
+        after.push_back(response);
+      });
+  MaskTally tally;
+  // Recorded track id -> id now, and back: a pair that differs from the
+  // one seen before, either way, is a switch.
+  std::map<uint64_t, uint64_t> now_id, recorded_id;
+  for (size_t i = 0; i < before.size(); ++i) {
+    std::vector<client::ByteMask> a, b;
+    std::vector<uint64_t> a_ids, b_ids;
+    TrackMasks(before[i], a, a_ids);
+    if (i < after.size()) TrackMasks(after[i], b, b_ids);
+    const std::vector<int> match = tally.Add(a, b, options);
+    for (size_t k = 0; k < a.size(); ++k) {
+      if (match[k] < 0) continue;
+      const uint64_t was = a_ids[k], now = b_ids[match[k]];
+      auto [forward, new_forward] = now_id.emplace(was, now);
+      auto [back, new_back] = recorded_id.emplace(now, was);
+      if ((!new_forward && forward->second != now) ||
+          (!new_back && back->second != was)) {
+        ++r.id_switches;
+      }
+      forward->second = now;
+      back->second = was;
+    }
+  }
+  tally.Into(r);
+  r.frames = static_cast<int>(before.size());
+  r.frames_now = static_cast<int>(after.size());
+  return status;
 }
 
 std::string CodeName(const absl::Status& status) {
@@ -240,11 +358,24 @@ ReplayResult ReplayOne(const fs::path& record, client::FoveaClient& client,
     r.now_ms = elapsed_ms();
     r.code = CodeName(status);
     CompareObjects(before, after, options, r);
+  } else if (r.method == "Track") {
+    status =
+        ReplayTrack(record, *request_text, lines, client, deadline, options, r);
+    if (status.code() == absl::StatusCode::kInvalidArgument ||
+        status.code() == absl::StatusCode::kNotFound) {
+      if (r.frames == 0) {  // the record, not the call, is at fault
+        r.error = std::string(status.message());
+        return r;
+      }
+    }
+    r.now_ms = elapsed_ms();
+    r.code = CodeName(status);
   } else {
     r.error = absl::StrCat("unknown method '", r.method, "'");
     return r;
   }
   r.changed = r.code != r.recorded_code || r.lost > 0 || r.found > 0 ||
+              r.id_switches > 0 || r.frames_now != r.frames ||
               r.max_shift_px > options.changed_point_px ||
               r.min_iou < options.changed_iou;
   return r;
@@ -331,6 +462,9 @@ int RunReplay(const std::string& dir, const ReplayOptions& options, bool json,
                              {"max_shift_px", r.max_shift_px},
                              {"mean_iou", r.mean_iou},
                              {"min_iou", r.min_iou},
+                             {"frames", r.frames},
+                             {"frames_now", r.frames_now},
+                             {"id_switches", r.id_switches},
                              {"recorded_ms", r.recorded_ms},
                              {"now_ms", r.now_ms},
                              {"changed", r.changed}};
@@ -344,7 +478,9 @@ int RunReplay(const std::string& dir, const ReplayOptions& options, bool json,
           points ? absl::StrFormat("%.1f (max %.1f)", r.mean_shift_px,
                                    r.max_shift_px)
                        .c_str()
-                 : "-",
+                 : (r.method == "Track"
+                        ? absl::StrFormat("%d id sw", r.id_switches).c_str()
+                        : "-"),
           points
               ? "-"
               : absl::StrFormat("%.3f (%.2f)", r.mean_iou, r.min_iou).c_str(),

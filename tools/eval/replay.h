@@ -31,12 +31,16 @@ struct ReplayResult {
   std::string method;
   std::string recorded_code, code;  // gRPC status code names
   std::string error;  // why it could not be replayed (then skipped)
-  // Detect: attention points; Segment / SegmentIncremental: objects.
+  // Detect: attention points; Segment / SegmentIncremental: objects;
+  // Track: objects in view, over all its frames.
   int recorded = 0, now = 0;
   int matched = 0, lost = 0, found = 0;
   double mean_shift_px = 0.0, max_shift_px = 0.0;  // Detect's points
   double mean_iou = 1.0, min_iou = 1.0;            // matched masks
   double recorded_ms = 0.0, now_ms = 0.0;          // server time / round trip
+  // Track: the frames recorded and answered now (objects above are summed
+  // over them), and recorded tracks whose matched object changed id.
+  int frames = 0, frames_now = 0, id_switches = 0;
   bool changed = false;
 };
 
