@@ -49,4 +49,11 @@ bool SubmitGated(WorkQueue& work, const std::shared_ptr<JobGate>& gate,
   return accepted;
 }
 
+absl::Status BusyError(const WorkQueue& work) {
+  RecordShed("busy");
+  return absl::ResourceExhaustedError(
+      absl::StrCat("server busy: ", work.workers(), " frames in work and ",
+                   work.queue_capacity(), " queued; retry later"));
+}
+
 }  // namespace fovea::server

@@ -161,6 +161,24 @@ std::pair<std::unique_ptr<Request>, absl::Status> Parse(
   return {std::move(request), std::move(parsed)};
 }
 
+// RESOURCE_EXHAUSTED "server busy: ..., retry later", counted in
+// fovea_calls_shed_total{reason="busy"}: a call the work queue cannot take.
+absl::Status BusyError(const WorkQueue& work);
+
+// Parse, unless the work queue is full now: then the call is refused as
+// BusyError before its body is parsed (the body is released unread), so a
+// refusal under overload costs next to nothing. A call parsed because
+// the queue had room may still be refused when it is submitted.
+template <typename Request>
+std::pair<std::unique_ptr<Request>, absl::Status> ParseUnlessBusy(
+    const WorkQueue& work, const grpc::ByteBuffer* body) {
+  if (work.Full()) {
+    const_cast<grpc::ByteBuffer*>(body)->Clear();
+    return {std::make_unique<Request>(), BusyError(work)};
+  }
+  return Parse<Request>(body);
+}
+
 }  // namespace fovea::server
 
 #endif  // FOVEA_SERVER_CALL_SUPPORT_H_

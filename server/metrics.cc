@@ -299,7 +299,7 @@ class Metrics {
         }
       }
       for (const char* reason : {"abandoned_in_queue", "stalled_stream",
-                                 "idle_stream", "stream_limit"}) {
+                                 "idle_stream", "stream_limit", "busy"}) {
         Shed(reason);
       }
       for (const char* outcome : {"segmented", "reused", "skipped"}) {

@@ -46,7 +46,8 @@ namespace fovea::server {
 //                                        cancelled, error)
 //   fovea_calls_shed_total{reason}       counter: calls the server ended
 //                                        itself (abandoned_in_queue,
-//                                        stalled_stream)
+//                                        stalled_stream, idle_stream,
+//                                        stream_limit, busy)
 //   fovea_track_open_streams               gauge: Track streams open
 //   fovea_track_frames_total{outcome}      counter: segmented, reused,
 //                                        skipped
@@ -97,7 +98,8 @@ void RecordAbandonedInQueue();
 void RecordStalledStream();
 // fovea_calls_shed_total{reason}: idle_stream (a Track stream that sent
 // nothing for its idle timeout), stream_limit (a Track stream refused by the
-// open-stream limits).
+// open-stream limits), busy (a call refused because the work queue was
+// full).
 void RecordShed(std::string_view reason);
 // Track: fovea_track_open_streams (gauge), fovea_track_frames_total{outcome}
 // (segmented, reused, skipped) and fovea_track_frame_seconds (arrival to

@@ -76,9 +76,7 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
     TsanHappensBefore(this);  // before the reactions (OnCancel)
     // The worker sees all of this through the queue's lock.
     if (!SubmitGated(work, gate_, [this] { Run(); })) {
-      Complete(absl::ResourceExhaustedError(
-          absl::StrCat("server busy: ", work.workers(), " frames in work and ",
-                       work.queue_capacity(), " queued; retry later")));
+      Complete(BusyError(work));
     }
   }
 
@@ -218,9 +216,7 @@ class StreamReactor final
     record_ = config.recorder != nullptr && config.recorder->ShouldRecord();
     TsanHappensBefore(this);  // before the reactions (OnCancel, ...)
     if (!SubmitGated(work, gate_, [this] { Run(); })) {
-      FinishOnce(absl::ResourceExhaustedError(
-          absl::StrCat("server busy: ", work.workers(), " frames in work and ",
-                       work.queue_capacity(), " queued; retry later")));
+      FinishOnce(BusyError(work));
     }
   }
 
@@ -522,7 +518,7 @@ grpc::ServerUnaryReactor* PerceptionService::OnDetect(
     grpc::CallbackServerContext* context, const grpc::ByteBuffer* body,
     v1::DetectResponse* response) {
   TsanHappensAfter(&config_);
-  auto [request, parsed] = Parse<v1::DetectRequest>(body);
+  auto [request, parsed] = ParseUnlessBusy<v1::DetectRequest>(*work_, body);
   return new DetectReactor(config_, *work_, context, std::move(request), parsed,
                            response);
 }
@@ -530,7 +526,7 @@ grpc::ServerUnaryReactor* PerceptionService::OnDetect(
 grpc::ServerWriteReactor<v1::SegmentResponse>* PerceptionService::OnSegment(
     grpc::CallbackServerContext* context, const grpc::ByteBuffer* body) {
   TsanHappensAfter(&config_);
-  auto [request, parsed] = Parse<v1::SegmentRequest>(body);
+  auto [request, parsed] = ParseUnlessBusy<v1::SegmentRequest>(*work_, body);
   return new StreamReactor<v1::SegmentRequest, SegmentOptions>(
       "Segment", &ToSegmentOptions, &HandleSegment, config_, *work_, context,
       std::move(request), parsed);
@@ -540,7 +536,8 @@ grpc::ServerWriteReactor<v1::SegmentResponse>*
 PerceptionService::OnSegmentIncremental(grpc::CallbackServerContext* context,
                                         const grpc::ByteBuffer* body) {
   TsanHappensAfter(&config_);
-  auto [request, parsed] = Parse<v1::SegmentIncrementalRequest>(body);
+  auto [request, parsed] =
+      ParseUnlessBusy<v1::SegmentIncrementalRequest>(*work_, body);
   return new StreamReactor<v1::SegmentIncrementalRequest, IncrementalOptions>(
       "SegmentIncremental", &ToIncrementalOptions, &HandleSegmentIncremental,
       config_, *work_, context, std::move(request), parsed);

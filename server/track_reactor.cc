@@ -206,9 +206,12 @@ class TrackReactor final
     RecordTrackFrame("skipped", 0.0);
   }
 
-  // Hands the next frame to a worker; a full queue skips it.
+  // Hands the next frame to a worker. An open stream was admitted (the
+  // stream limits) and holds at most one job: its frame waits its turn in
+  // the queue even when the queue is full, so that a client sending a frame
+  // after each answer always gets one. Only a stopping queue skips it.
   void Submit() {
-    if (work_.TrySubmit([this] { RunOne(); })) return;
+    if (work_.SubmitAdmitted([this] { RunOne(); })) return;
     std::optional<absl::Status> finish;
     {
       std::lock_guard<std::mutex> lock(mutex_);

@@ -55,6 +55,22 @@ bool WorkQueue::TrySubmit(absl::AnyInvocable<void() &&> job,
   return true;
 }
 
+bool WorkQueue::SubmitAdmitted(absl::AnyInvocable<void() &&> job) {
+  MutexLock lock(&mu_);
+  if (stopping_) return false;
+  jobs_.push_back({std::move(job), nullptr});
+  return true;
+}
+
+bool WorkQueue::Full() const {
+  MutexLock lock(&mu_);
+  int in_system = running_;
+  for (const Job& job : jobs_) {
+    in_system += !(job.abandoned && job.abandoned());
+  }
+  return stopping_ || in_system >= workers() + queue_capacity_;
+}
+
 void WorkQueue::DropAbandonedLocked() {
   for (auto it = jobs_.begin(); it != jobs_.end();) {
     if (it->abandoned && it->abandoned()) {

@@ -52,6 +52,17 @@ class WorkQueue {
   bool TrySubmit(absl::AnyInvocable<void() &&> job,
                  absl::AnyInvocable<bool() const> abandoned = nullptr);
 
+  // Queues `job` whatever the queue holds (false only when stopped): for a
+  // job whose caller was admitted already and holds at most one job at a
+  // time (an open Track stream's next frame; streams are limited), so the
+  // queue holds at most queue_capacity + that many.
+  bool SubmitAdmitted(absl::AnyInvocable<void() &&> job);
+
+  // Whether TrySubmit would refuse a job now (it may still, or may not,
+  // a moment later): what a call checks before parsing its request, so that
+  // a refusal costs next to nothing.
+  bool Full() const;
+
   // Refuses new jobs, runs every job already accepted, joins the workers.
   // Idempotent and safe to call from several threads at once: every caller
   // returns once the workers are joined. Accepted jobs always run: each one

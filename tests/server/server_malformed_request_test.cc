@@ -9,6 +9,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <future>
 #include <memory>
 #include <string>
 #include <vector>
@@ -25,9 +26,11 @@ namespace {
 
 using ::fovea::server::testing::FaultTest;
 using ::fovea::server::testing::kCallTimeout;
+using ::fovea::server::testing::MakeSyntheticRequest;
 using ::fovea::server::testing::Method;
 using ::fovea::server::testing::MethodName;
 using ::fovea::server::testing::MetricValue;
+using ::fovea::server::testing::ServerTest;
 using ::fovea::server::testing::SmallRequests;
 using ::testing::HasSubstr;
 
@@ -161,6 +164,36 @@ TEST_F(FaultTest,
   EXPECT_THAT(deep.status.error_message(),
               HasSubstr("field frame (2).frame_id ("));
   EXPECT_EQ(MetricValue(Scrape(), "fovea_inflight_requests", {}), 0);
+}
+
+// Under overload a refusal costs next to nothing: while the work queue is
+// full, a call is refused busy before its body is parsed (a malformed one
+// too: it is never read), and counted as shed; once there is room, the
+// same bytes are parsed and named as malformed.
+TEST_F(ServerTest, AFullServerRefusesBeforeParsingTheBody) {
+  ServerConfig config = DefaultConfig();
+  config.concurrency = 1;
+  config.queue = 0;
+  StartServer(config);
+  std::future<grpc::Status> running =
+      StartHeldDetect(MakeSyntheticRequest(1, false).request);
+  ASSERT_EQ(gate_.entered(), 1);
+  const std::string malformed = MalformedRequests()[0].bytes;
+  for (Method method :
+       {Method::kDetect, Method::kSegment, Method::kSegmentIncremental}) {
+    const std::string path = "/fovea.v1.Perception/" + MethodName(method);
+    const RawCallResult refused = CallWithBytes(channel_, path, malformed);
+    EXPECT_EQ(refused.status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED)
+        << path << ": " << refused.status.error_message();
+    EXPECT_THAT(refused.status.error_message(), HasSubstr("server busy"));
+  }
+  EXPECT_EQ(
+      MetricValue(Scrape(), "fovea_calls_shed_total", {"reason=\"busy\""}), 3);
+  gate_.Open();
+  ASSERT_TRUE(running.get().ok());
+  const RawCallResult parsed =
+      CallWithBytes(channel_, "/fovea.v1.Perception/Detect", malformed);
+  EXPECT_EQ(parsed.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
 }
 
 // Consistent encodings but 4e9 x 4e9 pixels over a few bytes of data:

@@ -6,6 +6,7 @@
 #include <grpcpp/grpcpp.h>
 
 #include <chrono>
+#include <future>
 #include <memory>
 #include <string>
 #include <thread>
@@ -23,6 +24,7 @@
 namespace fovea::server {
 namespace {
 
+using ::fovea::server::testing::kCallTimeout;
 using ::fovea::server::testing::MetricValue;
 using ::fovea::server::testing::ServerTest;
 using ::fovea::server::testing::WaitFor;
@@ -63,6 +65,37 @@ std::unique_ptr<grpc::ClientContext> Context() {
   context->set_deadline(std::chrono::system_clock::now() +
                         std::chrono::seconds(60));
   return context;
+}
+
+// An open stream was admitted: its frame waits its turn in a full work
+// queue instead of being skipped, so a client that sends a frame after
+// each answer gets one (it would wait forever for a skipped frame's).
+TEST_F(ServerTest, TrackFrameWaitsInAFullQueueAndIsAnswered) {
+  ServerConfig config = DefaultConfig();
+  config.concurrency = 1;
+  config.queue = 0;
+  StartServer(config);
+  std::future<grpc::Status> running =
+      StartHeldDetect(testing::MakeSyntheticRequest(1, false).request);
+  ASSERT_EQ(gate_.entered(), 1);
+  const synth::Sequence sequence =
+      synth::GenerateSequence(synth::SequenceKind::kStatic, 3, 2);
+  auto context = Context();
+  std::unique_ptr<Stream> stream = stub_->Track(context.get());
+  ASSERT_TRUE(stream->Write(Options("behind-a-busy-worker")));
+  ASSERT_TRUE(stream->Write(FrameMessage(sequence.frames[0], 1)));
+  // Queued past the queue's capacity (0), not skipped.
+  ASSERT_TRUE(
+      WaitFor([this] { return server_->queued_jobs() == 1; }, kCallTimeout));
+  gate_.Open();
+  v1::TrackResponse response;
+  ASSERT_TRUE(stream->Read(&response));
+  EXPECT_EQ(response.sequence(), 1u);
+  EXPECT_EQ(response.frames_skipped(), 0u);
+  EXPECT_GT(response.objects_size(), 0);
+  stream->WritesDone();
+  EXPECT_TRUE(stream->Finish().ok());
+  EXPECT_TRUE(running.get().ok());
 }
 
 // A still scene, frame by frame (each sent after the last answer): every

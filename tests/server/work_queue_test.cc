@@ -68,6 +68,32 @@ TEST(WorkQueueTest, RefusesBeyondWorkersPlusQueue) {
   EXPECT_EQ(ran.load(), 2);
 }
 
+// An admitted caller's job is queued past the capacity; Full says what
+// TrySubmit would do, abandoned jobs not counted.
+TEST(WorkQueueTest, AdmittedJobsQueuePastTheCapacityAndFullSaysSo) {
+  WorkQueue queue(1, 1);
+  Notification release;
+  std::atomic<int> ran{0};
+  EXPECT_FALSE(queue.Full());
+  ASSERT_TRUE(SubmitHeldJob(queue, release, ran));
+  EXPECT_FALSE(queue.Full());  // one queue slot left
+  std::atomic<bool> gone{false};
+  EXPECT_TRUE(queue.TrySubmit([&] { ran.fetch_add(100); },
+                              [&] { return gone.load(); }));
+  EXPECT_TRUE(queue.Full());
+  EXPECT_FALSE(queue.TrySubmit([&] { ran.fetch_add(1000); }));
+  gone = true;  // the abandoned one no longer counts
+  EXPECT_FALSE(queue.Full());
+  EXPECT_TRUE(queue.SubmitAdmitted([&] { ran.fetch_add(1); }));
+  EXPECT_TRUE(queue.Full());
+  EXPECT_TRUE(queue.SubmitAdmitted([&] { ran.fetch_add(1); }));  // past it
+  release.Notify();
+  queue.Stop();
+  EXPECT_EQ(ran.load(), 3);   // the held job and the two admitted ones
+  EXPECT_TRUE(queue.Full());  // stopped: nothing more is taken
+  EXPECT_FALSE(queue.SubmitAdmitted([&] { ran.fetch_add(1); }));
+}
+
 TEST(WorkQueueTest, AbandonedJobsNeverRunAndFreeTheirSlot) {
   WorkQueue queue(1, 1);
   Notification release;

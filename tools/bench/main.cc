@@ -15,11 +15,17 @@
 //                    (a digest of each frame's Detect, COS and INC results:
 //                    equal digests, equal results)
 //   fovea-bench load --server 127.0.0.1:PORT --clients C --requests N
-//                    [--seconds S] [--rpc detect|segment|segment-incremental]
+//                    [--seconds S]
+//                    [--rpc detect|segment|segment-incremental|track]
+//                    [--duration_s S] [--backoff true|false]
 //                    (closed-loop load on a running server, loopback only:
-//                    throughput, p50/p99 latency, time to first object,
-//                    calls per status code; --server may list replicas,
-//                    127.0.0.1:P1,127.0.0.1:P2, to load them round robin)
+//                    throughput, goodput (OK calls/s), p50/p99 latency,
+//                    time to first object, refusals and their latency,
+//                    calls per status code; --duration_s runs for a fixed
+//                    time instead of N calls; --backoff makes a refused
+//                    client wait as a gRPC retry policy would; --server may
+//                    list replicas, 127.0.0.1:P1,127.0.0.1:P2, to load
+//                    them round robin)
 //
 // Inputs: synthetic scenes (core/synth, seeds kSynthSeeds) and, when
 // FOVEA_OSD_DIR names the OSD data (learn/learn*.pcd), the same cases on
@@ -131,15 +137,16 @@ BenchFlags ParseFlags(int argc, char** argv, std::vector<char*>& args) {
 
 #ifdef FOVEA_BENCH_GRPC
 // `fovea-bench load --server ADDR --clients C --requests N --seconds S
-// --rpc detect|segment|segment-incremental [--deadline_s D]`.
+// --rpc detect|segment|segment-incremental|track [--deadline_s D]
+// [--duration_s S] [--backoff true|false]`.
 int RunLoadCommand(int argc, char** argv) {
   fovea::bench::LoadOptions options;
   if (argc % 2 != 0) {  // "fovea-bench load" and flag-value pairs
     std::fprintf(stderr,
                  "usage: fovea-bench load --server 127.0.0.1:PORT --clients C "
                  "--requests N [--seconds S] "
-                 "[--rpc detect|segment|segment-incremental] "
-                 "[--deadline_s D]\n");
+                 "[--rpc detect|segment|segment-incremental|track] "
+                 "[--deadline_s D] [--duration_s S] [--backoff true|false]\n");
     return argc == 3 && (std::string_view(argv[2]) == "--help" ||
                          std::string_view(argv[2]) == "-h")
                ? 0
@@ -162,6 +169,10 @@ int RunLoadCommand(int argc, char** argv) {
       options.max_seconds = x;
     } else if (flag == "--deadline_s" && absl::SimpleAtod(value, &x)) {
       options.deadline_seconds = x;
+    } else if (flag == "--duration_s" && absl::SimpleAtod(value, &x)) {
+      options.duration_seconds = x;
+    } else if (flag == "--backoff" && (value == "true" || value == "false")) {
+      options.backoff = value == "true";
     } else {
       std::fprintf(stderr, "fovea-bench load: bad flag %s %s\n", flag.c_str(),
                    value.c_str());
@@ -184,6 +195,11 @@ int RunLoadCommand(int argc, char** argv) {
   if (report->first_object_p50_ms > 0) {
     std::printf(", first object p50 %.1f ms", report->first_object_p50_ms);
   }
+  std::printf(
+      "\ngoodput %.1f OK calls/s (%d OK), %d refused, refusal p50 %.2f ms, "
+      "p99 %.2f ms",
+      report->goodput, report->ok, report->refused, report->refusal_p50_ms,
+      report->refusal_p99_ms);
   std::printf("\ncodes:");
   for (const auto& [code, count] : report->codes) {
     std::printf(" %s %d", code.c_str(), count);
