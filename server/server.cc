@@ -21,6 +21,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
 #include "core/base/status_macros.h"
+#include "core/base/tsan.h"
 #include "core/synth/synth_scene.h"
 #include "grpc/health/v1/health.pb.h"
 #include "server/accept_guard.h"
@@ -522,6 +523,9 @@ void FoveaServer::Shutdown(absl::Duration grace) {
     // What is left: health Watch streams (which never end on their own),
     // calls past the grace.
     server_->Shutdown(absl::ToChronoTime(absl::Now()));
+    // Every call's OnDone has run, and with it its CallRecord's last touch
+    // of the state (~CallRecord).
+    TsanHappensAfter(service_state_.get());
     LogInfo(absl::StrFormat("gRPC server stopped after %.1f ms",
                             SecondsSince(start) * 1e3));
   }
