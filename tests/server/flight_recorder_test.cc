@@ -163,8 +163,8 @@ TEST(FlightRecorderTest, SubmitNeverBlocksAndDropsWhatTheQueueCannotHold) {
 }
 
 // A Track stream is written as it goes, in parts of track_part_frames
-// frames, each in the layout `fovea-client track --frames` reads; a part
-// appears when complete, and frames the queue could not hold are counted.
+// frames, each in the layout `fovea-client track --frames` reads, and a
+// part appears (renamed from its temporary folder) when complete.
 TEST(FlightRecorderTest, AStreamIsWrittenInPartsAsItGoes) {
   const fs::path dir = testing::FreshTestDir("recorder_stream_");
   RecorderConfig config;
