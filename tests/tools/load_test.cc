@@ -95,6 +95,54 @@ TEST(LoadTest, AFullQueueAnswersResourceExhaustedNotACollapse) {
   EXPECT_EQ(report->codes["OK"] + report->codes["ResourceExhausted"], 6);
 }
 
+// Over a fixed time, clients that back off after a refusal: goodput is the
+// OK calls over that time, refusals are counted and timed, and backing off
+// keeps them few (calling again at once, three waiting clients would be
+// refused thousands of times in 1.5 s).
+TEST(LoadTest, FixedTimeWithBackoffCountsGoodputAndFewRefusals) {
+  server::ServerConfig config;
+  config.concurrency = 1;
+  config.queue = 0;
+  config.before_detect_job = [] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  };
+  std::unique_ptr<server::FoveaServer> s = Start(config);
+  ASSERT_NE(s, nullptr);
+  LoadOptions options;
+  options.server = "127.0.0.1:" + std::to_string(s->port());
+  options.clients = 4;
+  options.requests = 1;  // no limit with a duration
+  options.duration_seconds = 1.5;
+  options.backoff = true;
+  absl::StatusOr<LoadReport> report = RunLoad(options);
+  ASSERT_TRUE(report.ok()) << report.status();
+  EXPECT_GE(report->seconds, 1.5);
+  EXPECT_GE(report->ok, 3);
+  EXPECT_EQ(report->ok, report->codes["OK"]);
+  EXPECT_NEAR(report->goodput, report->ok / report->seconds, 1e-9);
+  EXPECT_GE(report->refused, 1);
+  EXPECT_LT(report->refused, 100);
+  EXPECT_EQ(report->refused, report->codes["ResourceExhausted"]);
+  EXPECT_GT(report->refusal_p50_ms, 0.0);
+  EXPECT_GE(report->refusal_p99_ms, report->refusal_p50_ms);
+}
+
+// rpc "track": a stream's answered frames are the OK calls.
+TEST(LoadTest, TrackCountsTheFramesAnswered) {
+  std::unique_ptr<server::FoveaServer> s = Start(server::ServerConfig());
+  ASSERT_NE(s, nullptr);
+  LoadOptions options;
+  options.server = "127.0.0.1:" + std::to_string(s->port());
+  options.clients = 1;
+  options.rpc = "track";
+  options.duration_seconds = 1.0;
+  absl::StatusOr<LoadReport> report = RunLoad(options);
+  ASSERT_TRUE(report.ok()) << report.status();
+  EXPECT_GE(report->ok, 2);
+  EXPECT_EQ(report->calls, report->ok);  // nothing refused, nothing failed
+  EXPECT_GT(report->p50_ms, 0.0);
+}
+
 TEST(LoadTest, OnlyLoopbackAndSaneNumbers) {
   LoadOptions options;
   options.server = "10.1.2.3:50051";
@@ -112,6 +160,10 @@ TEST(LoadTest, OnlyLoopbackAndSaneNumbers) {
             absl::StatusCode::kInvalidArgument);
   options.clients = 1;
   options.rpc = "nope";
+  EXPECT_EQ(RunLoad(options).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  options.rpc = "detect";
+  options.duration_seconds = -1;
   EXPECT_EQ(RunLoad(options).status().code(),
             absl::StatusCode::kInvalidArgument);
 }
