@@ -89,8 +89,11 @@ ABSL_FLAG(double, max_connection_age_s, 300.0,
           "Seconds after which a client connection is asked to reconnect "
           "(gRPC GOAWAY, +-10 % jitter), so clients re-resolve DNS and "
           "spread over replicas added since; 0 keeps connections forever.");
-ABSL_FLAG(double, max_connection_age_grace_s, 30.0,
-          "Seconds calls in flight on such a connection get to finish.");
+ABSL_FLAG(double, max_connection_age_grace_s,
+          fovea::server::ServerConfig{}.max_connection_age_grace_s,
+          "Seconds calls in flight on such a connection get to finish: a "
+          "day by default, as a Track stream is a robot's session (unary "
+          "calls and new streams move to the new connection at once).");
 ABSL_FLAG(double, stream_stall_timeout_s,
           fovea::server::ServerConfig{}.stream_stall_timeout_s,
           "A Segment stream whose client takes no message for this long "

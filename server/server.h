@@ -63,7 +63,8 @@ struct ServerConfig {
   // spread over replicas added since they connected; calls in flight get
   // max_connection_age_grace_s more to finish. 0: connections live forever.
   double max_connection_age_s = 0.0;
-  double max_connection_age_grace_s = 30.0;  // >= 0
+  // >= 0; a day: a Track stream, a robot's session, is not cut.
+  double max_connection_age_grace_s = 86400.0;
   // A stream whose client takes no message for this long while results
   // wait for it is cancelled (ServiceConfig::stream_stall_timeout), (0,
   // 3600].

@@ -98,6 +98,32 @@ TEST_F(ServerTest, TrackFrameWaitsInAFullQueueAndIsAnswered) {
   EXPECT_TRUE(running.get().ok());
 }
 
+// A connection older than --max_connection_age_s is asked to go away
+// (GOAWAY), but a Track stream on it, a robot's session, goes on: calls
+// in flight get the default grace, a day. (With a grace of 1 s the stream
+// was cut 1.5 s after it opened; at the defaults, 5.5 minutes.)
+TEST_F(ServerTest, TrackStreamOutlivesItsConnectionsAge) {
+  ServerConfig config = DefaultConfig();
+  config.max_connection_age_s = 0.5;
+  StartServer(config);
+  const synth::Sequence sequence =
+      synth::GenerateSequence(synth::SequenceKind::kStatic, 3, 2);
+  auto context = Context();
+  std::unique_ptr<Stream> stream = stub_->Track(context.get());
+  ASSERT_TRUE(stream->Write(Options("long-session")));
+  v1::TrackResponse response;
+  ASSERT_TRUE(stream->Write(FrameMessage(sequence.frames[0], 1)));
+  ASSERT_TRUE(stream->Read(&response));
+  // Past the age (and its jitter) and what a short grace would allow.
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+  ASSERT_TRUE(stream->Write(FrameMessage(sequence.frames[1], 2)));
+  ASSERT_TRUE(stream->Read(&response));
+  EXPECT_EQ(response.sequence(), 2u);
+  stream->WritesDone();
+  const grpc::Status status = stream->Finish();
+  EXPECT_TRUE(status.ok()) << status.error_message();
+}
+
 // A still scene, frame by frame (each sent after the last answer): every
 // frame is answered, the later ones reuse the first segmentation and keep
 // its identities, and the stream ends OK when the client half-closes.
