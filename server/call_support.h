@@ -74,6 +74,12 @@ class CallRecord {
   // A server stream; its messages were counted as they were sent.
   grpc::Status EndStream(const absl::Status& status) { return End(status); }
 
+  // The request id a stream's first message gave (Track's options arrive
+  // after the call started), for the call's log line.
+  void set_request_id(std::string_view request_id) {
+    request_id_ = std::string(request_id.substr(0, kMaxLoggedRequestId));
+  }
+
  private:
   grpc::Status End(const absl::Status& status) {
     const double seconds = SecondsSince(start_);
@@ -91,7 +97,7 @@ class CallRecord {
   }
 
   const std::string_view method_;  // a string literal
-  const std::string request_id_;
+  std::string request_id_;
   const Clock::time_point start_;
   ServiceState& state_;
 };

@@ -168,6 +168,11 @@ class TrackReactor final
       FOVEA_ASSIGN_OR_RETURN(TrackerOptions options,
                              ToTrackerOptions(request->options()));
       request_id_ = request->options().request_id();
+      {
+        // The idle timer may end the stream, and log it, on its own thread.
+        std::lock_guard<std::mutex> lock(mutex_);
+        call_.set_request_id(request_id_);
+      }
       tracker_ = std::make_unique<Tracker>(options, config_.segment_models.inc);
       if (config_.recorder != nullptr && config_.recorder->ShouldRecord()) {
         record_stream_ = config_.recorder->NewStream();
@@ -362,8 +367,12 @@ class TrackReactor final
       TsanHappensBefore(this);
       return;
     }
-    end_code_ = finish->code();
-    const grpc::Status end = call_.EndStream(*finish);
+    grpc::Status end;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);  // call_'s request id
+      end_code_ = finish->code();
+      end = call_.EndStream(*finish);
+    }
     TsanHappensBefore(this);
     Finish(end);
   }
@@ -371,7 +380,7 @@ class TrackReactor final
   const ServiceConfig& config_;
   WorkQueue& work_;
   grpc::CallbackServerContext* const context_;  // gRPC's, valid until OnDone
-  CallRecord call_;
+  CallRecord call_;  // its request id and end under mutex_
   std::shared_ptr<StreamRegistry::Handle> handle_;  // null when refused
   grpc::ByteBuffer in_;  // the read in flight (reactions run one at a time)
   // Set by the first message, on gRPC's thread; read by the jobs, which

@@ -67,63 +67,6 @@ std::unique_ptr<grpc::ClientContext> Context() {
   return context;
 }
 
-// An open stream was admitted: its frame waits its turn in a full work
-// queue instead of being skipped, so a client that sends a frame after
-// each answer gets one (it would wait forever for a skipped frame's).
-TEST_F(ServerTest, TrackFrameWaitsInAFullQueueAndIsAnswered) {
-  ServerConfig config = DefaultConfig();
-  config.concurrency = 1;
-  config.queue = 0;
-  StartServer(config);
-  std::future<grpc::Status> running =
-      StartHeldDetect(testing::MakeSyntheticRequest(1, false).request);
-  ASSERT_EQ(gate_.entered(), 1);
-  const synth::Sequence sequence =
-      synth::GenerateSequence(synth::SequenceKind::kStatic, 3, 2);
-  auto context = Context();
-  std::unique_ptr<Stream> stream = stub_->Track(context.get());
-  ASSERT_TRUE(stream->Write(Options("behind-a-busy-worker")));
-  ASSERT_TRUE(stream->Write(FrameMessage(sequence.frames[0], 1)));
-  // Queued past the queue's capacity (0), not skipped.
-  ASSERT_TRUE(
-      WaitFor([this] { return server_->queued_jobs() == 1; }, kCallTimeout));
-  gate_.Open();
-  v1::TrackResponse response;
-  ASSERT_TRUE(stream->Read(&response));
-  EXPECT_EQ(response.sequence(), 1u);
-  EXPECT_EQ(response.frames_skipped(), 0u);
-  EXPECT_GT(response.objects_size(), 0);
-  stream->WritesDone();
-  EXPECT_TRUE(stream->Finish().ok());
-  EXPECT_TRUE(running.get().ok());
-}
-
-// A connection older than --max_connection_age_s is asked to go away
-// (GOAWAY), but a Track stream on it, a robot's session, goes on: calls
-// in flight get the default grace, a day. (With a grace of 1 s the stream
-// was cut 1.5 s after it opened; at the defaults, 5.5 minutes.)
-TEST_F(ServerTest, TrackStreamOutlivesItsConnectionsAge) {
-  ServerConfig config = DefaultConfig();
-  config.max_connection_age_s = 0.5;
-  StartServer(config);
-  const synth::Sequence sequence =
-      synth::GenerateSequence(synth::SequenceKind::kStatic, 3, 2);
-  auto context = Context();
-  std::unique_ptr<Stream> stream = stub_->Track(context.get());
-  ASSERT_TRUE(stream->Write(Options("long-session")));
-  v1::TrackResponse response;
-  ASSERT_TRUE(stream->Write(FrameMessage(sequence.frames[0], 1)));
-  ASSERT_TRUE(stream->Read(&response));
-  // Past the age (and its jitter) and what a short grace would allow.
-  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
-  ASSERT_TRUE(stream->Write(FrameMessage(sequence.frames[1], 2)));
-  ASSERT_TRUE(stream->Read(&response));
-  EXPECT_EQ(response.sequence(), 2u);
-  stream->WritesDone();
-  const grpc::Status status = stream->Finish();
-  EXPECT_TRUE(status.ok()) << status.error_message();
-}
-
 // A still scene, frame by frame (each sent after the last answer): every
 // frame is answered, the later ones reuse the first segmentation and keep
 // its identities, and the stream ends OK when the client half-closes.
@@ -131,6 +74,7 @@ TEST_F(ServerTest, TrackKeepsIdentitiesOverAStillScene) {
   StartServer();
   const synth::Sequence sequence =
       synth::GenerateSequence(synth::SequenceKind::kStatic, 3, 3);
+  ::testing::internal::CaptureStderr();  // the call's log line
   auto context = Context();
   std::unique_ptr<Stream> stream = stub_->Track(context.get());
   ASSERT_TRUE(stream->Write(Options("still")));
@@ -145,7 +89,10 @@ TEST_F(ServerTest, TrackKeepsIdentitiesOverAStillScene) {
   v1::TrackResponse extra;
   EXPECT_FALSE(stream->Read(&extra));
   const grpc::Status status = stream->Finish();
+  const std::string log = ::testing::internal::GetCapturedStderr();
   ASSERT_TRUE(status.ok()) << status.error_message();
+  // Logged under the request id its options gave, as other calls are.
+  EXPECT_THAT(log, HasSubstr("call method=Track request_id=\"still\" code=OK"));
 
   ASSERT_EQ(responses.size(), 3u);
   EXPECT_EQ(responses[0].request_id(), "still");
@@ -356,6 +303,64 @@ TEST_F(ServerTest, TrackWhoseClientNeverReadsIsCancelledAndOthersGoOn) {
         return MetricValue(Scrape(), "fovea_track_open_streams", {}) == 0;
       },
       std::chrono::seconds(10)));
+}
+
+// Placed last: the tests above count their frames in the process's metrics.
+// An open stream was admitted: its frame waits its turn in a full work
+// queue instead of being skipped, so a client that sends a frame after
+// each answer gets one (it would wait forever for a skipped frame's).
+TEST_F(ServerTest, TrackFrameWaitsInAFullQueueAndIsAnswered) {
+  ServerConfig config = DefaultConfig();
+  config.concurrency = 1;
+  config.queue = 0;
+  StartServer(config);
+  std::future<grpc::Status> running =
+      StartHeldDetect(testing::MakeSyntheticRequest(1, false).request);
+  ASSERT_EQ(gate_.entered(), 1);
+  const synth::Sequence sequence =
+      synth::GenerateSequence(synth::SequenceKind::kStatic, 3, 2);
+  auto context = Context();
+  std::unique_ptr<Stream> stream = stub_->Track(context.get());
+  ASSERT_TRUE(stream->Write(Options("behind-a-busy-worker")));
+  ASSERT_TRUE(stream->Write(FrameMessage(sequence.frames[0], 1)));
+  // Queued past the queue's capacity (0), not skipped.
+  ASSERT_TRUE(
+      WaitFor([this] { return server_->queued_jobs() == 1; }, kCallTimeout));
+  gate_.Open();
+  v1::TrackResponse response;
+  ASSERT_TRUE(stream->Read(&response));
+  EXPECT_EQ(response.sequence(), 1u);
+  EXPECT_EQ(response.frames_skipped(), 0u);
+  EXPECT_GT(response.objects_size(), 0);
+  stream->WritesDone();
+  EXPECT_TRUE(stream->Finish().ok());
+  EXPECT_TRUE(running.get().ok());
+}
+
+// A connection older than --max_connection_age_s is asked to go away
+// (GOAWAY), but a Track stream on it, a robot's session, goes on: calls
+// in flight get the default grace, a day. (With a grace of 1 s the stream
+// was cut 1.5 s after it opened; at the defaults, 5.5 minutes.)
+TEST_F(ServerTest, TrackStreamOutlivesItsConnectionsAge) {
+  ServerConfig config = DefaultConfig();
+  config.max_connection_age_s = 0.5;
+  StartServer(config);
+  const synth::Sequence sequence =
+      synth::GenerateSequence(synth::SequenceKind::kStatic, 3, 2);
+  auto context = Context();
+  std::unique_ptr<Stream> stream = stub_->Track(context.get());
+  ASSERT_TRUE(stream->Write(Options("long-session")));
+  v1::TrackResponse response;
+  ASSERT_TRUE(stream->Write(FrameMessage(sequence.frames[0], 1)));
+  ASSERT_TRUE(stream->Read(&response));
+  // Past the age (and its jitter) and what a short grace would allow.
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+  ASSERT_TRUE(stream->Write(FrameMessage(sequence.frames[1], 2)));
+  ASSERT_TRUE(stream->Read(&response));
+  EXPECT_EQ(response.sequence(), 2u);
+  stream->WritesDone();
+  const grpc::Status status = stream->Finish();
+  EXPECT_TRUE(status.ok()) << status.error_message();
 }
 
 }  // namespace
