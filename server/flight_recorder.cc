@@ -1,6 +1,5 @@
 #include "server/flight_recorder.h"
 
-#include <google/protobuf/util/json_util.h>
 #include <pthread.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
@@ -12,8 +11,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <opencv2/core.hpp>
-#include <opencv2/imgproc.hpp>
 #include <regex>
 #include <system_error>
 #include <utility>
@@ -23,21 +20,15 @@
 #include "absl/strings/str_format.h"
 #include "absl/time/clock.h"
 #include "absl/time/time.h"
-#include "core/frame/image_codec.h"
-#include "core/frame/image_header.h"
-#include "fovea/v1/frame.pb.h"
-#include "server/convert.h"
 #include "server/log.h"
 #include "server/metrics.h"
+#include "server/record_files.h"
 
 namespace fovea::server {
 namespace {
 
 namespace fs = std::filesystem;
 
-// Metres per unit of the 16-bit depth PNG a 32FC1 frame is stored as:
-// 0.1 mm, up to 6.5 m.
-constexpr double kFloatDepthScale = 1e-4;
 // The writer thread's nice value: the lowest priority there is.
 constexpr int kWriterNice = 19;
 
@@ -48,162 +39,9 @@ const std::regex& RecordName() {
   return *name;
 }
 
-std::string ToJson(const google::protobuf::Message& message) {
-  std::string json;
-  google::protobuf::util::JsonPrintOptions options;
-  options.preserve_proto_field_names = true;
-  if (!google::protobuf::util::MessageToJsonString(message, &json, options)
-           .ok()) {
-    return "{}";
-  }
-  return json;
-}
-
-// The files of one record, names and contents, or why the frame could not
-// be kept.
-struct Files {
-  std::vector<std::pair<std::string, std::string>> files;
-  std::string frame_problem;
-  int64_t bytes() const {
-    int64_t total = 0;
-    for (const auto& [name, data] : files) total += data.size();
-    return total;
-  }
-};
-
-// A raw image's rows as a cv::Mat header over its bytes (no copy); empty
-// when its fields do not describe its data.
-cv::Mat RawView(const v1::Image& image, int type, size_t pixel_bytes) {
-  const size_t row = static_cast<size_t>(image.width()) * pixel_bytes;
-  const size_t step = image.step() == 0 ? row : image.step();
-  if (image.width() == 0 || image.height() == 0 || step < row ||
-      image.data().size() < step * (image.height() - 1) + row) {
-    return cv::Mat();
-  }
-  return cv::Mat(static_cast<int>(image.height()),
-                 static_cast<int>(image.width()), type,
-                 const_cast<char*>(image.data().data()), step);
-}
-
-// The colour image as a file: the compressed one as sent, a raw one as
-// an RGB PNG.
-absl::Status ColourFile(const v1::Image& color, const std::string& prefix,
-                        Files& out) {
-  if (!color.compressed().empty()) {
-    const std::string& file = color.compressed();
-    out.files.emplace_back(
-        prefix + (IsJpegFile(file) ? "color.jpg" : "color.png"), file);
-    return absl::OkStatus();
-  }
-  const bool rgb = color.encoding() == "rgb8";
-  if (!rgb && color.encoding() != "bgr8") {
-    return absl::InvalidArgumentError(
-        absl::StrCat("colour encoding '", color.encoding(), "'"));
-  }
-  const cv::Mat view = RawView(color, CV_8UC3, 3);
-  if (view.empty()) return absl::InvalidArgumentError("colour image size");
-  cv::Mat bgr;  // EncodePng's order in memory
-  if (rgb) {
-    cv::cvtColor(view, bgr, cv::COLOR_RGB2BGR);
-  } else {
-    bgr = view;
-  }
-  absl::StatusOr<std::string> png = EncodePng(bgr);
-  if (!png.ok()) return png.status();
-  out.files.emplace_back(prefix + "color.png", *std::move(png));
-  return absl::OkStatus();
-}
-
-// The depth image as a 16-bit PNG file and the scale it is in.
-absl::StatusOr<double> DepthFile(const v1::Frame& frame,
-                                 const std::string& prefix, Files& out) {
-  const v1::Image& depth = frame.depth();
-  const double scale =
-      frame.depth_scale() > 0.0 ? frame.depth_scale() : kDefaultDepthScale;
-  if (!depth.compressed().empty()) {
-    out.files.emplace_back(prefix + "depth.png", depth.compressed());
-    return scale;
-  }
-  if (depth.is_bigendian()) return absl::InvalidArgumentError("big-endian");
-  cv::Mat units;
-  double units_scale = scale;
-  if (depth.encoding() == "16UC1") {
-    units = RawView(depth, CV_16UC1, 2);  // the units exactly as sent
-  } else if (depth.encoding() == "32FC1") {
-    const cv::Mat metres = RawView(depth, CV_32FC1, 4);
-    if (!metres.empty()) {
-      units.create(metres.size(), CV_16UC1);
-      for (int v = 0; v < metres.rows; ++v) {
-        const float* in = metres.ptr<float>(v);
-        uint16_t* o = units.ptr<uint16_t>(v);
-        for (int u = 0; u < metres.cols; ++u) {
-          o[u] = ToDepthUnits(in[u], kFloatDepthScale);
-        }
-      }
-      units_scale = kFloatDepthScale;
-    }
-  } else {
-    return absl::InvalidArgumentError(
-        absl::StrCat("depth encoding '", depth.encoding(), "'"));
-  }
-  if (units.empty()) return absl::InvalidArgumentError("depth image size");
-  absl::StatusOr<std::string> png = EncodePng(units);
-  if (!png.ok()) return png.status();
-  out.files.emplace_back(prefix + "depth.png", *std::move(png));
-  return units_scale;
-}
-
-// The frame a request carries: its `frame` field when that is a Frame,
-// or the Frame inside it (a TrackRequest's frame.frame); null when none.
-v1::Frame* FrameIn(google::protobuf::Message* message) {
-  for (int depth = 0; depth < 2 && message != nullptr; ++depth) {
-    const google::protobuf::FieldDescriptor* field =
-        message->GetDescriptor()->FindFieldByName("frame");
-    if (field == nullptr ||
-        field->type() != google::protobuf::FieldDescriptor::TYPE_MESSAGE ||
-        field->is_repeated()) {
-      return nullptr;
-    }
-    if (!message->GetReflection()->HasField(*message, field)) return nullptr;
-    message = message->GetReflection()->MutableMessage(message, field);
-    if (message->GetDescriptor() == v1::Frame::descriptor()) {
-      return static_cast<v1::Frame*>(message);
-    }
-  }
-  return nullptr;
-}
-
-// The image files of the frame `request` carries (named with `prefix`),
-// whose pixels go out of the request (the recorder's) into them; false,
-// with out.frame_problem set and the pixels dropped, when they cannot be
-// kept.
-bool FrameFiles(google::protobuf::Message& request, const std::string& prefix,
-                Files& out) {
-  v1::Frame* frame = FrameIn(&request);
-  if (frame == nullptr) return true;
-  const size_t before = out.files.size();
-  absl::Status colour = ColourFile(frame->color(), prefix, out);
-  absl::StatusOr<double> scale = colour.ok() ? DepthFile(*frame, prefix, out)
-                                             : absl::StatusOr<double>(colour);
-  if (scale.ok()) {
-    // The request as replay sends it: the images as the files above.
-    frame->mutable_color()->Clear();
-    frame->mutable_depth()->Clear();
-    frame->set_depth_scale(*scale);
-    return true;
-  }
-  out.frame_problem = std::string(scale.status().message());
-  out.files.resize(before);
-  frame->mutable_color()->clear_data();
-  frame->mutable_color()->clear_compressed();
-  frame->mutable_depth()->clear_data();
-  frame->mutable_depth()->clear_compressed();
-  return false;
-}
-
 // Everything a whole call's record holds, in memory.
-Files MakeFiles(RecordedCall& call, int64_t sequence) {
-  Files out;
+RecordFiles MakeFiles(RecordedCall& call, int64_t sequence) {
+  RecordFiles out;
   FrameFiles(*call.request, "", out);
   out.files.emplace_back("request.json", ToJson(*call.request) + "\n");
   std::string responses;
@@ -213,20 +51,9 @@ Files MakeFiles(RecordedCall& call, int64_t sequence) {
   out.files.emplace_back("responses.jsonl", std::move(responses));
   out.files.emplace_back(
       "meta.json",
-      absl::StrFormat("{\"method\":\"%s\",\"sequence\":%d,\"unix_micros\":%d,"
-                      "\"code\":\"%s\",\"seconds\":%.6f,\"frame\":\"%s\"}\n",
-                      call.method, sequence, call.unix_micros, call.code,
-                      call.seconds,
-                      out.frame_problem.empty() ? "recorded" : "unreadable"));
+      MetaJson(call.method, sequence, call.unix_micros, call.code, call.seconds,
+               out.frame_problem.empty() ? "recorded" : "unreadable", ""));
   return out;
-}
-
-// Writes `data` to `path` (appending with `append`); false on failure.
-bool WriteFile(const fs::path& path, const std::string& data, bool append) {
-  std::ofstream out(
-      path, std::ios::binary | (append ? std::ios::app : std::ios::trunc));
-  out.write(data.data(), static_cast<std::streamsize>(data.size()));
-  return static_cast<bool>(out);
 }
 
 // Bytes of the files in a folder (not recursing).
@@ -451,7 +278,7 @@ void FlightRecorder::WriteOne(RecordedCall call) {
     return;
   }
   const int64_t sequence = next_sequence_;
-  const Files files = MakeFiles(call, sequence);
+  const RecordFiles files = MakeFiles(call, sequence);
   const int64_t bytes = files.bytes();
   if (bytes > config_.max_bytes || !MakeRoom(bytes)) {
     RecordRecorderOutcome("too_large");
@@ -511,14 +338,13 @@ bool FlightRecorder::OpenNextPart(OpenPart& part) {
 
 void FlightRecorder::ClosePart(OpenPart& part, const std::string& code,
                                double seconds, bool continues) {
-  const std::string meta = absl::StrFormat(
-      "{\"method\":\"%s\",\"sequence\":%d,\"unix_micros\":%d,"
-      "\"code\":\"%s\",\"seconds\":%.6f,\"frame\":\"recorded\","
-      "\"part\":%d,\"frames\":%d,\"frames_dropped\":%d,"
-      "\"continues\":%s}\n",
+  const std::string meta = MetaJson(
       part.method, part.sequence, absl::ToUnixMicros(absl::Now()), code,
-      seconds, part.part, part.frames, part.dropped,
-      continues ? "true" : "false");
+      seconds, "recorded",
+      absl::StrFormat(",\"part\":%d,\"frames\":%d,\"frames_dropped\":%d,"
+                      "\"continues\":%s",
+                      part.part, part.frames, part.dropped,
+                      continues ? "true" : "false"));
   const fs::path temporary(part.path);
   const fs::path final_path =
       fs::path(config_.dir) /
@@ -578,7 +404,7 @@ void FlightRecorder::WriteStreamMessage(RecordedCall call) {
       return;
     }
   }
-  Files files;
+  RecordFiles files;
   const int n = part.frames + 1;
   if (!FrameFiles(*call.frame, absl::StrCat(n, "_"), files)) {
     ++part.dropped;

@@ -127,9 +127,7 @@ class TrackReactor final
   void OnDone() override {
     TsanHappensAfter(this);
     if (record_stream_ != 0) {
-      RecordedCall end;
-      end.method = std::string(kMethod);
-      end.stream = record_stream_;
+      RecordedCall end = StreamRecord();
       end.stream_end = true;
       end.code = absl::StatusCodeToString(end_code_);
       end.seconds = SecondsSince(start_);
@@ -148,6 +146,14 @@ class TrackReactor final
     std::unique_ptr<v1::TrackRequest> request;
     Clock::time_point arrived;
   };
+
+  // A message of this stream for the flight recorder (record_stream_).
+  RecordedCall StreamRecord() const {
+    RecordedCall message;
+    message.method = std::string(kMethod);
+    message.stream = record_stream_;
+    return message;
+  }
 
   // The registry's idle timer fired: nothing came from the client.
   void OnIdle() {
@@ -176,9 +182,7 @@ class TrackReactor final
       tracker_ = std::make_unique<Tracker>(options, config_.segment_models.inc);
       if (config_.recorder != nullptr && config_.recorder->ShouldRecord()) {
         record_stream_ = config_.recorder->NewStream();
-        RecordedCall opening;
-        opening.method = std::string(kMethod);
-        opening.stream = record_stream_;
+        RecordedCall opening = StreamRecord();
         opening.request = std::move(request);
         config_.recorder->Submit(std::move(opening));
       }
@@ -296,9 +300,7 @@ class TrackReactor final
     FOVEA_RETURN_IF_ERROR(Send(std::move(response)));
     if (recorded) {
       // The frame, done with, and its answer go to the recorder.
-      RecordedCall frame;
-      frame.method = std::string(kMethod);
-      frame.stream = record_stream_;
+      RecordedCall frame = StreamRecord();
       frame.frame = std::move(pending.request);
       frame.responses.push_back(std::move(recorded));
       config_.recorder->Submit(std::move(frame));
