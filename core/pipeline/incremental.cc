@@ -1,8 +1,10 @@
 #include "core/pipeline/incremental.h"
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <new>
+#include <opencv2/imgproc.hpp>
 #include <optional>
 #include <utility>
 
@@ -52,8 +54,36 @@ absl::Status Validate(const IncrementalOptions& options) {
         absl::StrCat("time_budget_seconds must be a non-negative number, got ",
                      options.time_budget_seconds));
   }
+  if (!(options.change_weight >= 0.0f && options.change_weight <= 1.0f)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "change_weight must be in [0, 1], got ", options.change_weight));
+  }
+  if (!options.change.empty() && options.change.type() != CV_8UC1) {
+    return absl::InvalidArgumentError("change must be CV_8UC1");
+  }
   FOVEA_RETURN_IF_ERROR(Validate(options.box_fit));
   return Validate(options.object_points);
+}
+
+cv::Mat WithChangeCue(const cv::Mat& saliency, const cv::Mat& change,
+                      float weight) {
+  cv::Mat cue;
+  change.convertTo(cue, CV_32FC1, 1.0 / 255.0);
+  if (cue.size() != saliency.size()) {
+    cv::resize(cue, cue, saliency.size(), 0.0, 0.0, cv::INTER_AREA);
+  }
+  const double sigma = std::max(1.0, 0.01 * saliency.cols);
+  cv::GaussianBlur(cue, cue, cv::Size(), sigma);
+  double cue_max = 0.0;
+  cv::minMaxLoc(cue, nullptr, &cue_max);
+  if (cue_max <= 0.0) return saliency;  // nothing changed
+  double saliency_max = 0.0;
+  cv::minMaxLoc(saliency, nullptr, &saliency_max);
+  cv::Mat out;
+  cv::addWeighted(saliency,
+                  saliency_max > 0.0 ? (1.0 - weight) / saliency_max : 0.0, cue,
+                  weight / cue_max, 0.0, out);
+  return out;
 }
 
 cv::Mat AttentionPointsSaliency(const std::vector<cv::Point>& points,
@@ -90,6 +120,11 @@ absl::StatusOr<SegmentSummary> RunSegmentIncremental(
           "attention_points: (", p.x, ", ", p.y, ") lies outside the ",
           frame.width(), "x", frame.height(), " frame"));
     }
+  }
+  if (!options.change.empty() && options.change.size() != frame.depth.size()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "change: ", options.change.cols, "x", options.change.rows,
+        " is not the frame's ", frame.width(), "x", frame.height()));
   }
   if (svm == nullptr) {
     return absl::FailedPreconditionError(
@@ -154,6 +189,9 @@ absl::StatusOr<SegmentSummary> RunSegmentIncremental(
   }
   FOVEA_RETURN_IF_ERROR(CheckInterrupt(interrupt));
 
+  if (!options.change.empty()) {
+    saliency = WithChangeCue(saliency, options.change, options.change_weight);
+  }
   if (!surfaces.has_value()) build_surfaces();
   FOVEA_RETURN_IF_ERROR(surfaces->status());
   SteadyClock::time_point lap = SteadyClock::now();

@@ -31,6 +31,14 @@ struct IncrementalOptions {
   // random-points protocol, F first: 0.61 / 0.72 / 0.58 at 20 / 50 / 100.
   float attention_sigma_px = 50.0f;
   DetectOptions detect;
+  // A temporal cue (a camera that keeps looking, core/track): the pixels
+  // that changed since the camera's last frame, CV_8UC1 at the frame's
+  // size, non-zero where changed; empty: none. The saliency map becomes
+  // (1 - change_weight) S + change_weight C, S the map above scaled to
+  // max 1, C the change blurred over 1 % of the image's width and scaled to
+  // max 1: attention goes first to what changed.
+  cv::Mat change;
+  float change_weight = 0.5f;
   int max_objects = 0;  // 0: no limit
   // Objects showing less visible area are fragments and are not reported
   // (they still leave the scene), m^2 (SegmentOptions::min_object_area_m2).
@@ -49,6 +57,11 @@ absl::Status Validate(const IncrementalOptions& options);
 // `size`, max 1), as IncrementalOptions describes.
 cv::Mat AttentionPointsSaliency(const std::vector<cv::Point>& points,
                                 cv::Size size, float sigma_px);
+
+// `saliency` (CV_32FC1) with the temporal cue of `change` (CV_8UC1, any
+// size: resized to the map's), as IncrementalOptions::change describes.
+cv::Mat WithChangeCue(const cv::Mat& saliency, const cv::Mat& change,
+                      float weight);
 
 // Runs INC: the points sink gets the attention points used (given ones, or
 // Detect's), then each object goes to the object sink as it is final. The

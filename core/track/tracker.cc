@@ -82,6 +82,27 @@ void Join(const SegmentedObject& piece, SegmentedObject& into) {
                      piece.points.end());
 }
 
+// The colour of `object` in `color` (RGB, CV_8UC3, the mask's size): a
+// 4 x 4 x 4 histogram of its mask's pixels; empty without colour.
+cv::Mat Appearance(const cv::Mat& color, const SegmentedObject& object) {
+  if (color.empty() || color.type() != CV_8UC3 || object.mask.empty() ||
+      color.size() != object.mask.size()) {
+    return {};
+  }
+  const cv::Rect box = object.box & cv::Rect(0, 0, color.cols, color.rows);
+  if (box.empty()) return {};
+  const cv::Mat image = color(box);
+  const cv::Mat mask = object.mask(box);
+  const int channels[] = {0, 1, 2};
+  const int bins[] = {4, 4, 4};
+  const float range[] = {0.0f, 256.0f};
+  const float* ranges[] = {range, range, range};
+  cv::Mat histogram;
+  cv::calcHist(&image, 1, channels, mask, histogram, 3, bins, ranges);
+  if (cv::sum(histogram)[0] <= 0.0) return {};
+  return histogram;
+}
+
 int StateOrder(TrackState state) {
   switch (state) {
     case TrackState::kAppeared:
@@ -136,6 +157,13 @@ absl::Status Validate(const TrackerOptions& options) {
     return absl::InvalidArgumentError(
         "track.match_extent_fraction: must be >= 0");
   }
+  if (!(options.reidentify_distance >= 0.0f &&
+        options.reidentify_distance <= 1.0f)) {
+    return absl::InvalidArgumentError(
+        "track.reidentify_distance: must be in [0, 1]");
+  }
+  FOVEA_RETURN_IF_ERROR(positive("reidentify_size", options.reidentify_size));
+  FOVEA_RETURN_IF_ERROR(positive("reidentify_m", options.reidentify_m));
   if (options.remember_frames < 0) {
     return absl::InvalidArgumentError("track.remember_frames: must be >= 0");
   }
@@ -147,12 +175,13 @@ Tracker::Tracker(const TrackerOptions& options, const RbfSvm* relation_svm)
       valid_(Validate(options)),
       relation_svm_(relation_svm) {}
 
-double Tracker::ChangedFraction(const RgbdFrame& frame) const {
+double Tracker::ChangedFraction(const RgbdFrame& frame,
+                                cv::Mat& changed) const {
   const bool colors = !frame.color.empty() && !reference_.color.empty() &&
                       frame.color.size() == reference_.color.size() &&
                       frame.color.type() == CV_8UC3 &&
                       reference_.color.type() == CV_8UC3;
-  cv::Mat changed(frame.depth.size(), CV_8UC1, cv::Scalar(0));
+  changed = cv::Mat(frame.depth.size(), CV_8UC1, cv::Scalar(0));
   int64_t valid = 0;
   for (int v = 0; v < frame.depth.rows; ++v) {
     const float* z = frame.depth.ptr<float>(v);
@@ -200,6 +229,63 @@ bool Tracker::CameraStill(const std::optional<Eigen::Isometry3f>& pose) const {
          std::abs(angle) <= options_.still_rad;
 }
 
+void Tracker::Reidentify(const cv::Mat& color,
+                         const std::vector<SegmentedObject>& found,
+                         const std::vector<Eigen::Vector3f>& world,
+                         const Eigen::Vector3f& shift,
+                         const std::vector<Track>& tracks,
+                         const std::vector<int>& candidates,
+                         std::vector<int>& match) const {
+  std::vector<bool> taken(found.size(), false);
+  std::vector<int> free_tracks;
+  for (size_t i = 0; i < match.size(); ++i) {
+    if (match[i] >= 0) {
+      taken[match[i]] = true;
+    } else if (!tracks[candidates[i]].appearance.empty()) {
+      free_tracks.push_back(static_cast<int>(i));
+    }
+  }
+  std::vector<int> free_objects;
+  std::vector<cv::Mat> looks;
+  for (size_t j = 0; j < found.size(); ++j) {
+    if (taken[j]) continue;
+    cv::Mat look = Appearance(color, found[j]);
+    if (look.empty()) continue;
+    free_objects.push_back(static_cast<int>(j));
+    looks.push_back(std::move(look));
+  }
+  if (free_tracks.empty() || free_objects.empty()) return;
+  std::vector<std::vector<double>> score(
+      free_tracks.size(), std::vector<double>(free_objects.size(), 0.0));
+  for (size_t a = 0; a < free_tracks.size(); ++a) {
+    const Track& t = tracks[candidates[free_tracks[a]]];
+    for (size_t b = 0; b < free_objects.size(); ++b) {
+      const SegmentedObject& o = found[free_objects[b]];
+      const float size = std::max(LargestExtent(o), 1e-3f) /
+                         std::max(LargestExtent(t.object), 1e-3f);
+      if (size > options_.reidentify_size ||
+          size * options_.reidentify_size < 1.0f) {
+        continue;
+      }
+      if ((world[free_objects[b]] - shift - t.world_centroid).norm() >
+          options_.reidentify_m) {
+        continue;
+      }
+      const double distance =
+          cv::compareHist(t.appearance, looks[b], cv::HISTCMP_BHATTACHARYYA);
+      if (distance <= options_.reidentify_distance) {
+        score[a][b] = 1.0 - distance;
+      }
+    }
+  }
+  const std::vector<int> pairs = MaxWeightAssignment(score);
+  for (size_t a = 0; a < pairs.size(); ++a) {
+    if (pairs[a] >= 0 && score[a][pairs[a]] > 0.0) {
+      match[free_tracks[a]] = free_objects[pairs[a]];
+    }
+  }
+}
+
 TrackedObject Tracker::Gone(const Track& track) {
   TrackedObject gone;
   gone.track_id = track.id;
@@ -235,7 +321,8 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
   }
   // A camera known to have moved sees every pixel change: not looked at.
   const bool still = same_size && CameraStill(camera_to_world);
-  out.changed_fraction = still ? ChangedFraction(frame) : 1.0;
+  cv::Mat changed;
+  out.changed_fraction = still ? ChangedFraction(frame, changed) : 1.0;
   clock.Lap("change");
 
   const bool reuse = still && out.changed_fraction <= options_.static_fraction;
@@ -260,9 +347,12 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
       found.push_back(std::move(object));
       return absl::OkStatus();
     };
-    FOVEA_RETURN_IF_ERROR(RunSegmentIncremental(frame, options_.segment,
-                                                relation_svm_, sinks, interrupt)
-                              .status());
+    // What changed is where attention goes first.
+    IncrementalOptions segment = options_.segment;
+    if (still) segment.change = changed;
+    FOVEA_RETURN_IF_ERROR(
+        RunSegmentIncremental(frame, segment, relation_svm_, sinks, interrupt)
+            .status());
     clock.Lap("segment");
 
     // Candidates: tracks seen within remember_frames.
@@ -324,6 +414,10 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
         shift = CoordinateMedian(moves);
         match = assign(shift);
       }
+    }
+
+    if (options_.reidentify_distance > 0.0f) {
+      Reidentify(frame.color, found, world, shift, tracks, candidates, match);
     }
 
     std::vector<int> track_of(found.size(), -1);
@@ -443,6 +537,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
                 ? TrackState::kMoved
                 : TrackState::kKept;
         t.object = found[j];
+        t.appearance = Appearance(frame.color, found[j]);
         t.world_centroid = world[j];
         t.last_seen_frame = frame_index_;
         t.composite = t.composite || composite[j];
@@ -453,6 +548,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
         Track t;
         t.id = next_id_++;
         t.object = found[j];
+        t.appearance = Appearance(frame.color, found[j]);
         t.world_centroid = world[j];
         t.last_seen_frame = frame_index_;
         t.frames_seen = 1;

@@ -30,8 +30,13 @@ namespace fovea {
 //     (the support and the objects anchor a camera that moves a little
 //     between frames), by the one-to-one assignment of least distance
 //     within a gate.
-//   - What changed comes first: objects that appeared or moved are reported
-//     before those kept.
+//   - What changed comes first: with a still camera, the pixels that
+//     changed are INC's temporal cue (IncrementalOptions::change), so that
+//     its attention goes to them first; objects that appeared or moved are
+//     reported before those kept.
+//   - An object that comes back elsewhere (picked up and put down) keeps
+//     its identity when its colour and size are those of a track that
+//     matched nothing (TrackerOptions::reidentify_distance).
 //   - Pieces that move rigidly together become one object: two tracks whose
 //     masks touch and that moved by the same displacement (more than
 //     moved_m, within joint_motion_m of each other) join; the older
@@ -72,6 +77,15 @@ struct TrackerOptions {
   float joint_motion_m = 0.01f;
   // A gone track may come back (same identity) within this many frames.
   int remember_frames = 30;
+  // Re-identification: an object that matched no track (outside the gate:
+  // picked up and put down elsewhere, pushed fast) takes the identity of a
+  // track that matched nothing when their colours are alike (Bhattacharyya
+  // distance of 4 x 4 x 4 RGB histograms at most reidentify_distance),
+  // their largest extents within a factor reidentify_size, and it lies
+  // within reidentify_m of where the track was last seen. 0 turns it off.
+  float reidentify_distance = 0.3f;
+  float reidentify_size = 1.5f;
+  float reidentify_m = 0.5f;
 };
 
 absl::Status Validate(const TrackerOptions& options);
@@ -124,16 +138,29 @@ class Tracker {
   struct Track {
     int id = 0;
     SegmentedObject object;  // as last seen
+    cv::Mat appearance;      // Appearance() as last seen; empty: no colour
     Eigen::Vector3f world_centroid = Eigen::Vector3f::Zero();
     int frames_seen = 0;
     int last_seen_frame = 0;
     bool composite = false;  // pieces were joined into it
   };
 
+  // Re-identification (TrackerOptions::reidentify_distance): gives the
+  // objects of `found` that `match` left without a track the candidate
+  // tracks it left without an object, whose colour in `color` and size are
+  // alike, one-to-one; `world` and `shift` as the association's.
+  void Reidentify(const cv::Mat& color,
+                  const std::vector<SegmentedObject>& found,
+                  const std::vector<Eigen::Vector3f>& world,
+                  const Eigen::Vector3f& shift,
+                  const std::vector<Track>& tracks,
+                  const std::vector<int>& candidates,
+                  std::vector<int>& match) const;
   // The report of `track` leaving view.
   static TrackedObject Gone(const Track& track);
-  // The fraction of pixels that changed from the reference frame.
-  double ChangedFraction(const RgbdFrame& frame) const;
+  // The fraction of pixels that changed from the reference frame;
+  // `changed` gets them (CV_8UC1, 255 where changed).
+  double ChangedFraction(const RgbdFrame& frame, cv::Mat& changed) const;
   bool CameraStill(const std::optional<Eigen::Isometry3f>& pose) const;
 
   TrackerOptions options_;

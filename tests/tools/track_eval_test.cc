@@ -72,5 +72,25 @@ TEST(MatchFrame, AMaskMatchesTheObjectItCoversAtIouOneHalf) {
   EXPECT_EQ(f.matched[0], std::make_pair(3, 11));
 }
 
+TEST(MatchFrame, AMaskOfAnObjectTooSmallToCountIsIgnored) {
+  synth::SequenceFrame frame;
+  frame.frame.labels = cv::Mat(10, 10, CV_32SC1, cv::Scalar(1));
+  frame.frame.labels(cv::Rect(0, 0, 5, 4)).setTo(20);  // 20 px: counts
+  frame.frame.labels(cv::Rect(8, 8, 2, 2)).setTo(30);  // 4 px: too small
+  frame.object_ids = {0, 1};
+  TrackedObject sliver;  // the small object's 4 pixels and 2 more
+  sliver.track_id = 2;
+  sliver.object.mask = cv::Mat(10, 10, CV_8UC1, cv::Scalar(0));
+  sliver.object.mask(cv::Rect(7, 8, 3, 2)).setTo(255);
+  TrackedObject stray;  // table only: a false track
+  stray.track_id = 3;
+  stray.object.mask = cv::Mat(10, 10, CV_8UC1, cv::Scalar(0));
+  stray.object.mask(cv::Rect(0, 6, 4, 2)).setTo(255);
+  const FrameIdentities f = MatchFrame(frame, {sliver, stray}, 10);
+  EXPECT_EQ(f.truths, 1);
+  EXPECT_EQ(f.tracks, 1);  // the stray; the sliver is neither
+  EXPECT_TRUE(f.matched.empty());
+}
+
 }  // namespace
 }  // namespace fovea::eval

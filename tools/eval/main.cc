@@ -27,7 +27,10 @@
 #ifdef FOVEA_EVAL_REPLAY
 #include "tools/eval/replay.h"
 #endif
+#include "core/pipeline/incremental.h"
+#include "core/synth/replayed_scene.h"
 #include "core/synth/sequence.h"
+#include "core/track/tracker.h"
 #include "tools/eval/detect_eval.h"
 #include "tools/eval/inc_eval.h"
 #include "tools/eval/json_lines.h"
@@ -167,10 +170,20 @@ ABSL_FLAG(int, track_frames, 12, "track: frames per sequence.");
 ABSL_FLAG(std::string, kinds, "",
           absl::StrCat("track: sequence kinds, comma-separated (",
                        fovea::NameList(fovea::synth::SequenceKinds(), ", "),
-                       "); empty: all."));
+                       "; and real OSD scenes replayed: osd-",
+                       fovea::NameList(fovea::synth::ReplayKinds(), ", osd-"),
+                       ", from --data); empty: all (the osd ones when there "
+                       "is data)."));
 ABSL_FLAG(bool, pose, true,
           "track: send each frame's camera pose (false: the tracker "
           "anchors on the scene alone).");
+ABSL_FLAG(double, reidentify_distance,
+          fovea::TrackerOptions().reidentify_distance,
+          "track: the tracker's re-identification threshold (Bhattacharyya "
+          "distance of colour histograms); 0 turns re-identification off.");
+ABSL_FLAG(double, change_weight, fovea::IncrementalOptions().change_weight,
+          "track: the weight of the temporal cue (what changed since the "
+          "last frame) in INC's saliency; 0 turns it off.");
 ABSL_FLAG(std::string, filter, "",
           "sweep: only the rows whose label saliency/pyramid/combine/norm/"
           "extract contains this.");

@@ -2,9 +2,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <map>
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
+#include "absl/strings/str_cat.h"
 #include "core/base/stage_clock.h"
 #include "core/base/status_macros.h"
 #include "core/eval/hungarian.h"
@@ -13,18 +17,28 @@
 namespace fovea::eval {
 namespace {
 
-// The truth objects of a frame with at least `min_pixels`: id -> mask.
+// The truth objects of a frame with at least `min_pixels`: id -> mask;
+// the smaller ones in `small` when given.
 std::map<int, cv::Mat> TruthMasks(const synth::SequenceFrame& frame,
-                                  int min_pixels) {
+                                  int min_pixels,
+                                  std::vector<cv::Mat>* small = nullptr) {
   std::map<int, cv::Mat> masks;
   for (size_t k = 0; k < frame.object_ids.size(); ++k) {
     const int label = 10 * (static_cast<int>(k) + 2);
     cv::Mat mask = frame.frame.labels == label;
-    if (cv::countNonZero(mask) >= min_pixels) {
+    const int pixels = cv::countNonZero(mask);
+    if (pixels >= min_pixels) {
       masks[frame.object_ids[k]] = mask;
+    } else if (small != nullptr && pixels > 0) {
+      small->push_back(mask);
     }
   }
   return masks;
+}
+
+double Iou(const cv::Mat& a, const cv::Mat& b) {
+  const double both = cv::countNonZero(a & b);
+  return both / (cv::countNonZero(a) + cv::countNonZero(b) - both);
 }
 
 double Median(std::vector<double> v) {
@@ -34,7 +48,77 @@ double Median(std::vector<double> v) {
   return *mid;
 }
 
+// colour | depth (0-2 m) | the tracks' masks, each track in its own
+// colour, as <out_dir>/<frame name>.png.
+absl::Status WriteTrackedPng(const synth::SequenceFrame& frame,
+                             const TrackedFrame& tracked,
+                             const std::string& out_dir) {
+  cv::Mat bgr;
+  cv::cvtColor(frame.frame.frame.color, bgr, cv::COLOR_RGB2BGR);
+  cv::Mat depth8;
+  frame.frame.frame.depth.convertTo(depth8, CV_8U, 255.0 / 2.0);
+  cv::Mat depth;
+  cv::cvtColor(depth8, depth, cv::COLOR_GRAY2BGR);
+  cv::Mat masks = bgr.clone();
+  for (const TrackedObject& o : tracked.objects) {
+    if (o.object.mask.empty()) continue;
+    masks.setTo(cv::Scalar((o.track_id * 67) % 255, (o.track_id * 131) % 255,
+                           (o.track_id * 199) % 255),
+                o.object.mask);
+  }
+  cv::Mat row;
+  cv::hconcat(std::vector<cv::Mat>{bgr, depth, masks}, row);
+  const std::string path = out_dir + "/" + frame.frame.name + ".png";
+  if (!cv::imwrite(path, row)) {
+    return absl::InternalError("could not write " + path);
+  }
+  return absl::OkStatus();
+}
+
+// One line per sequence on stderr (IDTP, IDFP, IDFN, switches), and for a
+// sequence with switches the (truth -> track) pairs of every frame.
+void PrintSequence(const std::string& name,
+                   const std::vector<FrameIdentities>& identities) {
+  const IdentityCounts c = CountIdentities(identities);
+  std::fprintf(stderr, "%s: idtp %lld idfp %lld idfn %lld switches %lld\n",
+               name.c_str(), static_cast<long long>(c.idtp),
+               static_cast<long long>(c.idfp), static_cast<long long>(c.idfn),
+               static_cast<long long>(c.switches));
+  if (c.switches == 0) return;
+  for (size_t t = 0; t < identities.size(); ++t) {
+    std::fprintf(stderr, "  frame %zu: %d truths, %d tracks:", t,
+                 identities[t].truths, identities[t].tracks);
+    for (const auto& [truth, track] : identities[t].matched) {
+      std::fprintf(stderr, " %d->%d", truth, track);
+    }
+    std::fprintf(stderr, "\n");
+  }
+}
+
 }  // namespace
+
+std::vector<cv::Mat> ChangedTruths(const synth::SequenceFrame& before,
+                                   const synth::SequenceFrame& now,
+                                   int min_pixels) {
+  const std::map<int, cv::Mat> was = TruthMasks(before, min_pixels);
+  const std::map<int, cv::Mat> is = TruthMasks(now, min_pixels);
+  std::vector<cv::Mat> changed;
+  for (const auto& [id, mask] : is) {
+    const auto it = was.find(id);
+    if (it == was.end() || Iou(it->second, mask) < 0.8) {
+      changed.push_back(mask);
+    }
+  }
+  // All of them: the camera moved; none stands out.
+  if (changed.size() == is.size()) changed.clear();
+  return changed;
+}
+
+bool Covers(const cv::Mat& mask, const std::vector<cv::Mat>& truths) {
+  if (mask.empty()) return false;
+  return std::any_of(truths.begin(), truths.end(),
+                     [&](const cv::Mat& t) { return Iou(t, mask) >= 0.5; });
+}
 
 IdentityCounts CountIdentities(const std::vector<FrameIdentities>& frames) {
   IdentityCounts counts;
@@ -92,20 +176,26 @@ FrameIdentities MatchFrame(const synth::SequenceFrame& frame,
                            const std::vector<TrackedObject>& objects,
                            int min_pixels) {
   FrameIdentities out;
-  const std::map<int, cv::Mat> truths = TruthMasks(frame, min_pixels);
+  std::vector<cv::Mat> small;
+  const std::map<int, cv::Mat> truths = TruthMasks(frame, min_pixels, &small);
   out.truths = static_cast<int>(truths.size());
   for (const TrackedObject& o : objects) {
     if (o.state == TrackState::kGone || o.object.mask.empty()) continue;
-    ++out.tracks;
-    const double area = cv::countNonZero(o.object.mask);
+    bool found = false;
     for (const auto& [id, mask] : truths) {
-      const double both = cv::countNonZero(mask & o.object.mask);
-      const double iou = both / (area + cv::countNonZero(mask) - both);
-      if (iou >= 0.5) {
+      if (Iou(mask, o.object.mask) >= 0.5) {
         out.matched.emplace_back(id, o.track_id);
+        found = true;
         break;
       }
     }
+    // A mask of a truth too small to count is neither found nor false.
+    const bool ignored =
+        !found &&
+        std::any_of(small.begin(), small.end(), [&](const cv::Mat& m) {
+          return Iou(m, o.object.mask) >= 0.5;
+        });
+    if (!ignored) ++out.tracks;
   }
   return out;
 }
@@ -130,23 +220,54 @@ double MeanBestF(const synth::SequenceFrame& frame,
 absl::StatusOr<TrackFigures> EvaluateTracking(synth::SequenceKind kind,
                                               const TrackEvalOptions& options,
                                               const LoadedModels& models) {
+  return EvaluateSequences(
+      std::string(NameOf(synth::SequenceKinds(), kind)), options.count,
+      [&](int s) {
+        return synth::GenerateSequence(
+            kind, options.seed + static_cast<uint64_t>(s), options.frames);
+      },
+      options, models);
+}
+
+absl::StatusOr<TrackFigures> EvaluateReplayedTracking(
+    synth::ReplayKind kind, const std::vector<LabelledFrame>& scenes,
+    const TrackEvalOptions& options, const LoadedModels& models) {
+  if (scenes.empty()) return absl::InvalidArgumentError("no scenes to replay");
+  return EvaluateSequences(
+      absl::StrCat("osd-", AbslView(NameOf(synth::ReplayKinds(), kind))),
+      options.count,
+      [&](int s) {
+        return synth::ReplayAsSequence(
+            scenes[static_cast<size_t>(s) % scenes.size()], kind,
+            options.seed + static_cast<uint64_t>(s), options.frames);
+      },
+      options, models);
+}
+
+absl::StatusOr<TrackFigures> EvaluateSequences(
+    const std::string& kind, int count,
+    const std::function<synth::Sequence(int)>& sequence_at,
+    const TrackEvalOptions& options, const LoadedModels& models) {
   TrackFigures figures;
-  figures.kind = std::string(NameOf(synth::SequenceKinds(), kind));
+  figures.kind = kind;
   std::vector<double> track_ms;
   std::vector<double> fresh_ms;
   double f_sum = 0.0;
   double fresh_f_sum = 0.0;
   int reused = 0;
-  for (int s = 0; s < options.count; ++s) {
-    const synth::Sequence sequence = synth::GenerateSequence(
-        kind, options.seed + static_cast<uint64_t>(s), options.frames);
+  for (int s = 0; s < count; ++s) {
+    const synth::Sequence sequence = sequence_at(s);
     Tracker tracker(options.tracker, models.inc ? &*models.inc : nullptr);
     std::vector<FrameIdentities> identities;
+    const synth::SequenceFrame* previous = nullptr;
     for (const synth::SequenceFrame& frame : sequence.frames) {
       std::optional<Eigen::Isometry3f> pose;
       if (options.with_pose) pose = frame.camera_to_world;
       FOVEA_ASSIGN_OR_RETURN(TrackedFrame tracked,
                              tracker.Process(frame.frame.frame, pose));
+      if (!options.out_dir.empty() && s < options.out_sequences) {
+        FOVEA_RETURN_IF_ERROR(WriteTrackedPng(frame, tracked, options.out_dir));
+      }
       track_ms.push_back(tracked.seconds * 1e3);
       reused += tracked.reused ? 1 : 0;
       figures.joined += tracked.joined;
@@ -170,8 +291,28 @@ absl::StatusOr<TrackFigures> EvaluateTracking(synth::SequenceKind kind,
               .status());
       fresh_ms.push_back(SecondsSince(start) * 1e3);
       fresh_f_sum += MeanBestF(frame, fresh);
+      if (previous != nullptr) {
+        const std::vector<cv::Mat> changed = ChangedTruths(*previous, frame);
+        if (!changed.empty()) {
+          ++figures.change_frames;
+          cv::Mat first;  // the tracker's first object segmented
+          if (!tracked.reused) {
+            for (const TrackedObject& o : tracked.objects) {
+              if (o.state != TrackState::kGone && o.object.index == 0) {
+                first = o.object.mask;
+              }
+            }
+          }
+          figures.changed_first += Covers(first, changed) ? 1 : 0;
+          figures.fresh_changed_first +=
+              Covers(fresh.empty() ? cv::Mat() : fresh.front(), changed) ? 1
+                                                                         : 0;
+        }
+      }
+      previous = &frame;
       ++figures.frames;
     }
+    if (options.verbose) PrintSequence(sequence.name, identities);
     figures.identities += CountIdentities(identities);
     ++figures.sequences;
   }

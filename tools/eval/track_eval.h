@@ -2,12 +2,15 @@
 #define FOVEA_TOOLS_EVAL_TRACK_EVAL_H_
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "core/frame/osd_pcd.h"
 #include "core/pipeline/models.h"
+#include "core/synth/replayed_scene.h"
 #include "core/synth/sequence.h"
 #include "core/track/tracker.h"
 
@@ -41,7 +44,10 @@ double Idf1(const IdentityCounts& counts);
 IdentityCounts& operator+=(IdentityCounts& a, const IdentityCounts& b);
 
 // A frame's identities from its tracked objects against the labels:
-// truth objects with at least `min_pixels` labelled pixels count.
+// truth objects with at least `min_pixels` labelled pixels count. A mask
+// that matches a smaller truth object (a sliver of an occluded one) is
+// ignored, as MOTChallenge ignores detections of ignored objects: it is
+// neither a track found nor a false one.
 FrameIdentities MatchFrame(const synth::SequenceFrame& frame,
                            const std::vector<TrackedObject>& objects,
                            int min_pixels = 200);
@@ -50,6 +56,16 @@ FrameIdentities MatchFrame(const synth::SequenceFrame& frame,
 // overlap F of any mask.
 double MeanBestF(const synth::SequenceFrame& frame,
                  const std::vector<cv::Mat>& masks, int min_pixels = 200);
+
+// The truth masks of `now` (at least `min_pixels`) that appeared or whose
+// mask changed (IoU < 0.8 with `before`'s), when some of them did and
+// others did not (a camera that moved changes them all: none is returned).
+std::vector<cv::Mat> ChangedTruths(const synth::SequenceFrame& before,
+                                   const synth::SequenceFrame& now,
+                                   int min_pixels = 200);
+// Whether `mask` overlaps one of `truths` with IoU >= 0.5 (false when
+// empty).
+bool Covers(const cv::Mat& mask, const std::vector<cv::Mat>& truths);
 
 struct TrackFigures {
   std::string kind;
@@ -62,6 +78,12 @@ struct TrackFigures {
   double reused_fraction = 0.0;  // of the frames
   double median_track_ms = 0.0;
   double median_fresh_ms = 0.0;
+  // Frames where some objects appeared or moved and others did not
+  // (ChangedTruths), and of those, the frames whose first object segmented
+  // was one that changed: the tracker's, and a fresh SegmentIncremental's.
+  int change_frames = 0;
+  int changed_first = 0;
+  int fresh_changed_first = 0;
 };
 
 struct TrackEvalOptions {
@@ -70,13 +92,33 @@ struct TrackEvalOptions {
   uint64_t seed = 1;
   bool with_pose = true;  // send the camera's pose
   TrackerOptions tracker;
+  // When set: the first out_sequences sequences of each kind, frame by
+  // frame, as PNGs (colour | depth | the tracks' masks) in this folder.
+  std::string out_dir;
+  int out_sequences = 3;
+  bool verbose = false;  // one line per sequence on stderr
 };
 
-// Plays `count` sequences of `kind` through a Tracker with the shipped INC
-// model, and each frame through a fresh RunSegmentIncremental too.
+// Plays `count` sequences, the s-th `sequence_at(s)`, through a Tracker
+// with the shipped INC model, and each frame through a fresh
+// RunSegmentIncremental too; the figures are named `kind`.
+absl::StatusOr<TrackFigures> EvaluateSequences(
+    const std::string& kind, int count,
+    const std::function<synth::Sequence(int)>& sequence_at,
+    const TrackEvalOptions& options, const LoadedModels& models);
+
+// EvaluateSequences over options.count synthetic sequences of `kind`.
 absl::StatusOr<TrackFigures> EvaluateTracking(synth::SequenceKind kind,
                                               const TrackEvalOptions& options,
                                               const LoadedModels& models);
+
+// EvaluateSequences over options.count real scenes replayed as `kind`
+// (synth::ReplayAsSequence), named "osd-<kind>": the s-th replays scene
+// s % scenes.size() with seed options.seed + s. INVALID_ARGUMENT when
+// `scenes` is empty.
+absl::StatusOr<TrackFigures> EvaluateReplayedTracking(
+    synth::ReplayKind kind, const std::vector<LabelledFrame>& scenes,
+    const TrackEvalOptions& options, const LoadedModels& models);
 
 }  // namespace fovea::eval
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <opencv2/imgproc.hpp>
 
 #include "core/pipeline/detect.h"
 #include "core/pipeline/incremental.h"
@@ -330,6 +331,71 @@ TEST(RunSegmentIncrementalTest, BudgetsAndGivenPointsAreHonoured) {
           .status()
           .code(),
       absl::StatusCode::kInvalidArgument);
+}
+
+TEST(WithChangeCueTest, WhatChangedOutweighsThePeakAtHalfWeight) {
+  // A 40 x 20 map whose peak (1) is at the left; a 6 x 6 change at the right.
+  cv::Mat saliency(20, 40, CV_32FC1, cv::Scalar(0.1f));
+  saliency(cv::Rect(2, 7, 6, 6)).setTo(1.0f);
+  cv::Mat change(20, 40, CV_8UC1, cv::Scalar(0));
+  change(cv::Rect(30, 7, 6, 6)).setTo(255);
+  cv::Point at;
+  cv::minMaxLoc(WithChangeCue(saliency, change, 0.5f), nullptr, nullptr,
+                nullptr, &at);
+  EXPECT_GE(at.x, 30);  // 0.5 + 0.05 there against 0.5 at the old peak
+  EXPECT_LT(at.x, 36);
+  // Weight 0, or nothing changed: the map as it was (scaled to max 1).
+  EXPECT_EQ(
+      cv::norm(WithChangeCue(saliency, change, 0.0f), saliency, cv::NORM_INF),
+      0.0);
+  EXPECT_EQ(
+      cv::norm(WithChangeCue(saliency, cv::Mat::zeros(20, 40, CV_8UC1), 0.5f),
+               saliency, cv::NORM_INF),
+      0.0);
+  // A change at another resolution is resized to the map's.
+  cv::Mat big;
+  cv::resize(change, big, cv::Size(80, 40), 0, 0, cv::INTER_NEAREST);
+  cv::minMaxLoc(WithChangeCue(saliency, big, 0.5f), nullptr, nullptr, nullptr,
+                &at);
+  EXPECT_GE(at.x, 30);
+}
+
+TEST(RunSegmentIncrementalTest, AttentionGoesFirstToWhatChanged) {
+  const synth::SynthScene scene = testing::TwoBoxesOnTable(0.05f);
+  const cv::Mat red = scene.frame.labels == 20;
+  const cv::Mat blue = scene.frame.labels == 30;
+  IncrementalOptions options;
+  options.max_objects = 1;
+  std::vector<SegmentedObject> objects;
+  SegmentSinks sinks;
+  sinks.object = [&](SegmentedObject o) {
+    objects.push_back(std::move(o));
+    return absl::OkStatus();
+  };
+  ASSERT_TRUE(
+      RunSegmentIncremental(scene.frame.frame, options, &TrainedSvm(), sinks)
+          .ok());
+  ASSERT_EQ(objects.size(), 1u);
+  // The box saliency did not put first is the one that changed.
+  const bool red_first = Iou(objects[0].mask, red) > 0.8;
+  options.change = red_first ? blue : red;
+  objects.clear();
+  ASSERT_TRUE(
+      RunSegmentIncremental(scene.frame.frame, options, &TrainedSvm(), sinks)
+          .ok());
+  ASSERT_EQ(objects.size(), 1u);
+  EXPECT_GT(Iou(objects[0].mask, options.change), 0.8);
+
+  options.change = cv::Mat(10, 10, CV_8UC1, cv::Scalar(255));
+  const absl::Status wrong =
+      RunSegmentIncremental(scene.frame.frame, options, &TrainedSvm(), sinks)
+          .status();
+  EXPECT_EQ(wrong.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(wrong.message().find("change"), std::string::npos);
+  options.change = cv::Mat();
+  options.change_weight = 1.5f;
+  EXPECT_NE(Validate(options).message().find("change_weight"),
+            std::string::npos);
 }
 
 }  // namespace

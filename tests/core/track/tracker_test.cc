@@ -1,6 +1,7 @@
 // The tracker on synthetic sequences with ground-truth identities: a still
 // scene is segmented once and keeps its identities, an object taken away
-// is reported gone once, a drifting camera keeps every identity.
+// is reported gone once, a drifting camera keeps every identity, an object
+// put down elsewhere keeps its own.
 
 #include "core/track/tracker.h"
 
@@ -58,8 +59,9 @@ int TruthOf(const synth::SequenceFrame& frame, const cv::Mat& mask) {
 // object cut in two is not a second identity; a new id on its largest piece
 // is).
 std::map<int, std::set<int>> Play(const Sequence& sequence, bool with_pose,
-                                  std::vector<TrackedFrame>* frames = nullptr) {
-  Tracker tracker(TrackerOptions{}, &*Models()->inc);
+                                  std::vector<TrackedFrame>* frames = nullptr,
+                                  const TrackerOptions& options = {}) {
+  Tracker tracker(options, &*Models()->inc);
   std::map<int, std::set<int>> tracks_of_truth;
   for (const synth::SequenceFrame& f : sequence.frames) {
     std::optional<Eigen::Isometry3f> pose;
@@ -158,6 +160,34 @@ TEST(Tracker, ADriftingCameraKeepsEveryIdentityWithAndWithoutItsPose) {
       EXPECT_FALSE(frames[t].reused);  // the camera moved
     }
   }
+}
+
+TEST(Tracker, AnObjectPutDownElsewhereKeepsItsIdentityByItsColour) {
+  ASSERT_NE(Models(), nullptr);
+  // 9 frames: the object is lifted out of view at frame 3 and put down
+  // 12 cm away, outside the association's gate, at frame 6.
+  const Sequence sequence = GenerateSequence(SequenceKind::kPickAndPlace, 4, 9);
+  std::set<int> lifted;
+  for (int id : sequence.frames[0].object_ids) lifted.insert(id);
+  for (int id : sequence.frames[4].object_ids) lifted.erase(id);
+  ASSERT_EQ(lifted.size(), 1u);
+  const int moving = *lifted.begin();
+  std::vector<TrackedFrame> frames;
+  std::map<int, std::set<int>> tracks = Play(sequence, true, &frames);
+  EXPECT_EQ(tracks[moving].size(), 1u);
+  bool came_back_moved = false;
+  for (const TrackedObject& o : frames[6].objects) {
+    if (o.state != TrackState::kGone &&
+        TruthOf(sequence.frames[6], o.object.mask) == moving) {
+      came_back_moved |= o.state == TrackState::kMoved;
+    }
+  }
+  EXPECT_TRUE(came_back_moved);
+  // Without re-identification it comes back as a new identity.
+  TrackerOptions blind;
+  blind.reidentify_distance = 0.0f;
+  tracks = Play(sequence, true, nullptr, blind);
+  EXPECT_EQ(tracks[moving].size(), 2u);
 }
 
 TEST(Tracker, BadOptionsAreNamed) {
