@@ -176,9 +176,11 @@ class DetectReactor final : public grpc::ServerUnaryReactor {
 // waits while kMaxPendingMessages are unwritten (a client that stops
 // reading holds at most that many messages in memory) and stops when the
 // client cancels or a write fails. A client that takes no message for
-// config.stream_stall_timeout while the worker waits on it (for room, or
-// for its last messages to go) has its stream cancelled: a slow reader
-// holds a worker for at most that long. Finishes exactly once, after every
+// config.stream_stall_timeout while the worker waits for room has its
+// stream cancelled: a slow reader holds a worker for at most that long.
+// The last messages (at most kMaxPendingMessages) do not hold the worker:
+// they wait for the client under a stall watch (config.stalls), which
+// cancels the stream after the same timeout. Finishes exactly once, after every
 // queued message was written; deletes itself in OnDone, which gRPC calls
 // only after Finish, and Finish only comes after the worker's last touch.
 template <typename Request, typename Options>
@@ -235,6 +237,7 @@ class StreamReactor final
         pending_bytes_ = 0;
       } else {
         RecordMessageSent(method_);
+        if (stall_watch_) stall_watch_->Touch();  // the client took one
       }
       if (!pending_.empty()) {
         StartNextWriteLocked();
@@ -294,9 +297,47 @@ class StreamReactor final
   void Run() {
     FinishOnce(Guarded(method_, [this] {
       absl::Status status = Compute();
-      if (status.ok()) WaitForTheLastWrites();
+      if (status.ok()) LeaveTheLastWrites();
       return status;
     }));
+  }
+
+  // After the job's last Send: the messages still unwritten are left to
+  // the reactor and the worker goes back to the queue, a stall watch
+  // (config.stalls) cancelling the stream should the client take nothing
+  // for the stall timeout. Without config.stalls, the worker waits for them
+  // itself. Runs before FinishOnce, so the call cannot end meanwhile.
+  void LeaveTheLastWrites() {
+    if (config_.stalls == nullptr) {
+      WaitForTheLastWrites();
+      return;
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (broken_ || (!writing_ && pending_.empty())) return;
+    }
+    absl::StatusOr<std::shared_ptr<StreamRegistry::Handle>> watch =
+        config_.stalls->Open(context_->peer(), [this] { OnStalled(); });
+    if (!watch.ok()) {
+      WaitForTheLastWrites();
+      return;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    stall_watch_ = *std::move(watch);
+  }
+
+  // The stall watch fired (on its own thread, before EndCall closed it):
+  // the client took nothing for the stall timeout.
+  void OnStalled() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (broken_ || (!writing_ && pending_.empty())) return;
+      broken_ = true;
+      stalled_ = true;
+    }
+    changed_.notify_all();
+    // Ends the write in flight (OnWriteDone(false)), which finishes.
+    context_->TryCancel();
   }
 
   absl::Status Compute() {
@@ -394,6 +435,13 @@ class StreamReactor final
   // Records the call's end and finishes it: the reactor's last touch, as
   // OnDone may delete it right after.
   void EndCall(const absl::Status& status) {
+    std::shared_ptr<StreamRegistry::Handle> watch;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      watch = std::move(stall_watch_);
+    }
+    // Waits for OnStalled in progress; none comes after.
+    if (watch) config_.stalls->Close(watch);
     end_code_ = status.code();
     const grpc::Status end = call_.EndStream(status);
     TsanHappensBefore(this);
@@ -447,6 +495,9 @@ class StreamReactor final
   Clock::time_point write_started_;  // guarded by mutex_
   bool finished_ = false;            // guarded by mutex_
   std::optional<absl::Status> final_status_;  // guarded by mutex_
+  // Open while the last messages wait for the client (LeaveTheLastWrites);
+  // guarded by mutex_.
+  std::shared_ptr<StreamRegistry::Handle> stall_watch_;
   const std::shared_ptr<JobGate> gate_ = std::make_shared<JobGate>();
 };
 

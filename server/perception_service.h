@@ -60,6 +60,11 @@ struct ServiceConfig {
   // The open Track streams and their limits (not owned: it outlives the
   // service), or null: then Track is UNIMPLEMENTED.
   StreamRegistry* streams = nullptr;
+  // Segment and SegmentIncremental streams whose work is done and whose
+  // last messages wait for the client to take them (its idle timeout is
+  // stream_stall_timeout: a stream whose client takes nothing for that
+  // long is cancelled), not owned; null: the worker waits for them itself.
+  StreamRegistry* stalls = nullptr;
 };
 
 // fovea.v1.Perception on gRPC's callback API. Handlers are thin: they

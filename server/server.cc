@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <thread>
@@ -311,6 +312,14 @@ absl::StatusOr<std::unique_ptr<FoveaServer>> FoveaServer::Start(
       std::lround(config.track_idle_timeout_s * 1000.0));
   server->streams_ = std::make_unique<StreamRegistry>(stream_limits);
   service.streams = server->streams_.get();
+  // Not limits: a stall watch is only ever opened for a call admitted.
+  StreamLimits stall_limits;
+  stall_limits.max_streams = std::numeric_limits<int>::max();
+  stall_limits.max_streams_per_peer = std::numeric_limits<int>::max();
+  stall_limits.idle_timeout = service.stream_stall_timeout;
+  stall_limits.shed_reason = "stalled_stream";
+  server->stalls_ = std::make_unique<StreamRegistry>(stall_limits);
+  service.stalls = server->stalls_.get();
   server->service_ = std::make_unique<PerceptionService>(std::move(service),
                                                          server->work_.get());
 

@@ -195,6 +195,8 @@ class FoveaServer {
   // Before service_: the calls hand themselves to it until the last ends.
   std::unique_ptr<FlightRecorder> recorder_;
   std::unique_ptr<StreamRegistry> streams_;  // the Track streams
+  // Segment streams whose last messages wait for their client.
+  std::unique_ptr<StreamRegistry> stalls_;
   std::shared_ptr<ServiceState> service_state_;
   double drain_delay_s_ = 0.0;
   std::unique_ptr<PerceptionService> service_;

@@ -100,7 +100,7 @@ void StreamRegistry::Reap() {
       std::lock_guard<std::recursive_mutex> hold(handle->mutex_);
       if (handle->cancel_ && !handle->cancelled_) {
         handle->cancelled_ = true;
-        RecordShed("idle_stream");
+        RecordShed(limits_.shed_reason);
         handle->cancel_();
       }
     }

@@ -24,6 +24,8 @@ struct StreamLimits {
   int max_streams_per_peer = 8;  // open at once from one peer address
   // A stream whose client sent nothing for this long is cancelled.
   std::chrono::milliseconds idle_timeout{10000};
+  // fovea_calls_shed_total's reason for a stream cancelled so.
+  std::string_view shed_reason = "idle_stream";
 };
 
 // The open streams: admits a new one against the limits, and cancels those

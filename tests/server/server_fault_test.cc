@@ -457,6 +457,52 @@ TEST_F(FaultTest, StreamWhoseClientLeavesBeforeTheLastMessageIsNotRecordedOk) {
   EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::CANCELLED);
 }
 
+// A finished job's last messages wait for the client without its worker:
+// with one worker, a Detect is answered while a stream whose client reads
+// nothing still holds its last messages (it waited for the stall timeout
+// before), and the stall watch then cancels that stream.
+TEST_F(FaultTest, LastMessagesWaitingForTheClientHoldNoWorker) {
+  ServerConfig config = DefaultConfig();
+  config.warm_up = false;
+  config.concurrency = 1;
+  config.stream_stall_timeout_s = 6.0;
+  StartServer(config);
+  // 3 messages of 256 KiB: each over the client's 64 KiB window, all
+  // within the reactor's 2 MiB of unwritten messages (the job is done).
+  Requests requests = SmallRequests();
+  requests.segment.set_request_id(std::string(256 << 10, 'x'));
+  requests.segment.set_max_objects(1);
+  const std::unique_ptr<v1::Perception::Stub> stub =
+      SmallWindowStub(server_->port());
+  const std::string before = Scrape();
+  const auto stops = [](const std::string& text) {
+    return MetricValue(text, "fovea_segment_stops_total",
+                       {"grpc_method=\"Segment\"", "reason=\"max_objects\""})
+        .value_or(0);
+  };
+  const auto stalled = [](const std::string& text) {
+    return MetricValue(text, "fovea_calls_shed_total",
+                       {"reason=\"stalled_stream\""})
+        .value_or(0);
+  };
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + kCallTimeout);
+  auto reader = stub->Segment(&context, requests.segment);
+  ASSERT_TRUE(WaitFor([&] { return stops(Scrape()) == stops(before) + 1; },
+                      kCallTimeout));
+  EXPECT_EQ(MetricValue(Scrape(), "fovea_inflight_requests", {}), 1);
+  // Half the stall timeout: the only worker must be free to serve it.
+  const CallResult detect = Call(Method::kDetect, std::chrono::seconds(3));
+  EXPECT_TRUE(detect.status.ok()) << detect.status.error_message();
+  ASSERT_TRUE(WaitForHandled(Method::kSegment, "Canceled",
+                             Handled(before, "Segment", "Canceled") + 1));
+  EXPECT_EQ(stalled(Scrape()), stalled(before) + 1);
+  v1::SegmentResponse message;
+  while (reader->Read(&message)) {
+  }
+  EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::CANCELLED);
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Streams, StalledReaderTest,
     ::testing::Combine(::testing::Values(Method::kSegment,
