@@ -105,9 +105,15 @@ std::vector<cv::Mat> ChangedTruths(const synth::SequenceFrame& before,
   std::vector<cv::Mat> changed;
   for (const auto& [id, mask] : is) {
     const auto it = was.find(id);
-    if (it == was.end() || Iou(it->second, mask) < 0.8) {
-      changed.push_back(mask);
+    bool moved = it == was.end();
+    if (!moved) {
+      const cv::Moments a = cv::moments(it->second, true);
+      const cv::Moments b = cv::moments(mask, true);
+      const cv::Point2d shift(b.m10 / b.m00 - a.m10 / a.m00,
+                              b.m01 / b.m00 - a.m01 / a.m00);
+      moved = cv::norm(shift) > 3.0;
     }
+    if (moved) changed.push_back(mask);
   }
   // All of them: the camera moved; none stands out.
   if (changed.size() == is.size()) changed.clear();
@@ -254,6 +260,7 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
   std::vector<double> fresh_ms;
   double f_sum = 0.0;
   double fresh_f_sum = 0.0;
+  std::map<std::string, double> stage_seconds;  // the fresh calls
   int reused = 0;
   for (int s = 0; s < count; ++s) {
     const synth::Sequence sequence = sequence_at(s);
@@ -285,11 +292,14 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
         return absl::OkStatus();
       };
       const SteadyClock::time_point start = SteadyClock::now();
-      FOVEA_RETURN_IF_ERROR(
+      FOVEA_ASSIGN_OR_RETURN(
+          SegmentSummary summary,
           RunSegmentIncremental(frame.frame.frame, options.tracker.segment,
-                                models.inc ? &*models.inc : nullptr, sinks)
-              .status());
+                                models.inc ? &*models.inc : nullptr, sinks));
       fresh_ms.push_back(SecondsSince(start) * 1e3);
+      for (const StageTiming& t : summary.timings) {
+        stage_seconds[t.stage] += t.seconds;
+      }
       fresh_f_sum += MeanBestF(frame, fresh);
       if (previous != nullptr) {
         const std::vector<cv::Mat> changed = ChangedTruths(*previous, frame);
@@ -320,6 +330,15 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
     figures.overlap_f = f_sum / figures.frames;
     figures.single_frame_f = fresh_f_sum / figures.frames;
     figures.reused_fraction = static_cast<double>(reused) / figures.frames;
+  }
+  if (options.verbose && figures.frames > 0) {
+    std::fprintf(stderr,
+                 "%s: a fresh call's mean ms per stage:", figures.kind.c_str());
+    for (const auto& [stage, seconds] : stage_seconds) {
+      std::fprintf(stderr, " %s %.1f", stage.c_str(),
+                   1e3 * seconds / figures.frames);
+    }
+    std::fprintf(stderr, "\n");
   }
   figures.median_track_ms = Median(track_ms);
   figures.median_fresh_ms = Median(fresh_ms);

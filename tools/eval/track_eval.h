@@ -57,9 +57,10 @@ FrameIdentities MatchFrame(const synth::SequenceFrame& frame,
 double MeanBestF(const synth::SequenceFrame& frame,
                  const std::vector<cv::Mat>& masks, int min_pixels = 200);
 
-// The truth masks of `now` (at least `min_pixels`) that appeared or whose
-// mask changed (IoU < 0.8 with `before`'s), when some of them did and
-// others did not (a camera that moved changes them all: none is returned).
+// The truth masks of `now` (at least `min_pixels`) that appeared or moved
+// (their centroid by more than 3 pixels: sensor noise and dropouts move it
+// less; a 1 cm push at 1 m moves it 5), when some of them did and others
+// did not (a camera that moved moves them all: none is returned).
 std::vector<cv::Mat> ChangedTruths(const synth::SequenceFrame& before,
                                    const synth::SequenceFrame& now,
                                    int min_pixels = 200);
