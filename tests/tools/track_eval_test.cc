@@ -92,5 +92,32 @@ TEST(MatchFrame, AMaskOfAnObjectTooSmallToCountIsIgnored) {
   EXPECT_TRUE(f.matched.empty());
 }
 
+TEST(ChangedTruths, WhatMovedOrAppearedAndNotWhatLostPixels) {
+  synth::SequenceFrame before;
+  before.frame.labels = cv::Mat(40, 60, CV_32SC1, cv::Scalar(1));
+  before.frame.labels(cv::Rect(2, 2, 16, 16)).setTo(20);   // id 7
+  before.frame.labels(cv::Rect(30, 2, 16, 16)).setTo(30);  // id 8
+  before.object_ids = {7, 8};
+  synth::SequenceFrame now = before;
+  now.frame.labels = before.frame.labels.clone();
+  // id 7 loses a few scattered pixels (dropouts); id 8 moves 6 pixels down.
+  for (int i = 0; i < 16; i += 3) now.frame.labels.at<int>(2 + i, 2 + i) = 0;
+  now.frame.labels(cv::Rect(30, 2, 16, 16)).setTo(1);
+  now.frame.labels(cv::Rect(30, 8, 16, 16)).setTo(30);
+  std::vector<cv::Mat> changed = ChangedTruths(before, now, 100);
+  ASSERT_EQ(changed.size(), 1u);
+  EXPECT_EQ(cv::countNonZero(changed[0] != (now.frame.labels == 30)), 0);
+  // A third object appears: changed too.
+  now.frame.labels(cv::Rect(2, 22, 16, 16)).setTo(40);
+  now.object_ids = {7, 8, 9};
+  EXPECT_EQ(ChangedTruths(before, now, 100).size(), 2u);
+  // All of them moved (the camera did): none stands out.
+  synth::SequenceFrame shifted = before;
+  shifted.frame.labels = cv::Mat(40, 60, CV_32SC1, cv::Scalar(1));
+  shifted.frame.labels(cv::Rect(2, 12, 16, 16)).setTo(20);
+  shifted.frame.labels(cv::Rect(30, 12, 16, 16)).setTo(30);
+  EXPECT_TRUE(ChangedTruths(before, shifted, 100).empty());
+}
+
 }  // namespace
 }  // namespace fovea::eval
