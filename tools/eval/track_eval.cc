@@ -279,6 +279,9 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
       reused += tracked.reused ? 1 : 0;
       figures.joined += tracked.joined;
       identities.push_back(MatchFrame(frame, tracked.objects));
+      figures.detections_matched +=
+          static_cast<int64_t>(identities.back().matched.size());
+      figures.detections += identities.back().truths + identities.back().tracks;
       std::vector<cv::Mat> masks;
       for (const TrackedObject& o : tracked.objects) {
         if (o.state != TrackState::kGone) masks.push_back(o.object.mask);

@@ -76,6 +76,11 @@ struct TrackFigures {
   double overlap_f = 0.0;       // tracker, mean over frames
   double single_frame_f = 0.0;  // a fresh SegmentIncremental, same frames
   int64_t joined = 0;
+  // Frame by frame, the masks matched to a truth (IoU >= 0.5) and the truths
+  // plus masks: 2 matched / detections is the detection F1, what IDF1
+  // would be were every identity kept (IDF1's bound given the masks).
+  int64_t detections_matched = 0;
+  int64_t detections = 0;
   double reused_fraction = 0.0;  // of the frames
   double median_track_ms = 0.0;
   double median_fresh_ms = 0.0;
@@ -86,6 +91,11 @@ struct TrackFigures {
   int changed_first = 0;
   int fresh_changed_first = 0;
 };
+
+// 2 detections_matched / detections; 1 when there is nothing to count.
+inline double DetectionF1(const TrackFigures& f) {
+  return f.detections == 0 ? 1.0 : 2.0 * f.detections_matched / f.detections;
+}
 
 struct TrackEvalOptions {
   int count = 20;   // sequences per kind
