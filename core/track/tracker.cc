@@ -349,7 +349,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
     };
     // What changed is where attention goes first.
     IncrementalOptions segment = options_.segment;
-    if (still) segment.change = changed;
+    if (still && segment.change_weight > 0.0f) segment.change = changed;
     FOVEA_RETURN_IF_ERROR(
         RunSegmentIncremental(frame, segment, relation_svm_, sinks, interrupt)
             .status());

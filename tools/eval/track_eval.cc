@@ -261,6 +261,7 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
   double f_sum = 0.0;
   double fresh_f_sum = 0.0;
   std::map<std::string, double> stage_seconds;  // the fresh calls
+  std::map<std::string, double> track_stage_seconds;
   int reused = 0;
   for (int s = 0; s < count; ++s) {
     const synth::Sequence sequence = sequence_at(s);
@@ -276,6 +277,9 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
         FOVEA_RETURN_IF_ERROR(WriteTrackedPng(frame, tracked, options.out_dir));
       }
       track_ms.push_back(tracked.seconds * 1e3);
+      for (const StageTiming& t : tracked.timings) {
+        track_stage_seconds[t.stage] += t.seconds;
+      }
       reused += tracked.reused ? 1 : 0;
       figures.joined += tracked.joined;
       identities.push_back(MatchFrame(frame, tracked.objects));
@@ -338,6 +342,12 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
     std::fprintf(stderr,
                  "%s: a fresh call's mean ms per stage:", figures.kind.c_str());
     for (const auto& [stage, seconds] : stage_seconds) {
+      std::fprintf(stderr, " %s %.1f", stage.c_str(),
+                   1e3 * seconds / figures.frames);
+    }
+    std::fprintf(
+        stderr, "\n%s: the tracker's mean ms per stage:", figures.kind.c_str());
+    for (const auto& [stage, seconds] : track_stage_seconds) {
       std::fprintf(stderr, " %s %.1f", stage.c_str(),
                    1e3 * seconds / figures.frames);
     }
