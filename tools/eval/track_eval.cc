@@ -308,7 +308,9 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
         stage_seconds[t.stage] += t.seconds;
       }
       fresh_f_sum += MeanBestF(frame, fresh);
-      if (previous != nullptr) {
+      // Counted with a still camera only: the cue is given only then.
+      if (previous != nullptr &&
+          previous->camera_to_world.isApprox(frame.camera_to_world)) {
         const std::vector<cv::Mat> changed = ChangedTruths(*previous, frame);
         if (!changed.empty()) {
           ++figures.change_frames;

@@ -84,9 +84,10 @@ struct TrackFigures {
   double reused_fraction = 0.0;  // of the frames
   double median_track_ms = 0.0;
   double median_fresh_ms = 0.0;
-  // Frames where some objects appeared or moved and others did not
-  // (ChangedTruths), and of those, the frames whose first object segmented
-  // was one that changed: the tracker's, and a fresh SegmentIncremental's.
+  // Frames of a still camera (the same pose as the frame before) where
+  // some objects appeared or moved and others did not (ChangedTruths), and
+  // of those, the frames whose first object segmented was one that
+  // changed: the tracker's, and a fresh SegmentIncremental's.
   int change_frames = 0;
   int changed_first = 0;
   int fresh_changed_first = 0;
