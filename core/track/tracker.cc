@@ -11,6 +11,7 @@
 #include "core/base/status_macros.h"
 #include "core/eval/hungarian.h"
 #include "core/frame/sensor_model.h"
+#include "core/track/object_ops.h"
 
 namespace fovea {
 namespace {
@@ -22,85 +23,6 @@ Eigen::Vector3f ToWorld(const std::optional<Eigen::Isometry3f>& pose,
 
 float LargestExtent(const SegmentedObject& object) {
   return object.extent.maxCoeff();
-}
-
-// The median of each coordinate of `v` (zero when empty).
-Eigen::Vector3f CoordinateMedian(std::vector<Eigen::Vector3f> v) {
-  Eigen::Vector3f m = Eigen::Vector3f::Zero();
-  if (v.empty()) return m;
-  for (int axis = 0; axis < 3; ++axis) {
-    auto mid = v.begin() + static_cast<ptrdiff_t>(v.size() / 2);
-    std::nth_element(
-        v.begin(), mid, v.end(),
-        [axis](const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
-          return a[axis] < b[axis];
-        });
-    m[axis] = (*mid)[axis];
-  }
-  return m;
-}
-
-// Whether masks `a` and `b` (CV_8UC1, same size) touch: `a` grown by
-// `radius` pixels overlaps `b`.
-bool Touch(const cv::Mat& a, const cv::Rect& a_box, const cv::Mat& b,
-           const cv::Rect& b_box, int radius) {
-  const cv::Rect grown =
-      cv::Rect(a_box.x - radius, a_box.y - radius, a_box.width + 2 * radius,
-               a_box.height + 2 * radius) &
-      cv::Rect(0, 0, a.cols, a.rows);
-  const cv::Rect both = grown & b_box;
-  if (both.empty()) return false;
-  cv::Mat dilated;
-  cv::dilate(a(grown), dilated,
-             cv::getStructuringElement(
-                 cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1)));
-  const cv::Rect local(both.x - grown.x, both.y - grown.y, both.width,
-                       both.height);
-  cv::Mat overlap;
-  cv::bitwise_and(dilated(local), b(both), overlap);
-  return cv::countNonZero(overlap) > 0;
-}
-
-// Adds `piece` to `into`: the union of the masks, the box and area of the
-// union, the area-weighted centroid, the larger extent.
-void Join(const SegmentedObject& piece, SegmentedObject& into) {
-  const double total = static_cast<double>(into.area) + piece.area;
-  if (total > 0) {
-    into.centroid = ((into.centroid * static_cast<float>(into.area)) +
-                     (piece.centroid * static_cast<float>(piece.area))) /
-                    static_cast<float>(total);
-  }
-  into.extent = into.extent.cwiseMax(piece.extent);
-  cv::bitwise_or(into.mask, piece.mask, into.mask);
-  into.box = into.box | piece.box;
-  into.area = cv::countNonZero(into.mask);
-  into.geometry.reset();  // the pieces' boxes are not the whole's
-  into.point_indices.insert(into.point_indices.end(),
-                            piece.point_indices.begin(),
-                            piece.point_indices.end());
-  into.points.insert(into.points.end(), piece.points.begin(),
-                     piece.points.end());
-}
-
-// The colour of `object` in `color` (RGB, CV_8UC3, the mask's size): a
-// 4 x 4 x 4 histogram of its mask's pixels; empty without colour.
-cv::Mat Appearance(const cv::Mat& color, const SegmentedObject& object) {
-  if (color.empty() || color.type() != CV_8UC3 || object.mask.empty() ||
-      color.size() != object.mask.size()) {
-    return {};
-  }
-  const cv::Rect box = object.box & cv::Rect(0, 0, color.cols, color.rows);
-  if (box.empty()) return {};
-  const cv::Mat image = color(box);
-  const cv::Mat mask = object.mask(box);
-  const int channels[] = {0, 1, 2};
-  const int bins[] = {4, 4, 4};
-  const float range[] = {0.0f, 256.0f};
-  const float* ranges[] = {range, range, range};
-  cv::Mat histogram;
-  cv::calcHist(&image, 1, channels, mask, histogram, 3, bins, ranges);
-  if (cv::sum(histogram)[0] <= 0.0) return {};
-  return histogram;
 }
 
 int StateOrder(TrackState state) {
@@ -286,6 +208,67 @@ void Tracker::Reidentify(const cv::Mat& color,
   }
 }
 
+absl::StatusOr<bool> Tracker::Segment(
+    const RgbdFrame& frame, IncrementalOptions segment,
+    const std::optional<Eigen::Isometry3f>& pose, double changed_fraction,
+    std::vector<SegmentedObject>& found, const InterruptCheck& interrupt) {
+  std::optional<SupportPlane> support;
+  SegmentSinks sinks;
+  sinks.support = [&support](const SupportPlane& plane) {
+    support = plane;
+    return absl::OkStatus();
+  };
+  sinks.object = [&found](SegmentedObject object) {
+    found.push_back(std::move(object));
+    return absl::OkStatus();
+  };
+  std::optional<Eigen::Vector4f>& hint = segment.detect.scene.support.plane;
+  const bool asked = hint.has_value();
+  bool kept = false;
+  if (!asked && options_.reuse_support && support_ &&
+      (pose || changed_fraction <= options_.reuse_support_changed)) {
+    // The world's plane in this camera: n_c = R^T n_w, d_c = d_w + n_w . t.
+    hint = *support_;
+    if (pose) {
+      hint->head<3>() = pose->linear().transpose() * support_->head<3>();
+      (*hint)[3] =
+          (*support_)[3] + support_->head<3>().dot(pose->translation());
+    }
+    kept = true;
+  }
+  absl::Status status =
+      RunSegmentIncremental(frame, segment, relation_svm_, sinks, interrupt)
+          .status();
+  const bool fits =
+      status.ok() && support.has_value() &&
+      support->inlier_count >= options_.support_fit * support_inliers_;
+  if (kept && (status.ok() ? !fits : absl::IsNotFound(status))) {
+    // It no longer fits (or has nothing on it): search afresh.
+    found.clear();
+    support.reset();
+    hint.reset();
+    kept = false;
+    status =
+        RunSegmentIncremental(frame, segment, relation_svm_, sinks, interrupt)
+            .status();
+  }
+  FOVEA_RETURN_IF_ERROR(status);
+  if (!support.has_value()) {
+    support_.reset();
+    return kept;
+  }
+  if (!kept) support_inliers_ = support->inlier_count;
+  // Kept in the world: n_w = R n_c, d_w = d_c - n_w . t.
+  Eigen::Vector4f plane(support->normal.x(), support->normal.y(),
+                        support->normal.z(), support->d);
+  if (pose) {
+    plane.head<3>() = pose->linear() * support->normal;
+    plane[3] = support->d - plane.head<3>().dot(pose->translation());
+  }
+  support_ = plane;
+  return kept;
+}
+
 TrackedObject Tracker::Gone(const Track& track) {
   TrackedObject gone;
   gone.track_id = track.id;
@@ -318,6 +301,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
       out.objects.push_back(Gone(t));
     }
     tracks.clear();
+    support_.reset();
   }
   // A camera known to have moved sees every pixel change: not looked at.
   const bool still = same_size && CameraStill(camera_to_world);
@@ -342,17 +326,12 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
     }
   } else {
     std::vector<SegmentedObject> found;
-    SegmentSinks sinks;
-    sinks.object = [&found](SegmentedObject object) {
-      found.push_back(std::move(object));
-      return absl::OkStatus();
-    };
     // What changed is where attention goes first.
     IncrementalOptions segment = options_.segment;
     if (still && segment.change_weight > 0.0f) segment.change = changed;
-    FOVEA_RETURN_IF_ERROR(
-        RunSegmentIncremental(frame, segment, relation_svm_, sinks, interrupt)
-            .status());
+    FOVEA_ASSIGN_OR_RETURN(out.support_kept,
+                           Segment(frame, std::move(segment), camera_to_world,
+                                   out.changed_fraction, found, interrupt));
     clock.Lap("segment");
 
     // Candidates: tracks seen within remember_frames.

@@ -30,6 +30,7 @@ namespace fovea {
 //     (the support and the objects anchor a camera that moves a little
 //     between frames), by the one-to-one assignment of least distance
 //     within a gate.
+//   - The support is kept while it fits (TrackerOptions::reuse_support).
 //   - What changed comes first: with a still camera, the pixels that
 //     changed are INC's temporal cue (IncrementalOptions::change), so that
 //     its attention goes to them first; objects that appeared or moved are
@@ -75,6 +76,16 @@ struct TrackerOptions {
   float match_extent_fraction = 0.5f;
   float moved_m = 0.02f;
   float joint_motion_m = 0.01f;
+  // The support while it fits: the plane of the last frame segmented is
+  // given to the next (SupportHints::plane: no search), moved by the
+  // camera's pose when given, else only when at most reuse_support_changed
+  // of the pixels changed (the camera did not move). When it then holds
+  // fewer than support_fit of the inliers it had when last searched for,
+  // the frame is segmented again with a search. Not when the options give a
+  // plane.
+  bool reuse_support = true;
+  double reuse_support_changed = 0.1;
+  double support_fit = 0.8;
   // A gone track may come back (same identity) within this many frames.
   int remember_frames = 30;
   // Re-identification: an object that matched no track (outside the gate:
@@ -110,7 +121,9 @@ struct TrackedFrame {
   // See TrackerOptions::static_fraction; 1 when the pose says the camera
   // moved (the pixels are then not compared).
   double changed_fraction = 0.0;
-  int joined = 0;                    // tracks joined into others in this frame
+  int joined = 0;  // tracks joined into others in this frame
+  // Segmented on the last frame's support plane (no search).
+  bool support_kept = false;
   std::vector<StageTiming> timings;  // "change", INC's stages, "associate"
   double seconds = 0.0;
 };
@@ -162,6 +175,15 @@ class Tracker {
   // `changed` gets them (CV_8UC1, 255 where changed).
   double ChangedFraction(const RgbdFrame& frame, cv::Mat& changed) const;
   bool CameraStill(const std::optional<Eigen::Isometry3f>& pose) const;
+  // Segments `frame` with INC (`segment` its options) on the last support
+  // when TrackerOptions::reuse_support allows; the objects go to `found`,
+  // the support to support_. Whether the support was kept.
+  absl::StatusOr<bool> Segment(const RgbdFrame& frame,
+                               IncrementalOptions segment,
+                               const std::optional<Eigen::Isometry3f>& pose,
+                               double changed_fraction,
+                               std::vector<SegmentedObject>& found,
+                               const InterruptCheck& interrupt);
 
   TrackerOptions options_;
   absl::Status valid_;  // Validate(options_), once
@@ -171,6 +193,10 @@ class Tracker {
   RgbdFrame reference_;
   std::optional<Eigen::Isometry3f> reference_pose_;
   std::vector<Track> tracks_;  // in view at the last frame, or remembered
+  // The support plane of the last frame segmented, in the world (camera
+  // frame without a pose), and its inliers when it was last searched for.
+  std::optional<Eigen::Vector4f> support_;
+  int support_inliers_ = 0;
   int next_id_ = 1;
   int frame_index_ = 0;
   int segmentations_ = 0;

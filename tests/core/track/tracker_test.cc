@@ -190,6 +190,37 @@ TEST(Tracker, AnObjectPutDownElsewhereKeepsItsIdentityByItsColour) {
   EXPECT_EQ(tracks[moving].size(), 2u);
 }
 
+TEST(Tracker, TheSupportIsKeptWhileItFits) {
+  ASSERT_NE(Models(), nullptr);
+  const Sequence sequence = GenerateSequence(SequenceKind::kDrift, 7, 4);
+  // With the pose: the plane found in frame 0 is moved into each camera.
+  std::vector<TrackedFrame> frames;
+  Play(sequence, true, &frames);
+  ASSERT_EQ(frames.size(), 4u);
+  EXPECT_FALSE(frames[0].support_kept);
+  for (size_t t = 1; t < frames.size(); ++t) {
+    EXPECT_TRUE(frames[t].support_kept) << "frame " << t;
+    EXPECT_FALSE(frames[t].objects.empty());
+  }
+  // Without it, a camera that moved changes most pixels: searched afresh.
+  frames.clear();
+  Play(sequence, false, &frames);
+  for (const TrackedFrame& f : frames) EXPECT_FALSE(f.support_kept);
+  // A pose that jumps at frame 2 (the camera said 30 cm higher than it
+  // is): the plane it gives holds nothing there, so frame 2 is segmented
+  // with a search; frame 3's true pose then disagrees with the plane frame
+  // 2 left, and it is searched for again.
+  Sequence jumping = sequence;
+  jumping.frames[2].camera_to_world.pretranslate(Eigen::Vector3f(0, 0, 0.3f));
+  frames.clear();
+  Play(jumping, true, &frames);
+  ASSERT_EQ(frames.size(), 4u);
+  EXPECT_TRUE(frames[1].support_kept);
+  EXPECT_FALSE(frames[2].support_kept);
+  EXPECT_FALSE(frames[3].support_kept);
+  for (const TrackedFrame& f : frames) EXPECT_FALSE(f.objects.empty());
+}
+
 TEST(Tracker, BadOptionsAreNamed) {
   TrackerOptions options;
   options.static_fraction = 1.5;

@@ -1,0 +1,80 @@
+#include "core/track/object_ops.h"
+
+#include <algorithm>
+#include <opencv2/imgproc.hpp>
+
+namespace fovea {
+
+Eigen::Vector3f CoordinateMedian(std::vector<Eigen::Vector3f> v) {
+  Eigen::Vector3f m = Eigen::Vector3f::Zero();
+  if (v.empty()) return m;
+  for (int axis = 0; axis < 3; ++axis) {
+    auto mid = v.begin() + static_cast<ptrdiff_t>(v.size() / 2);
+    std::nth_element(
+        v.begin(), mid, v.end(),
+        [axis](const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
+          return a[axis] < b[axis];
+        });
+    m[axis] = (*mid)[axis];
+  }
+  return m;
+}
+
+bool Touch(const cv::Mat& a, const cv::Rect& a_box, const cv::Mat& b,
+           const cv::Rect& b_box, int radius) {
+  const cv::Rect grown =
+      cv::Rect(a_box.x - radius, a_box.y - radius, a_box.width + 2 * radius,
+               a_box.height + 2 * radius) &
+      cv::Rect(0, 0, a.cols, a.rows);
+  const cv::Rect both = grown & b_box;
+  if (both.empty()) return false;
+  cv::Mat dilated;
+  cv::dilate(a(grown), dilated,
+             cv::getStructuringElement(
+                 cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1)));
+  const cv::Rect local(both.x - grown.x, both.y - grown.y, both.width,
+                       both.height);
+  cv::Mat overlap;
+  cv::bitwise_and(dilated(local), b(both), overlap);
+  return cv::countNonZero(overlap) > 0;
+}
+
+void Join(const SegmentedObject& piece, SegmentedObject& into) {
+  const double total = static_cast<double>(into.area) + piece.area;
+  if (total > 0) {
+    into.centroid = ((into.centroid * static_cast<float>(into.area)) +
+                     (piece.centroid * static_cast<float>(piece.area))) /
+                    static_cast<float>(total);
+  }
+  into.extent = into.extent.cwiseMax(piece.extent);
+  cv::bitwise_or(into.mask, piece.mask, into.mask);
+  into.box = into.box | piece.box;
+  into.area = cv::countNonZero(into.mask);
+  into.geometry.reset();  // the pieces' boxes are not the whole's
+  into.point_indices.insert(into.point_indices.end(),
+                            piece.point_indices.begin(),
+                            piece.point_indices.end());
+  into.points.insert(into.points.end(), piece.points.begin(),
+                     piece.points.end());
+}
+
+cv::Mat Appearance(const cv::Mat& color, const SegmentedObject& object) {
+  if (color.empty() || color.type() != CV_8UC3 || object.mask.empty() ||
+      color.size() != object.mask.size()) {
+    return {};
+  }
+  const cv::Rect box = object.box & cv::Rect(0, 0, color.cols, color.rows);
+  if (box.empty()) return {};
+  const cv::Mat image = color(box);
+  const cv::Mat mask = object.mask(box);
+  const int channels[] = {0, 1, 2};
+  const int bins[] = {4, 4, 4};
+  const float range[] = {0.0f, 256.0f};
+  const float* ranges[] = {range, range, range};
+  cv::Mat histogram;
+  cv::calcHist(&image, 1, channels, mask, histogram, 3, bins, ranges);
+  if (cv::sum(histogram)[0] <= 0.0) return {};
+  return histogram;
+}
+
+}  // namespace fovea

@@ -1,0 +1,69 @@
+// The tracker's operations on one frame's objects, on hand-made masks.
+
+#include "core/track/object_ops.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+namespace fovea {
+namespace {
+
+SegmentedObject Square(int x, int y, int side,
+                       const Eigen::Vector3f& centroid) {
+  SegmentedObject o;
+  o.mask = cv::Mat(20, 20, CV_8UC1, cv::Scalar(0));
+  o.box = cv::Rect(x, y, side, side);
+  o.mask(o.box).setTo(255);
+  o.area = side * side;
+  o.centroid = centroid;
+  o.extent = Eigen::Vector3f(0.01f, 0.02f, 0.03f) * static_cast<float>(side);
+  return o;
+}
+
+TEST(ObjectOps, SquaresTwoPixelsApartTouchWhenOneGrowsByThree) {
+  // Columns 2-4 and 7-9: a gap of columns 5 and 6, which a grown by 2
+  // fills; by 3 it reaches column 7.
+  const SegmentedObject a = Square(2, 2, 3, Eigen::Vector3f::Zero());
+  const SegmentedObject b = Square(7, 2, 3, Eigen::Vector3f::Zero());
+  EXPECT_FALSE(Touch(a.mask, a.box, b.mask, b.box, 2));
+  EXPECT_TRUE(Touch(a.mask, a.box, b.mask, b.box, 3));
+  EXPECT_TRUE(Touch(b.mask, b.box, a.mask, a.box, 3));
+}
+
+TEST(ObjectOps, JoiningIsTheUnionWithAnAreaWeightedCentroid) {
+  SegmentedObject into = Square(0, 0, 4, Eigen::Vector3f(0, 0, 1));  // 16 px
+  const SegmentedObject piece = Square(10, 10, 2, Eigen::Vector3f(1, 0, 1));
+  Join(piece, into);
+  EXPECT_EQ(into.area, 20);
+  EXPECT_EQ(into.box, cv::Rect(0, 0, 12, 12));
+  EXPECT_NEAR(into.centroid.x(), 4.0f / 20.0f, 1e-6f);
+  EXPECT_FLOAT_EQ(into.extent.z(), 0.12f);  // the larger
+  EXPECT_FALSE(into.geometry.has_value());
+}
+
+TEST(ObjectOps, AppearanceTellsColoursApartNotShapes) {
+  cv::Mat color(20, 20, CV_8UC3, cv::Scalar(200, 30, 30));        // red (RGB)
+  color(cv::Rect(10, 0, 10, 20)).setTo(cv::Scalar(30, 30, 200));  // blue
+  const SegmentedObject red_square = Square(1, 1, 6, Eigen::Vector3f::Zero());
+  SegmentedObject red_bar = Square(0, 10, 2, Eigen::Vector3f::Zero());
+  red_bar.mask(cv::Rect(0, 10, 8, 2)).setTo(255);
+  red_bar.box = cv::Rect(0, 10, 8, 2);
+  const SegmentedObject blue = Square(12, 4, 5, Eigen::Vector3f::Zero());
+  const cv::Mat a = Appearance(color, red_square);
+  const cv::Mat b = Appearance(color, red_bar);
+  const cv::Mat c = Appearance(color, blue);
+  ASSERT_FALSE(a.empty());
+  EXPECT_NEAR(cv::compareHist(a, b, cv::HISTCMP_BHATTACHARYYA), 0.0, 1e-6);
+  EXPECT_NEAR(cv::compareHist(a, c, cv::HISTCMP_BHATTACHARYYA), 1.0, 1e-6);
+  EXPECT_TRUE(Appearance(cv::Mat(), red_square).empty());
+}
+
+TEST(ObjectOps, CoordinateMedianIsTakenPerAxis) {
+  const Eigen::Vector3f m = CoordinateMedian({{1, 9, 0}, {5, 1, 2}, {3, 4, 1}});
+  EXPECT_EQ(m, Eigen::Vector3f(3, 4, 1));
+  EXPECT_EQ(CoordinateMedian({}), Eigen::Vector3f::Zero());
+}
+
+}  // namespace
+}  // namespace fovea
