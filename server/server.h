@@ -176,6 +176,9 @@ class FoveaServer {
 
   // Detect jobs accepted and waiting for a worker.
   int queued_jobs() const { return work_->waiting(); }
+  // Jobs on a worker now (a call's answer may reach its client a moment
+  // before its job leaves the worker).
+  int running_jobs() const { return work_->running(); }
 
  private:
   FoveaServer() = default;

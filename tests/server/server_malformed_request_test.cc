@@ -191,6 +191,10 @@ TEST_F(ServerTest, AFullServerRefusesBeforeParsingTheBody) {
       MetricValue(Scrape(), "fovea_calls_shed_total", {"reason=\"busy\""}), 3);
   gate_.Open();
   ASSERT_TRUE(running.get().ok());
+  // The answer can come before its job leaves the only worker, and until
+  // then the server is still full.
+  ASSERT_TRUE(testing::WaitFor([this] { return server_->running_jobs() == 0; },
+                               kCallTimeout));
   const RawCallResult parsed =
       CallWithBytes(channel_, "/fovea.v1.Perception/Detect", malformed);
   EXPECT_EQ(parsed.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
