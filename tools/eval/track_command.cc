@@ -41,29 +41,26 @@ int RunTrackCommand() {
   std::vector<synth::SequenceKind> kinds;
   std::vector<synth::ReplayKind> replays;
   const std::string kinds_flag = absl::GetFlag(FLAGS_kinds);
+  // Parses `name` from `table` into `into`; false (reported) when unknown.
+  const auto parse = [](const auto& table, std::string_view what,
+                        absl::string_view name, auto& into) {
+    auto value = ParseNamed(table, "--kinds", what,
+                            std::string_view(name.data(), name.size()));
+    if (!value.ok()) {
+      std::fprintf(stderr, "fovea-eval: %s\n",
+                   std::string(value.status().message()).c_str());
+      return false;
+    }
+    into.push_back(*value);
+    return true;
+  };
   for (absl::string_view name :
        absl::StrSplit(kinds_flag, ',', absl::SkipEmpty())) {
-    if (absl::ConsumePrefix(&name, "osd-")) {
-      absl::StatusOr<synth::ReplayKind> replay =
-          ParseNamed(synth::ReplayKinds(), "--kinds", "replay kind",
-                     std::string_view(name.data(), name.size()));
-      if (!replay.ok()) {
-        std::fprintf(stderr, "fovea-eval: %s\n",
-                     std::string(replay.status().message()).c_str());
-        return kUsageError;
-      }
-      replays.push_back(*replay);
-      continue;
-    }
-    absl::StatusOr<synth::SequenceKind> kind =
-        ParseNamed(synth::SequenceKinds(), "--kinds", "sequence kind",
-                   std::string_view(name.data(), name.size()));
-    if (!kind.ok()) {
-      std::fprintf(stderr, "fovea-eval: %s\n",
-                   std::string(kind.status().message()).c_str());
-      return kUsageError;
-    }
-    kinds.push_back(*kind);
+    const bool ok =
+        absl::ConsumePrefix(&name, "osd-")
+            ? parse(synth::ReplayKinds(), "replay kind", name, replays)
+            : parse(synth::SequenceKinds(), "sequence kind", name, kinds);
+    if (!ok) return kUsageError;
   }
   std::string data = absl::GetFlag(FLAGS_data);
   if (data.empty() && std::getenv("FOVEA_OSD_DIR") != nullptr) {

@@ -95,6 +95,16 @@ void PrintSequence(const std::string& name,
   }
 }
 
+// "<kind>: <whose> mean ms per stage: <stage> <ms> ..." on stderr.
+void PrintStages(const std::string& kind, const char* whose,
+                 const std::map<std::string, double>& seconds, int frames) {
+  std::fprintf(stderr, "%s: %s mean ms per stage:", kind.c_str(), whose);
+  for (const auto& [stage, total] : seconds) {
+    std::fprintf(stderr, " %s %.1f", stage.c_str(), 1e3 * total / frames);
+  }
+  std::fprintf(stderr, "\n");
+}
+
 }  // namespace
 
 std::vector<cv::Mat> ChangedTruths(const synth::SequenceFrame& before,
@@ -341,19 +351,9 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
     figures.reused_fraction = static_cast<double>(reused) / figures.frames;
   }
   if (options.verbose && figures.frames > 0) {
-    std::fprintf(stderr,
-                 "%s: a fresh call's mean ms per stage:", figures.kind.c_str());
-    for (const auto& [stage, seconds] : stage_seconds) {
-      std::fprintf(stderr, " %s %.1f", stage.c_str(),
-                   1e3 * seconds / figures.frames);
-    }
-    std::fprintf(
-        stderr, "\n%s: the tracker's mean ms per stage:", figures.kind.c_str());
-    for (const auto& [stage, seconds] : track_stage_seconds) {
-      std::fprintf(stderr, " %s %.1f", stage.c_str(),
-                   1e3 * seconds / figures.frames);
-    }
-    std::fprintf(stderr, "\n");
+    PrintStages(figures.kind, "a fresh call's", stage_seconds, figures.frames);
+    PrintStages(figures.kind, "the tracker's", track_stage_seconds,
+                figures.frames);
   }
   figures.median_track_ms = Median(track_ms);
   figures.median_fresh_ms = Median(fresh_ms);
