@@ -147,6 +147,7 @@ absl::StatusOr<SegmentSummary> RunSegmentIncremental(
   // The surface models' noise is the scene's sensor's.
   IncOptions inc_options = options.inc;
   AdaptToSensor(scene.sensor, inc_options.surface_models);
+  AdaptToSensor(scene.sensor, inc_options.body_join.fit);
   // The surfaces do not depend on the saliency map: with two threads they
   // are built while Detect runs.
   std::optional<absl::StatusOr<CosScene>> surfaces;

@@ -18,4 +18,9 @@ void AdaptToSensor(const SensorModel& sensor, SurfaceModelOptions& options) {
   options.surface_sigma = std::hypot(options.surface_sigma, sensor.sigma0_m);
 }
 
+void AdaptToSensor(const SensorModel& sensor, BodyFitOptions& options) {
+  options.sigma0_m = sensor.sigma0_m;
+  options.sigma_per_z2 = sensor.sigma_per_z2;
+}
+
 }  // namespace fovea

@@ -4,6 +4,7 @@
 #include "core/frame/sensor_model.h"
 #include "core/scene/support_plane.h"
 #include "core/scene/table_scene.h"
+#include "core/segmentation/body_fit.h"
 #include "core/segmentation/surface_model.h"
 
 namespace fovea {
@@ -31,6 +32,9 @@ void AdaptToSensor(const SensorModel& sensor, TableSceneOptions& options);
 // frames gained less (2.04). A Kinect v1 model leaves the defaults as they
 // are.
 void AdaptToSensor(const SensorModel& sensor, SurfaceModelOptions& options);
+// INC's body join (one sphere or cylinder through two surfaces) allows the
+// sensor's depth noise sigma(z), both terms.
+void AdaptToSensor(const SensorModel& sensor, BodyFitOptions& options);
 
 }  // namespace fovea
 

@@ -84,6 +84,14 @@ absl::Status Validate(const IncOptions& options) {
         absl::StrCat("convex_join.joined_probability must be in (0.5, 1], got ",
                      convex.joined_probability));
   }
+  if (absl::Status s = Validate(options.body_join.fit); !s.ok()) {
+    return s;
+  }
+  const double body = options.body_join.joined_probability;
+  if (!(body > 0.5 && body <= 1.0)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "body_join.joined_probability must be in (0.5, 1], got ", body));
+  }
   if (options.max_growth_steps < 1) {
     return absl::InvalidArgumentError(absl::StrCat(
         "max_growth_steps must be positive, got ", options.max_growth_steps));
@@ -145,6 +153,7 @@ absl::StatusOr<IncScene> BuildIncScene(CosScene surfaces,
   }
   scene.relations = std::make_unique<RelationComputer>(
       cloud, object_labels, n, plane.normal, options.relations);
+  scene.up = plane.normal;
   // Eq. 3.6: a surface's saliency is the mean saliency of its points.
   std::vector<double> sum(n, 0.0);
   std::vector<int> count(n, 0);
@@ -214,7 +223,12 @@ double IncSegmenter::SameProbability(int a, int b) {
       relation[kBorderConvexityFeature] >= convex.min_convexity &&
       relation[kBorderSharpConcaveFeature] <= convex.max_sharp_concave;
   const double svm = svm_.Probability(relation);
-  const double p = convex_join ? std::max(svm, convex.joined_probability) : svm;
+  double p = convex_join ? std::max(svm, convex.joined_probability) : svm;
+  const IncOptions::BodyJoin& body = options_.body_join;
+  if (body.enabled && p < body.joined_probability &&
+      OnOneBody(scene_.points[a], scene_.points[b], scene_.up, body.fit)) {
+    p = body.joined_probability;
+  }
   probability_.emplace(key, p);
   return p;
 }

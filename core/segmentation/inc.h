@@ -12,6 +12,7 @@
 #include "core/base/interrupt.h"
 #include "core/frame/organized_cloud.h"
 #include "core/scene/support_plane.h"
+#include "core/segmentation/body_fit.h"
 #include "core/segmentation/cos.h"
 #include "core/segmentation/rbf_svm.h"
 #include "core/segmentation/relations.h"
@@ -68,6 +69,18 @@ struct IncOptions {
     double joined_probability = 0.75;  // (0.5, 1]
   };
   ConvexJoin convex_join;
+  // One curved body (body_fit.h) beside the SVM: two neighbouring surfaces
+  // whose points lie together on one sphere or one upright cylinder (a
+  // bowl's or a mug's inside and outside, seen across a depth jump at the
+  // rim; a can's side cut in strips) have p(same) at least
+  // `joined_probability`. Reads the surfaces' points, which the scene
+  // keeps when fuse_surfaces is on.
+  struct BodyJoin {
+    bool enabled = true;
+    BodyFitOptions fit;
+    double joined_probability = 0.75;  // (0.5, 1]
+  };
+  BodyJoin body_join;
   // Objects of fewer points leave the scene without being emitted (noise
   // surfaces), pixels.
   int min_object_points = 150;
@@ -91,6 +104,7 @@ struct IncScene {
   // surfaces an object's growth reaches, when it first reaches them.
   std::vector<std::vector<Eigen::Vector3f>> points;
   int object_points = 0;  // pixels of non-support surfaces
+  Eigen::Vector3f up = Eigen::Vector3f::UnitZ();  // the support's normal
   // The surfaces' stages, then "relations" and "surface_points".
   std::vector<StageTiming> timings;
 };
@@ -142,7 +156,8 @@ class IncSegmenter {
 
  private:
   // p(same object) of two neighbouring surfaces: the SVM's, raised to
-  // convex_join.joined_probability where that criterion holds; cached.
+  // convex_join.joined_probability or body_join.joined_probability where
+  // that criterion holds; cached.
   double SameProbability(int a, int b);
   // Fits the surface models of `selection`'s surfaces and decides for each
   // neighbouring pair of them whether one B-spline explains both (then

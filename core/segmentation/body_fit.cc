@@ -1,0 +1,132 @@
+#include "core/segmentation/body_fit.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+
+#include "core/base/status_macros.h"
+
+namespace fovea {
+namespace {
+
+// At most `limit` of `points`, evenly strided, appended to `out`.
+void Sample(const std::vector<Eigen::Vector3f>& points, int limit,
+            std::vector<Eigen::Vector3f>& out) {
+  const size_t stride =
+      std::max<size_t>(1, (points.size() + limit - 1) / std::max(1, limit));
+  for (size_t i = 0; i < points.size(); i += stride) out.push_back(points[i]);
+}
+
+// The least-squares solution of |q|^2 + g . q + f = 0 over `q` (rows of
+// dimension n): the centre -g / 2 and radius, with the geometric rms.
+template <int N>
+std::optional<BodyFit> FitRound(
+    const std::vector<Eigen::Matrix<double, N, 1>>& q) {
+  if (static_cast<int>(q.size()) < N + 1) return std::nullopt;
+  Eigen::Matrix<double, N, 1> mean = Eigen::Matrix<double, N, 1>::Zero();
+  for (const auto& p : q) mean += p;
+  mean /= static_cast<double>(q.size());
+  // Centred, for conditioning.
+  Eigen::MatrixXd a(q.size(), N + 1);
+  Eigen::VectorXd b(q.size());
+  for (size_t i = 0; i < q.size(); ++i) {
+    const Eigen::Matrix<double, N, 1> p = q[i] - mean;
+    a.row(i).head<N>() = p.transpose();
+    a(i, N) = 1.0;
+    b(i) = -p.squaredNorm();
+  }
+  const Eigen::VectorXd x = a.colPivHouseholderQr().solve(b);
+  if (!x.allFinite()) return std::nullopt;
+  const Eigen::Matrix<double, N, 1> center = -0.5 * x.template head<N>();
+  const double r2 = center.squaredNorm() - x(N);
+  if (!(r2 > 0.0)) return std::nullopt;
+  const double r = std::sqrt(r2);
+  double sum = 0.0;
+  for (const auto& p : q) {
+    const double e = (p - mean - center).norm() - r;
+    sum += e * e;
+  }
+  BodyFit fit;
+  fit.radius = static_cast<float>(r);
+  fit.rms = static_cast<float>(std::sqrt(sum / static_cast<double>(q.size())));
+  const Eigen::Matrix<double, N, 1> c = center + mean;
+  for (int i = 0; i < N; ++i) fit.center[i] = static_cast<float>(c[i]);
+  return fit;
+}
+
+}  // namespace
+
+absl::Status Validate(const BodyFitOptions& o) {
+  if (o.min_points < 4) {
+    return absl::InvalidArgumentError("body_join.min_points must be >= 4");
+  }
+  if (!(o.min_radius_m > 0.0f) || !(o.max_radius_m > o.min_radius_m)) {
+    return absl::InvalidArgumentError(
+        "body_join radii must satisfy 0 < min_radius_m < max_radius_m");
+  }
+  if (!(o.wall_m >= 0.0f) || !(o.sigma0_m >= 0.0f) ||
+      !(o.sigma_per_z2 >= 0.0f) ||
+      !(o.wall_m + o.sigma0_m + o.sigma_per_z2 > 0.0f)) {
+    return absl::InvalidArgumentError(
+        "body_join: wall_m, sigma0_m and sigma_per_z2 must be >= 0, not all "
+        "0");
+  }
+  if (o.max_fit_points < 4) {
+    return absl::InvalidArgumentError("body_join.max_fit_points must be >= 4");
+  }
+  return absl::OkStatus();
+}
+
+std::optional<BodyFit> FitSphere(const std::vector<Eigen::Vector3f>& points) {
+  std::vector<Eigen::Vector3d> q;
+  q.reserve(points.size());
+  for (const Eigen::Vector3f& p : points) q.push_back(p.cast<double>());
+  return FitRound<3>(q);
+}
+
+std::optional<BodyFit> FitUprightCylinder(
+    const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& up) {
+  // Two axes normal to `up`.
+  const Eigen::Vector3d n = up.cast<double>().normalized();
+  const Eigen::Vector3d helper = std::abs(n.x()) < 0.9
+                                     ? Eigen::Vector3d::UnitX()
+                                     : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d u = n.cross(helper).normalized();
+  const Eigen::Vector3d v = n.cross(u);
+  std::vector<Eigen::Vector2d> q;
+  q.reserve(points.size());
+  for (const Eigen::Vector3f& p : points) {
+    const Eigen::Vector3d d = p.cast<double>();
+    q.emplace_back(u.dot(d), v.dot(d));
+  }
+  std::optional<BodyFit> fit = FitRound<2>(q);
+  if (!fit.has_value()) return fit;
+  // The centre back in 3D, on the plane through the origin normal to up.
+  const Eigen::Vector3d c = u * fit->center.x() + v * fit->center.y();
+  fit->center = c.cast<float>();
+  return fit;
+}
+
+bool OnOneBody(const std::vector<Eigen::Vector3f>& a,
+               const std::vector<Eigen::Vector3f>& b, const Eigen::Vector3f& up,
+               const BodyFitOptions& options) {
+  if (static_cast<int>(a.size()) < options.min_points ||
+      static_cast<int>(b.size()) < options.min_points) {
+    return false;
+  }
+  std::vector<Eigen::Vector3f> both;
+  both.reserve(2 * options.max_fit_points);
+  Sample(a, options.max_fit_points, both);
+  Sample(b, options.max_fit_points, both);
+  float z = 0.0f;
+  for (const Eigen::Vector3f& p : both) z += p.z();
+  z /= static_cast<float>(both.size());
+  const float max_rms = std::hypot(
+      options.wall_m, options.sigma0_m + options.sigma_per_z2 * z * z);
+  const auto fits = [&](const std::optional<BodyFit>& fit) {
+    return fit.has_value() && fit->radius >= options.min_radius_m &&
+           fit->radius <= options.max_radius_m && fit->rms <= max_rms;
+  };
+  return fits(FitSphere(both)) || fits(FitUprightCylinder(both, up));
+}
+
+}  // namespace fovea

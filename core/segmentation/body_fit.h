@@ -1,0 +1,67 @@
+#ifndef FOVEA_CORE_SEGMENTATION_BODY_FIT_H_
+#define FOVEA_CORE_SEGMENTATION_BODY_FIT_H_
+
+#include <Eigen/Core>
+#include <optional>
+#include <vector>
+
+#include "absl/status/status.h"
+
+namespace fovea {
+
+// One curved body: whether the points of two surfaces lie together on one
+// sphere or on one upright cylinder (its axis along the support's normal).
+// A bowl's inside and outside meet at its rim, a mug's inside and its side
+// at the mug's, where the camera sees a depth jump and no fold; a can's
+// side cut into strips has folds too slight to call convex. A sphere or a
+// cylinder through both surfaces joins them where the relation SVM doubts
+// (IncOptions::body_join); a cup in a bowl, a can beside a can, a ball on a
+// box lie on no one body.
+
+struct BodyFitOptions {
+  // Each surface needs this many points: a few dozen fit any sphere.
+  int min_points = 150;
+  // The body's radius, metres: household bowls, cups and cans; a larger
+  // sphere is a plane's fit.
+  float min_radius_m = 0.02f;
+  float max_radius_m = 0.2f;
+  // The points' root mean square distance to the body may be at most
+  // hypot(wall_m, sigma(z)), metres: half a bowl's or a mug's wall (its
+  // inside and outside are radii a wall apart) and the sensor's depth noise
+  // sigma(z) = sigma0_m + sigma_per_z2 z^2 at the points' mean depth z
+  // (the Kinect's by default; AdaptToSensor sets the sensor's).
+  float wall_m = 0.002f;
+  float sigma0_m = 0.0f;
+  float sigma_per_z2 = 1.43e-3f;
+  // Each surface is sampled down to at most this many points for the fit.
+  int max_fit_points = 400;
+};
+
+absl::Status Validate(const BodyFitOptions& options);
+
+struct BodyFit {
+  Eigen::Vector3f center = Eigen::Vector3f::Zero();  // a point on the axis
+  float radius = 0.0f;                               // metres
+  float rms = 0.0f;                                  // metres
+};
+
+// The least-squares sphere through `points` (algebraic fit: |p|^2 + D.p + F
+// = 0 solved linearly, then the geometric rms); nullopt for fewer than 4
+// points or a degenerate fit.
+std::optional<BodyFit> FitSphere(const std::vector<Eigen::Vector3f>& points);
+
+// The least-squares cylinder of axis `up` (unit) through `points`: a circle
+// fitted to their projection on the plane normal to `up`; `center` is on
+// the axis. nullopt for fewer than 3 points or a degenerate fit.
+std::optional<BodyFit> FitUprightCylinder(
+    const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& up);
+
+// Whether `a` and `b` (camera frame: z is depth) lie together on one
+// sphere or one cylinder of axis `up` within `options`.
+bool OnOneBody(const std::vector<Eigen::Vector3f>& a,
+               const std::vector<Eigen::Vector3f>& b, const Eigen::Vector3f& up,
+               const BodyFitOptions& options);
+
+}  // namespace fovea
+
+#endif  // FOVEA_CORE_SEGMENTATION_BODY_FIT_H_
