@@ -458,6 +458,7 @@ v1::TrackResponse ToTrackResponse(const TrackedFrame& frame,
   out.set_reused(frame.reused);
   out.set_changed_fraction(frame.changed_fraction);
   out.set_joined(static_cast<uint32_t>(frame.joined));
+  out.set_split(static_cast<uint32_t>(frame.split));
   out.set_frames_skipped(skipped);
   out.set_seconds(frame.seconds);
   for (const StageTiming& timing : frame.timings) {

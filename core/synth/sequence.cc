@@ -56,6 +56,35 @@ SceneSpec WithObjects(const SceneSpec& base, const std::vector<bool>& present,
   return spec;
 }
 
+// How far object k reaches from its centre along the unit horizontal
+// direction `d`: a box's support function, a round body's radius.
+float Reach(const Primitive& object, const Eigen::Vector3f& d) {
+  if (object.shape != Shape::kBox) return object.radius;
+  const Eigen::Matrix3f r = object.pose.linear();
+  float reach = 0.0f;
+  for (int i = 0; i < 3; ++i) {
+    reach += std::abs(d.dot(r.col(i))) * object.half_extents[i];
+  }
+  return reach;
+}
+
+// The object nearest to object k on the table (-1 when it is alone).
+int Nearest(const SceneSpec& spec, int k) {
+  int nearest = -1;
+  float best = 0.0f;
+  for (int j = 0; j < static_cast<int>(spec.objects.size()); ++j) {
+    if (j == k) continue;
+    Eigen::Vector3f d =
+        spec.objects[j].pose.translation() - spec.objects[k].pose.translation();
+    d.z() = 0.0f;
+    if (nearest < 0 || d.norm() < best) {
+      nearest = j;
+      best = d.norm();
+    }
+  }
+  return nearest;
+}
+
 // Moves object k (and its parts) by `delta` in the world.
 void Translate(SceneSpec& spec, int k, const Eigen::Vector3f& delta) {
   spec.objects[k].pose.pretranslate(delta);
@@ -75,6 +104,7 @@ absl::Span<const NamedValue<SequenceKind>> SequenceKinds() {
       {SequenceKind::kRemove, "remove"},
       {SequenceKind::kPush, "push"},
       {SequenceKind::kPickAndPlace, "pick-place"},
+      {SequenceKind::kPushApart, "push-apart"},
   };
   return kTable;
 }
@@ -103,6 +133,26 @@ Sequence GenerateSequence(SequenceKind kind, uint64_t seed, int frames) {
     Eigen::Vector3f d = base.objects[moving].pose.translation() - mean;
     d.z() = 0.0f;
     if (d.norm() > 1e-3f) away = d.normalized();
+  }
+
+  // The push-apart's pair: `moving` and its nearest neighbour, moved to
+  // stand against it, 2 mm apart, on its side (`side`, from `moving`); both
+  // are swept along `away`, then `moving` is pulled back from `side`.
+  int partner = -1;
+  Eigen::Vector3f side = Eigen::Vector3f::UnitX();
+  if (kind == SequenceKind::kPushApart && n > 1) {
+    partner = Nearest(base, moving);
+    side = base.objects[partner].pose.translation() -
+           base.objects[moving].pose.translation();
+    side.z() = 0.0f;
+    side = side.norm() > 1e-3f ? side.normalized() : Eigen::Vector3f::UnitX();
+    const Eigen::Vector3f at =
+        base.objects[moving].pose.translation() +
+        side * (Reach(base.objects[moving], side) +
+                Reach(base.objects[partner], side) + 0.002f);
+    Eigen::Vector3f delta = at - base.objects[partner].pose.translation();
+    delta.z() = 0.0f;
+    Translate(base, partner, delta);
   }
 
   Sequence sequence;
@@ -150,6 +200,15 @@ Sequence GenerateSequence(SequenceKind kind, uint64_t seed, int frames) {
         const int put = 2 * frames / 3;
         if (n > 0 && t >= lift && t < put) present[moving] = false;
         if (n > 0 && t >= put) Translate(moved, moving, away * 0.12f);
+        break;
+      }
+      case SequenceKind::kPushApart: {
+        if (partner < 0) break;
+        const int half = frames / 2;
+        const float swept = 0.03f * static_cast<float>(std::min(t, half));
+        const float pulled = 0.03f * static_cast<float>(std::max(0, t - half));
+        Translate(moved, moving, away * swept - side * pulled);
+        Translate(moved, partner, away * swept);
         break;
       }
     }

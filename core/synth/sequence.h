@@ -24,9 +24,15 @@ enum class SequenceKind {
   kRemove,        // objects taken away one at a time
   kPush,          // one object pushed 1 cm a frame across the table
   kPickAndPlace,  // one object lifted out of view, put down elsewhere
+  // Two objects side by side swept along together 3 cm a frame for the
+  // first half (what moves as one is one object), then one pulled away
+  // 3 cm a frame while the other stays (parts that move apart split).
+  // Moving 3 cm a frame, more than the tracker's moved_m.
+  kPushApart,
 };
 
-// "static", "drift", "approach", "place", "remove", "push", "pick-place".
+// "static", "drift", "approach", "place", "remove", "push", "pick-place",
+// "push-apart".
 absl::Span<const NamedValue<SequenceKind>> SequenceKinds();
 
 struct SequenceFrame {

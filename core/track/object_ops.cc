@@ -77,4 +77,40 @@ cv::Mat Appearance(const cv::Mat& color, const SegmentedObject& object) {
   return histogram;
 }
 
+Piece PieceOf(const SegmentedObject& object,
+              const Eigen::Vector3f& world_centroid) {
+  Piece piece;
+  piece.box = object.box & cv::Rect(0, 0, object.mask.cols, object.mask.rows);
+  if (!piece.box.empty()) piece.mask = object.mask(piece.box).clone();
+  piece.area = object.area;
+  piece.world_centroid = world_centroid;
+  return piece;
+}
+
+int MatchingPiece(const Piece& now, const Eigen::Vector3f& shift,
+                  const std::vector<Piece>& before) {
+  int best = -1;
+  float nearest = 0.0f;
+  if (now.mask.empty() || now.area <= 0) return best;
+  for (int i = 0; i < static_cast<int>(before.size()); ++i) {
+    const Piece& p = before[i];
+    if (p.mask.empty() || p.area <= 0 || 2 * now.area > 3 * p.area ||
+        2 * p.area > 3 * now.area) {
+      continue;
+    }
+    const cv::Rect both = p.box & now.box;
+    if (both.empty()) continue;
+    cv::Mat overlap;
+    cv::bitwise_and(now.mask(both - now.box.tl()), p.mask(both - p.box.tl()),
+                    overlap);
+    if (cv::countNonZero(overlap) == 0) continue;
+    const float d = (now.world_centroid - shift - p.world_centroid).norm();
+    if (best < 0 || d < nearest) {
+      best = i;
+      nearest = d;
+    }
+  }
+  return best;
+}
+
 }  // namespace fovea

@@ -2,7 +2,9 @@
 #define FOVEA_CORE_TRACK_OBJECT_OPS_H_
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <vector>
 
 #include "core/pipeline/segment.h"
@@ -12,6 +14,12 @@ namespace fovea {
 // What the tracker does to one frame's objects (tracker.h): whether two
 // touch, joining pieces into one, an object's colour, the common motion
 // of many.
+
+// `p` (camera frame) in the world by the camera's pose; `p` without one.
+inline Eigen::Vector3f ToWorld(const std::optional<Eigen::Isometry3f>& pose,
+                               const Eigen::Vector3f& p) {
+  return pose ? Eigen::Vector3f(*pose * p) : p;
+}
 
 // The median of each coordinate of `v` (zero when empty).
 Eigen::Vector3f CoordinateMedian(std::vector<Eigen::Vector3f> v);
@@ -30,6 +38,31 @@ void Join(const SegmentedObject& piece, SegmentedObject& into);
 // 4 x 4 x 4 histogram (CV_32F) of its mask's pixels, to compare with
 // cv::compareHist; empty without colour or pixels.
 cv::Mat Appearance(const cv::Mat& color, const SegmentedObject& object);
+
+// A piece of a joined object as last seen: its mask within its box and its
+// centroid in the world, so that each part's motion can be told, and the
+// identity it had before it was joined (0: none), so that a part that
+// splits off again gets it back.
+struct Piece {
+  cv::Rect box;
+  cv::Mat mask;  // CV_8UC1 of the box's size, non-zero on the piece
+  int area = 0;
+  Eigen::Vector3f world_centroid = Eigen::Vector3f::Zero();
+  int former_id = 0;
+  int former_frames_seen = 0;
+};
+
+// `object` (its mask at the frame's size) as a piece, `world_centroid` its
+// centroid in the world.
+Piece PieceOf(const SegmentedObject& object,
+              const Eigen::Vector3f& world_centroid);
+
+// Which of `before` `now` is: of those its mask overlaps whose area is
+// within a factor of 1.5 of its own (a piece cut otherwise is not it), the one
+// whose centroid is nearest to now's minus `shift` (the camera's own motion);
+// -1 when none (the object was cut otherwise this time).
+int MatchingPiece(const Piece& now, const Eigen::Vector3f& shift,
+                  const std::vector<Piece>& before);
 
 }  // namespace fovea
 

@@ -16,11 +16,6 @@
 namespace fovea {
 namespace {
 
-Eigen::Vector3f ToWorld(const std::optional<Eigen::Isometry3f>& pose,
-                        const Eigen::Vector3f& p) {
-  return pose ? Eigen::Vector3f(*pose * p) : p;
-}
-
 float LargestExtent(const SegmentedObject& object) {
   return object.extent.maxCoeff();
 }
@@ -325,7 +320,8 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
       out.objects.push_back(std::move(kept));
     }
   } else {
-    std::vector<SegmentedObject> found;
+    Association a;
+    std::vector<SegmentedObject>& found = a.found;
     // What changed is where attention goes first.
     IncrementalOptions segment = options_.segment;
     if (still && segment.change_weight > 0.0f) segment.change = changed;
@@ -342,7 +338,8 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
         candidates.push_back(i);
       }
     }
-    std::vector<Eigen::Vector3f> world(found.size());
+    std::vector<Eigen::Vector3f>& world = a.world;
+    world.resize(found.size());
     for (size_t j = 0; j < found.size(); ++j) {
       world[j] = ToWorld(camera_to_world, found[j].centroid);
     }
@@ -378,7 +375,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
       }
       return match;
     };
-    Eigen::Vector3f shift = Eigen::Vector3f::Zero();
+    Eigen::Vector3f& shift = a.shift;
     std::vector<int> match = assign(shift);
     if (!camera_to_world) {
       // The camera's own motion, as the objects' common displacement.
@@ -399,107 +396,28 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
       Reidentify(frame.color, found, world, shift, tracks, candidates, match);
     }
 
-    std::vector<int> track_of(found.size(), -1);
-    std::vector<Eigen::Vector3f> displacement(found.size(),
-                                              Eigen::Vector3f::Zero());
+    std::vector<int>& track_of = a.track_of;
+    track_of.assign(found.size(), -1);
+    std::vector<Eigen::Vector3f>& displacement = a.displacement;
+    displacement.assign(found.size(), Eigen::Vector3f::Zero());
     for (size_t i = 0; i < match.size(); ++i) {
       if (match[i] < 0) continue;
       track_of[match[i]] = candidates[i];
       displacement[match[i]] =
           world[match[i]] - shift - tracks[candidates[i]].world_centroid;
     }
-    std::vector<TrackState> state(found.size(), TrackState::kAppeared);
+    std::vector<TrackState>& state = a.state;
+    state.assign(found.size(), TrackState::kAppeared);
     for (size_t j = 0; j < found.size(); ++j) {
       if (track_of[j] < 0) continue;
       state[j] = displacement[j].norm() > options_.moved_m ? TrackState::kMoved
                                                            : TrackState::kKept;
     }
-    // Pieces that moved together: join the younger into the older.
-    std::vector<bool> absorbed(found.size(), false);
-    std::vector<bool> composite(found.size(), false);
-    // Object `piece` joins object `into` of this frame.
-    const auto join = [&](size_t piece, size_t into) {
-      Join(found[piece], found[into]);
-      composite[into] = true;
-      world[into] = ToWorld(camera_to_world, found[into].centroid);
-      absorbed[piece] = true;
-    };
-    for (size_t a = 0; a < found.size(); ++a) {
-      if (state[a] != TrackState::kMoved || absorbed[a]) continue;
-      for (size_t b = 0; b < found.size(); ++b) {
-        if (b == a || absorbed[b] || state[b] != TrackState::kMoved) continue;
-        if ((displacement[a] - displacement[b]).norm() >
-            options_.joint_motion_m) {
-          continue;
-        }
-        if (!Touch(found[a].mask, found[a].box, found[b].mask, found[b].box,
-                   3)) {
-          continue;
-        }
-        const bool a_older = tracks[track_of[a]].id < tracks[track_of[b]].id;
-        const size_t keep = a_older ? a : b;
-        const size_t drop = a_older ? b : a;
-        join(drop, keep);
-        tracks[track_of[drop]].last_seen_frame = -1;  // forgotten
-        tracks[track_of[drop]].id = 0;
-        ++out.joined;
-        if (drop == a) break;
-      }
-    }
-    // A piece that appeared inside the last mask of a track that was joined
-    // before is that track's again (INC cuts it in two again).
-    for (size_t j = 0; j < found.size(); ++j) {
-      if (absorbed[j] || track_of[j] >= 0) continue;
-      for (size_t k = 0; k < found.size(); ++k) {
-        if (k == j || absorbed[k] || track_of[k] < 0) continue;
-        const Track& t = tracks[track_of[k]];
-        if (t.composite && !t.object.mask.empty() &&
-            t.object.mask.size() == found[j].mask.size()) {
-          cv::Mat inside;
-          cv::bitwise_and(found[j].mask, t.object.mask, inside);
-          if (cv::countNonZero(inside) * 2 > found[j].area) {
-            join(j, k);
-            break;
-          }
-        }
-      }
-    }
-
-    // A track seen last frame and matched to nothing, whose last mask is
-    // mostly under one object's mask now, was a piece of that object: its
-    // identity joins the object's (the pieces of an object INC cut in two
-    // become one object when it comes whole).
-    std::vector<bool> matched_track(tracks.size(), false);
-    for (size_t j = 0; j < found.size(); ++j) {
-      if (track_of[j] >= 0) matched_track[track_of[j]] = true;
-    }
-    for (size_t i = 0; i < tracks.size(); ++i) {
-      Track& t = tracks[i];
-      if (matched_track[i] || t.id == 0 ||
-          t.last_seen_frame != frame_index_ - 1 || t.object.mask.empty()) {
-        continue;
-      }
-      for (size_t k = 0; k < found.size(); ++k) {
-        if (absorbed[k] || track_of[k] < 0 ||
-            found[k].mask.size() != t.object.mask.size()) {
-          continue;
-        }
-        cv::Mat under;
-        cv::bitwise_and(t.object.mask, found[k].mask, under);
-        if (2 * cv::countNonZero(under) > t.object.area) {
-          // The object goes on under the identity of its larger piece.
-          Track& whole = tracks[track_of[k]];
-          if (t.object.area > whole.object.area) {
-            std::swap(t.id, whole.id);
-            whole.frames_seen = std::max(whole.frames_seen, t.frames_seen);
-          }
-          composite[k] = true;
-          t.id = 0;  // forgotten below
-          ++out.joined;
-          break;
-        }
-      }
-    }
+    JoinAndSplit(camera_to_world, a, tracks, out);
+    const std::vector<bool>& absorbed = a.absorbed;
+    const std::vector<bool>& composite = a.composite;
+    std::vector<std::vector<Piece>>& pieces = a.pieces;
+    const std::vector<std::optional<Piece>>& split_from = a.split_from;
 
     std::vector<bool> seen(tracks.size(), false);
     for (size_t j = 0; j < found.size(); ++j) {
@@ -520,20 +438,45 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
         t.world_centroid = world[j];
         t.last_seen_frame = frame_index_;
         t.composite = t.composite || composite[j];
+        if (t.composite) {
+          // The pieces keep the identities they had before being joined.
+          for (Piece& p : pieces[j]) {
+            const int before =
+                p.former_id == 0 ? MatchingPiece(p, shift, t.pieces) : -1;
+            if (before >= 0) {
+              p.former_id = t.pieces[before].former_id;
+              p.former_frames_seen = t.pieces[before].former_frames_seen;
+            }
+          }
+          t.pieces = std::move(pieces[j]);
+        }
         ++t.frames_seen;
         result.track_id = t.id;
         result.frames_seen = t.frames_seen;
       } else {
         Track t;
-        t.id = next_id_++;
+        t.frames_seen = 1;
+        result.state = TrackState::kAppeared;
+        if (split_from[j].has_value() && split_from[j]->former_id != 0 &&
+            std::none_of(tracks.begin(), tracks.end(), [&](const Track& o) {
+              return o.id == split_from[j]->former_id;
+            })) {
+          // A part that splits off gets back the identity it had before.
+          t.id = split_from[j]->former_id;
+          t.frames_seen = split_from[j]->former_frames_seen + 1;
+          result.state =
+              (world[j] - shift - split_from[j]->world_centroid).norm() >
+                      options_.moved_m
+                  ? TrackState::kMoved
+                  : TrackState::kKept;
+        }
+        if (t.id == 0) t.id = next_id_++;
         t.object = found[j];
         t.appearance = Appearance(frame.color, found[j]);
         t.world_centroid = world[j];
         t.last_seen_frame = frame_index_;
-        t.frames_seen = 1;
-        result.state = TrackState::kAppeared;
         result.track_id = t.id;
-        result.frames_seen = 1;
+        result.frames_seen = t.frames_seen;
         tracks.push_back(t);
         seen.push_back(true);
       }

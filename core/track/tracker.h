@@ -13,6 +13,7 @@
 #include "core/pipeline/incremental.h"
 #include "core/pipeline/segment.h"
 #include "core/segmentation/rbf_svm.h"
+#include "core/track/object_ops.h"
 
 namespace fovea {
 
@@ -41,7 +42,10 @@ namespace fovea {
 //   - Pieces that move rigidly together become one object: two tracks whose
 //     masks touch and that moved by the same displacement (more than
 //     moved_m, within joint_motion_m of each other) join; the older
-//     identity stays.
+//     identity stays. A joined object keeps its pieces: when INC cuts it
+//     again, a part that moved more than joint_motion_m apart from the
+//     rest (the two were separate objects swept along together) splits
+//     off with an identity of its own.
 
 enum class TrackState {
   kAppeared,  // first seen in this frame: a new track_id
@@ -122,6 +126,9 @@ struct TrackedFrame {
   // moved (the pixels are then not compared).
   double changed_fraction = 0.0;
   int joined = 0;  // tracks joined into others in this frame
+  // Parts of joined tracks that moved apart in this frame: each is an
+  // object of its own again.
+  int split = 0;
   // Segmented on the last frame's support plane (no search).
   bool support_kept = false;
   std::vector<StageTiming> timings;  // "change", INC's stages, "associate"
@@ -155,7 +162,8 @@ class Tracker {
     Eigen::Vector3f world_centroid = Eigen::Vector3f::Zero();
     int frames_seen = 0;
     int last_seen_frame = 0;
-    bool composite = false;  // pieces were joined into it
+    bool composite = false;     // pieces were joined into it
+    std::vector<Piece> pieces;  // when composite: its pieces as last seen
   };
 
   // Re-identification (TrackerOptions::reidentify_distance): gives the
@@ -169,6 +177,32 @@ class Tracker {
                   const std::vector<Track>& tracks,
                   const std::vector<int>& candidates,
                   std::vector<int>& match) const;
+  // One frame's objects after the association (Process), for the rules on
+  // pieces.
+  struct Association {
+    std::vector<SegmentedObject> found;
+    std::vector<Eigen::Vector3f> world;  // their centroids in the world
+    // Without a pose: the camera's own motion, taken from the centroids.
+    Eigen::Vector3f shift = Eigen::Vector3f::Zero();
+    std::vector<int> track_of;  // per object: its track's index, or -1
+    std::vector<Eigen::Vector3f> displacement;  // since its track's last
+    std::vector<TrackState> state;
+    // Filled by JoinAndSplit, per object: joined into another; pieces
+    // joined into it; its pieces (itself first); split off a joined track:
+    // the piece it was.
+    std::vector<bool> absorbed;
+    std::vector<bool> composite;
+    std::vector<std::vector<Piece>> pieces;
+    std::vector<std::optional<Piece>> split_from;
+  };
+  // The rules on pieces (pieces.cc): objects that moved together and touch
+  // join; an object without a track that is one of a joined track's pieces
+  // joins it again, unless the two moved apart (split); a track last seen
+  // in the previous frame that matched nothing and lies mostly under one
+  // object joins it. Counts in out.joined and out.split.
+  void JoinAndSplit(const std::optional<Eigen::Isometry3f>& camera_to_world,
+                    Association& a, std::vector<Track>& tracks,
+                    TrackedFrame& out) const;
   // The report of `track` leaving view.
   static TrackedObject Gone(const Track& track);
   // The fraction of pixels that changed from the reference frame;

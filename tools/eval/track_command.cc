@@ -112,8 +112,8 @@ int RunTrackCommand() {
   std::printf(
       "| kind | sequences | frames | IDF1 (bound) | switches / 100 "
       "object-frames | "
-      "overlap F (track / single frame) | joined | reused | ms per frame "
-      "(track / fresh) | cost | changed first (track / fresh) "
+      "overlap F (track / single frame) | joined / split | reused | ms per "
+      "frame (track / fresh) | cost | changed first (track / fresh) "
       "|\n|---|---|---|---|---|---|---|---|---|---|---|\n");
   // Runs and prints one kind's figures; false on error.
   const auto report = [&](const absl::StatusOr<TrackFigures>& f) {
@@ -127,13 +127,14 @@ int RunTrackCommand() {
             ? 0.0
             : 100.0 * f->identities.switches / f->identities.truth_frames;
     std::printf(
-        "| %s | %d | %d | %.3f (%.3f) | %.2f | %.3f / %.3f | %lld | %.2f | "
+        "| %s | %d | %d | %.3f (%.3f) | %.2f | %.3f / %.3f | %lld / %lld | "
+        "%.2f | "
         "%.1f / "
         "%.1f | %.2fx | %s |\n",
         f->kind.c_str(), f->sequences, f->frames, Idf1(f->identities),
         DetectionF1(*f), switches, f->overlap_f, f->single_frame_f,
-        static_cast<long long>(f->joined), f->reused_fraction,
-        f->median_track_ms, f->median_fresh_ms,
+        static_cast<long long>(f->joined), static_cast<long long>(f->split),
+        f->reused_fraction, f->median_track_ms, f->median_fresh_ms,
         f->median_fresh_ms > 0 ? f->median_track_ms / f->median_fresh_ms : 0.0,
         f->change_frames == 0
             ? "-"
@@ -146,14 +147,15 @@ int RunTrackCommand() {
           "{\"kind\":\"%s\",\"sequences\":%d,\"frames\":%d,\"idf1\":%.4f,"
           "\"detection_f1\":%.4f,\"switches_per_100\":%.3f,\"overlap_f\":%.4f,"
           "\"single_frame_f\":"
-          "%.4f,\"joined\":%lld,\"reused\":%.3f,\"track_ms\":%.2f,"
+          "%.4f,\"joined\":%lld,\"split\":%lld,\"reused\":%.3f,"
+          "\"track_ms\":%.2f,"
           "\"fresh_ms\":%.2f,\"change_frames\":%d,\"changed_first\":%d,"
           "\"fresh_changed_first\":%d}\n",
           f->kind.c_str(), f->sequences, f->frames, Idf1(f->identities),
           DetectionF1(*f), switches, f->overlap_f, f->single_frame_f,
-          static_cast<long long>(f->joined), f->reused_fraction,
-          f->median_track_ms, f->median_fresh_ms, f->change_frames,
-          f->changed_first, f->fresh_changed_first);
+          static_cast<long long>(f->joined), static_cast<long long>(f->split),
+          f->reused_fraction, f->median_track_ms, f->median_fresh_ms,
+          f->change_frames, f->changed_first, f->fresh_changed_first);
     }
     return true;
   };

@@ -76,9 +76,11 @@ absl::Status WriteTrackedPng(const synth::SequenceFrame& frame,
 }
 
 // One line per sequence on stderr (IDTP, IDFP, IDFN, switches), and for a
-// sequence with switches the (truth -> track) pairs of every frame.
+// sequence with switches the (truth -> track) pairs of every frame and the
+// tracks joined and split in it (`events`, per frame).
 void PrintSequence(const std::string& name,
-                   const std::vector<FrameIdentities>& identities) {
+                   const std::vector<FrameIdentities>& identities,
+                   const std::vector<std::pair<int, int>>& events) {
   const IdentityCounts c = CountIdentities(identities);
   std::fprintf(stderr, "%s: idtp %lld idfp %lld idfn %lld switches %lld\n",
                name.c_str(), static_cast<long long>(c.idtp),
@@ -86,8 +88,13 @@ void PrintSequence(const std::string& name,
                static_cast<long long>(c.switches));
   if (c.switches == 0) return;
   for (size_t t = 0; t < identities.size(); ++t) {
-    std::fprintf(stderr, "  frame %zu: %d truths, %d tracks:", t,
+    std::fprintf(stderr, "  frame %zu: %d truths, %d tracks", t,
                  identities[t].truths, identities[t].tracks);
+    if (t < events.size() && (events[t].first > 0 || events[t].second > 0)) {
+      std::fprintf(stderr, " (%d joined, %d split)", events[t].first,
+                   events[t].second);
+    }
+    std::fprintf(stderr, ":");
     for (const auto& [truth, track] : identities[t].matched) {
       std::fprintf(stderr, " %d->%d", truth, track);
     }
@@ -277,6 +284,7 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
     const synth::Sequence sequence = sequence_at(s);
     Tracker tracker(options.tracker, models.inc ? &*models.inc : nullptr);
     std::vector<FrameIdentities> identities;
+    std::vector<std::pair<int, int>> events;  // joined, split per frame
     const synth::SequenceFrame* previous = nullptr;
     for (const synth::SequenceFrame& frame : sequence.frames) {
       std::optional<Eigen::Isometry3f> pose;
@@ -292,6 +300,8 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
       }
       reused += tracked.reused ? 1 : 0;
       figures.joined += tracked.joined;
+      figures.split += tracked.split;
+      events.emplace_back(tracked.joined, tracked.split);
       identities.push_back(MatchFrame(frame, tracked.objects));
       figures.detections_matched +=
           static_cast<int64_t>(identities.back().matched.size());
@@ -341,7 +351,7 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
       previous = &frame;
       ++figures.frames;
     }
-    if (options.verbose) PrintSequence(sequence.name, identities);
+    if (options.verbose) PrintSequence(sequence.name, identities, events);
     figures.identities += CountIdentities(identities);
     ++figures.sequences;
   }

@@ -76,6 +76,7 @@ struct TrackFigures {
   double overlap_f = 0.0;       // tracker, mean over frames
   double single_frame_f = 0.0;  // a fresh SegmentIncremental, same frames
   int64_t joined = 0;
+  int64_t split = 0;  // parts of joined tracks that moved apart
   // Frame by frame, the masks matched to a truth (IoU >= 0.5) and the truths
   // plus masks: 2 matched / detections is the detection F1, what IDF1
   // would be were every identity kept (IDF1's bound given the masks).

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
+#include <vector>
 
 namespace fovea {
 namespace {
@@ -63,6 +64,42 @@ TEST(ObjectOps, CoordinateMedianIsTakenPerAxis) {
   const Eigen::Vector3f m = CoordinateMedian({{1, 9, 0}, {5, 1, 2}, {3, 4, 1}});
   EXPECT_EQ(m, Eigen::Vector3f(3, 4, 1));
   EXPECT_EQ(CoordinateMedian({}), Eigen::Vector3f::Zero());
+}
+
+TEST(ObjectOps, APieceIsTheOverlappingOneOfItsSizeNearest) {
+  // Last frame's pieces: a 4x4 square at (0,0) and a 4x4 at (4,0) beside
+  // it, and a 9x9 one covering both.
+  const std::vector<Piece> before = {
+      PieceOf(Square(0, 0, 4, Eigen::Vector3f(0.00f, 0, 1)),
+              Eigen::Vector3f(0.00f, 0, 1)),
+      PieceOf(Square(4, 0, 4, Eigen::Vector3f(0.05f, 0, 1)),
+              Eigen::Vector3f(0.05f, 0, 1)),
+      PieceOf(Square(0, 0, 9, Eigen::Vector3f(0.02f, 0, 1)),
+              Eigen::Vector3f(0.02f, 0, 1))};
+  ASSERT_EQ(before[0].box, cv::Rect(0, 0, 4, 4));
+  EXPECT_EQ(before[0].mask.size(), cv::Size(4, 4));
+  EXPECT_EQ(before[0].area, 16);
+  // A 4x4 square 1 px right of the first overlaps all three: the big one
+  // is more than 1.5x its size, and the first is nearer than the second.
+  const Piece moved = PieceOf(Square(1, 0, 4, Eigen::Vector3f(0.01f, 0, 1)),
+                              Eigen::Vector3f(0.01f, 0, 1));
+  EXPECT_EQ(MatchingPiece(moved, Eigen::Vector3f::Zero(), before), 0);
+  // Of two the same size it overlaps, the nearer after the camera's own
+  // motion (`shift`) is taken out.
+  const Piece between = PieceOf(Square(3, 0, 6, Eigen::Vector3f(0.05f, 0, 1)),
+                                Eigen::Vector3f(0.05f, 0, 1));
+  EXPECT_EQ(
+      MatchingPiece(between, Eigen::Vector3f::Zero(), {before[0], before[1]}),
+      -1);  // 36 px against 16: none is its size
+  const Piece small = PieceOf(Square(2, 0, 4, Eigen::Vector3f(0.05f, 0, 1)),
+                              Eigen::Vector3f(0.05f, 0, 1));
+  const std::vector<Piece> pair = {before[0], before[1]};
+  EXPECT_EQ(MatchingPiece(small, Eigen::Vector3f::Zero(), pair), 1);
+  EXPECT_EQ(MatchingPiece(small, Eigen::Vector3f(0.05f, 0, 0), pair), 0);
+  // Nothing overlaps: none.
+  const Piece away = PieceOf(Square(14, 14, 4, Eigen::Vector3f(0, 0, 1)),
+                             Eigen::Vector3f(0, 0, 1));
+  EXPECT_EQ(MatchingPiece(away, Eigen::Vector3f::Zero(), before), -1);
 }
 
 }  // namespace

@@ -1,0 +1,173 @@
+// The tracker's rules on pieces (tracker.h): pieces that moved together
+// join, a joined track's parts that moved apart split, a track whose last
+// mask one object covers joins it.
+
+#include <algorithm>
+#include <opencv2/core.hpp>
+#include <utility>
+
+#include "core/track/object_ops.h"
+#include "core/track/tracker.h"
+
+namespace fovea {
+
+void Tracker::JoinAndSplit(
+    const std::optional<Eigen::Isometry3f>& camera_to_world, Association& a,
+    std::vector<Track>& tracks, TrackedFrame& out) const {
+  // Pieces that moved together: join the younger into the older.
+  std::vector<SegmentedObject>& found = a.found;
+  std::vector<Eigen::Vector3f>& world = a.world;
+  const Eigen::Vector3f& shift = a.shift;
+  std::vector<int>& track_of = a.track_of;
+  const std::vector<Eigen::Vector3f>& displacement = a.displacement;
+  std::vector<TrackState>& state = a.state;
+  std::vector<bool>& absorbed = a.absorbed;
+  absorbed.assign(found.size(), false);
+  std::vector<bool>& composite = a.composite;
+  composite.assign(found.size(), false);
+  // Each object's pieces: itself, and what joins it.
+  std::vector<std::vector<Piece>>& pieces = a.pieces;
+  pieces.assign(found.size(), {});
+  for (size_t j = 0; j < found.size(); ++j) {
+    pieces[j].push_back(PieceOf(found[j], world[j]));
+  }
+  // Object `piece` joins object `into` of this frame.
+  const auto join = [&](size_t piece, size_t into) {
+    Join(found[piece], found[into]);
+    pieces[into].insert(pieces[into].end(), pieces[piece].begin(),
+                        pieces[piece].end());
+    composite[into] = true;
+    world[into] = ToWorld(camera_to_world, found[into].centroid);
+    absorbed[piece] = true;
+  };
+  for (size_t a = 0; a < found.size(); ++a) {
+    if (state[a] != TrackState::kMoved || absorbed[a]) continue;
+    for (size_t b = 0; b < found.size(); ++b) {
+      if (b == a || absorbed[b] || state[b] != TrackState::kMoved) continue;
+      if ((displacement[a] - displacement[b]).norm() >
+          options_.joint_motion_m) {
+        continue;
+      }
+      if (!Touch(found[a].mask, found[a].box, found[b].mask, found[b].box, 3)) {
+        continue;
+      }
+      const bool a_older = tracks[track_of[a]].id < tracks[track_of[b]].id;
+      const size_t keep = a_older ? a : b;
+      const size_t drop = a_older ? b : a;
+      for (Piece& p : pieces[drop]) {
+        p.former_id = tracks[track_of[drop]].id;
+        p.former_frames_seen = tracks[track_of[drop]].frames_seen;
+      }
+      join(drop, keep);
+      tracks[track_of[drop]].last_seen_frame = -1;  // forgotten
+      tracks[track_of[drop]].id = 0;
+      ++out.joined;
+      if (drop == a) break;
+    }
+  }
+  // Objects j (no track) and k (joined track t's): whether j is one of
+  // t's pieces that moved with k's (1: INC cut the object in two again)
+  // or apart from it and no longer touches it (0: they are two objects;
+  // `piece` gets j's), by their own pieces before this frame's joins; -1
+  // when neither (or either is not one of t's pieces). `k_piece` gets k's.
+  const auto moved_with = [&](size_t j, size_t k, const Track& t, int* piece,
+                              int* k_piece) {
+    const Piece& now_j = pieces[j].front();
+    const Piece& now_k = pieces[k].front();
+    const int pj = MatchingPiece(now_j, shift, t.pieces);
+    const int pk = MatchingPiece(now_k, shift, t.pieces);
+    if (pj < 0 || pk < 0 || pj == pk) return -1;
+    *piece = pj;
+    *k_piece = pk;
+    const Eigen::Vector3f motion_j =
+        now_j.world_centroid - shift - t.pieces[pj].world_centroid;
+    const Eigen::Vector3f motion_k =
+        now_k.world_centroid - shift - t.pieces[pk].world_centroid;
+    if ((motion_j - motion_k).norm() <= options_.joint_motion_m) return 1;
+    // Parts of one object cut otherwise this time touch still.
+    return Touch(found[j].mask, found[j].box, found[k].mask, found[k].box, 3)
+               ? -1
+               : 0;
+  };
+  // An object without a track that is one of a joined track's pieces, or
+  // lies inside its last mask, is that track's again (INC cut it in two
+  // again), unless the two moved apart: then it is an object of its own
+  // (split). Per object that split off: the piece it was.
+  std::vector<std::optional<Piece>>& split_from = a.split_from;
+  split_from.assign(found.size(), std::nullopt);
+  for (size_t j = 0; j < found.size(); ++j) {
+    if (absorbed[j] || track_of[j] >= 0 || split_from[j]) continue;
+    for (size_t k = 0; k < found.size(); ++k) {
+      if (k == j || absorbed[k] || track_of[k] < 0) continue;
+      const Track& t = tracks[track_of[k]];
+      if (!t.composite || t.object.mask.empty() ||
+          t.object.mask.size() != found[j].mask.size()) {
+        continue;
+      }
+      int piece = -1;
+      int k_piece = -1;
+      const int with = moved_with(j, k, t, &piece, &k_piece);
+      if (with == 0) {
+        ++out.split;
+        if (t.pieces[piece].former_id != 0) {
+          split_from[j] = t.pieces[piece];
+          break;
+        }
+        // j is the track's own first piece: it keeps the identity, and k
+        // splits off with its piece's.
+        const Eigen::Vector3f moved =
+            world[j] - shift - t.pieces[piece].world_centroid;
+        state[j] = moved.norm() > options_.moved_m ? TrackState::kMoved
+                                                   : TrackState::kKept;
+        track_of[j] = track_of[k];
+        track_of[k] = -1;
+        split_from[k] = t.pieces[k_piece];
+        break;
+      }
+      cv::Mat inside;
+      cv::bitwise_and(found[j].mask, t.object.mask, inside);
+      if (with == 1 || cv::countNonZero(inside) * 2 > found[j].area) {
+        join(j, k);
+        break;
+      }
+    }
+  }
+
+  // A track seen last frame and matched to nothing, whose last mask is
+  // mostly under one object's mask now, was a piece of that object: its
+  // identity joins the object's (the pieces of an object INC cut in two
+  // become one object when it comes whole).
+  std::vector<bool> matched_track(tracks.size(), false);
+  for (size_t j = 0; j < found.size(); ++j) {
+    if (track_of[j] >= 0) matched_track[track_of[j]] = true;
+  }
+  for (size_t i = 0; i < tracks.size(); ++i) {
+    Track& t = tracks[i];
+    if (matched_track[i] || t.id == 0 ||
+        t.last_seen_frame != frame_index_ - 1 || t.object.mask.empty()) {
+      continue;
+    }
+    for (size_t k = 0; k < found.size(); ++k) {
+      if (absorbed[k] || track_of[k] < 0 ||
+          found[k].mask.size() != t.object.mask.size()) {
+        continue;
+      }
+      cv::Mat under;
+      cv::bitwise_and(t.object.mask, found[k].mask, under);
+      if (2 * cv::countNonZero(under) > t.object.area) {
+        // The object goes on under the identity of its larger piece.
+        Track& whole = tracks[track_of[k]];
+        if (t.object.area > whole.object.area) {
+          std::swap(t.id, whole.id);
+          whole.frames_seen = std::max(whole.frames_seen, t.frames_seen);
+        }
+        composite[k] = true;
+        t.id = 0;  // forgotten below
+        ++out.joined;
+        break;
+      }
+    }
+  }
+}
+
+}  // namespace fovea
