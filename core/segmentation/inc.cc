@@ -16,6 +16,55 @@
 namespace fovea {
 namespace {
 
+// Adds to scene.neighbours the pairs of object surfaces at most
+// body_join.gap_px apart in `labels` (-1: none or support) within `box`,
+// across pixels of no object surface, that are not neighbours and lie on
+// one body.
+void AddGapNeighbours(const cv::Mat& labels, const cv::Rect& box, float fx,
+                      const IncOptions& options, IncScene& scene) {
+  const IncOptions::BodyJoin& body = options.body_join;
+  const int gap =
+      static_cast<int>(std::lround(body.gap_px * std::max(fx, 1.0f) / 525.0f));
+  if (!body.enabled || gap <= 0 || !options.fuse_surfaces) return;
+  std::set<std::pair<int, int>> near;
+  for (int v = box.y; v < box.br().y; ++v) {
+    const int* row = labels.ptr<int>(v);
+    for (int u = box.x; u < box.br().x; ++u) {
+      const int a = row[u];
+      if (a < 0) continue;
+      // Right and down, across pixels without a surface only.
+      for (const auto [du, dv] : {std::pair{1, 0}, std::pair{0, 1}}) {
+        for (int step = 1; step <= gap + 1; ++step) {
+          const int x = u + du * step;
+          const int y = v + dv * step;
+          if (x >= box.br().x || y >= box.br().y) break;
+          const int b = labels.at<int>(y, x);
+          if (b == a) break;
+          if (b < 0) continue;
+          if (step > 1) near.emplace(std::min(a, b), std::max(a, b));
+          break;
+        }
+      }
+    }
+  }
+  // Across a gap there is no border to speak for the pair: the fit must be
+  // as tight as the Kinect's noise allows, even for a noisier sensor.
+  BodyFitOptions fit = body.fit;
+  const BodyFitOptions kinect;
+  fit.sigma0_m = std::min(fit.sigma0_m, kinect.sigma0_m);
+  fit.sigma_per_z2 = std::min(fit.sigma_per_z2, kinect.sigma_per_z2);
+  for (const auto& [a, b] : near) {
+    std::vector<int>& na = scene.neighbours[a];
+    if (std::binary_search(na.begin(), na.end(), b)) continue;
+    if (!OnOneBody(scene.points[a], scene.points[b], scene.up, fit)) {
+      continue;
+    }
+    na.insert(std::lower_bound(na.begin(), na.end(), b), b);
+    std::vector<int>& nb = scene.neighbours[b];
+    nb.insert(std::lower_bound(nb.begin(), nb.end(), a), a);
+  }
+}
+
 uint64_t PairKey(int a, int b) {
   return (static_cast<uint64_t>(std::min(a, b)) << 32) |
          static_cast<uint32_t>(std::max(a, b));
@@ -86,6 +135,9 @@ absl::Status Validate(const IncOptions& options) {
   }
   if (absl::Status s = Validate(options.body_join.fit); !s.ok()) {
     return s;
+  }
+  if (options.body_join.gap_px < 0) {
+    return absl::InvalidArgumentError("body_join.gap_px must be >= 0");
   }
   const double body = options.body_join.joined_probability;
   if (!(body > 0.5 && body <= 1.0)) {
@@ -188,6 +240,8 @@ absl::StatusOr<IncScene> BuildIncScene(CosScene surfaces,
     if (count[l] > 0) scene.saliency[l] = sum[l] / count[l];
     if (!scene.surfaces.support[l]) scene.object_points += count[l];
   }
+  scene.neighbours = scene.surfaces.neighbours;
+  AddGapNeighbours(object_labels, box, cloud.intrinsics.fx, options, scene);
   clock.Lap("surface_points");
   return scene;
 }
@@ -242,7 +296,7 @@ void IncSegmenter::DecideFusions(const std::vector<int>& selection) {
   std::vector<std::pair<int, int>> to_decide;
   for (const int a : selection) {
     if (!fitted_[a]) to_fit.push_back(a);
-    for (const int b : scene_.surfaces.neighbours[a]) {
+    for (const int b : scene_.neighbours[a]) {
       if (a < b && std::binary_search(selection.begin(), selection.end(), b) &&
           fused_.count(PairKey(a, b)) == 0 &&
           std::binary_search(bordering.begin(), bordering.end(),
@@ -300,7 +354,7 @@ std::vector<int> IncSegmenter::GroupOf(const std::vector<int>& selection,
   std::vector<std::map<int, EdgeSums>> edges(n);
   DecideFusions(selection);
   for (int i = 0; i < n; ++i) {
-    for (const int neighbour : scene_.surfaces.neighbours[selection[i]]) {
+    for (const int neighbour : scene_.neighbours[selection[i]]) {
       const auto j = index.find(neighbour);
       if (j == index.end() || j->second <= i) continue;
       const auto fused = fused_.find(PairKey(selection[i], neighbour));
@@ -391,7 +445,7 @@ absl::StatusOr<std::optional<IncObject>> IncSegmenter::Next(
       FOVEA_RETURN_IF_ERROR(CheckInterrupt(interrupt));
       std::set<int> grown(selection.begin(), selection.end());
       for (const int s : selection) {
-        for (const int t : scene_.surfaces.neighbours[s]) {
+        for (const int t : scene_.neighbours[s]) {
           if (!removed_[t]) grown.insert(t);
         }
       }
