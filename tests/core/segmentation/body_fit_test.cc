@@ -16,6 +16,21 @@ namespace {
 
 constexpr float kPi = static_cast<float>(M_PI);
 
+// 30 x 30 points of `surface`(s, t, noise) over (s, t) in [0, 1]^2, with
+// Gaussian noise of `sigma` drawn for each.
+template <typename Surface>
+std::vector<Eigen::Vector3f> Grid(Surface surface, float sigma, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> noise(0.0f, sigma);
+  std::vector<Eigen::Vector3f> points;
+  for (int i = 0; i < 30; ++i) {
+    for (int j = 0; j < 30; ++j) {
+      points.push_back(surface(i / 29.0f, j / 29.0f, noise(rng)));
+    }
+  }
+  return points;
+}
+
 // Points of the sphere of centre c and radius r between polar angles
 // [theta0, theta1] (from +z) and azimuths [phi0, phi1], with Gaussian noise
 // of `sigma` along the radius.
@@ -23,19 +38,16 @@ std::vector<Eigen::Vector3f> SpherePatch(const Eigen::Vector3f& c, float r,
                                          float theta0, float theta1, float phi0,
                                          float phi1, float sigma,
                                          unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<float> noise(0.0f, sigma);
-  std::vector<Eigen::Vector3f> points;
-  for (int i = 0; i < 30; ++i) {
-    for (int j = 0; j < 30; ++j) {
-      const float theta = theta0 + (theta1 - theta0) * i / 29.0f;
-      const float phi = phi0 + (phi1 - phi0) * j / 29.0f;
-      const Eigen::Vector3f n(std::sin(theta) * std::cos(phi),
-                              std::sin(theta) * std::sin(phi), std::cos(theta));
-      points.push_back(c + (r + noise(rng)) * n);
-    }
-  }
-  return points;
+  return Grid(
+      [&](float s, float t, float e) {
+        const float theta = theta0 + (theta1 - theta0) * s;
+        const float phi = phi0 + (phi1 - phi0) * t;
+        const Eigen::Vector3f n(std::sin(theta) * std::cos(phi),
+                                std::sin(theta) * std::sin(phi),
+                                std::cos(theta));
+        return Eigen::Vector3f(c + (r + e) * n);
+      },
+      sigma, seed);
 }
 
 // Points of the upright (axis +z) cylinder of axis through c, radius r,
@@ -44,19 +56,14 @@ std::vector<Eigen::Vector3f> CylinderPatch(const Eigen::Vector3f& c, float r,
                                            float z0, float z1, float phi0,
                                            float phi1, float sigma,
                                            unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<float> noise(0.0f, sigma);
-  std::vector<Eigen::Vector3f> points;
-  for (int i = 0; i < 30; ++i) {
-    for (int j = 0; j < 30; ++j) {
-      const float z = z0 + (z1 - z0) * i / 29.0f;
-      const float phi = phi0 + (phi1 - phi0) * j / 29.0f;
-      const float rr = r + noise(rng);
-      points.push_back(
-          c + Eigen::Vector3f(rr * std::cos(phi), rr * std::sin(phi), z));
-    }
-  }
-  return points;
+  return Grid(
+      [&](float s, float t, float e) {
+        const float z = z0 + (z1 - z0) * s;
+        const float phi = phi0 + (phi1 - phi0) * t;
+        return Eigen::Vector3f(c + Eigen::Vector3f((r + e) * std::cos(phi),
+                                                   (r + e) * std::sin(phi), z));
+      },
+      sigma, seed);
 }
 
 const Eigen::Vector3f kUp = Eigen::Vector3f::UnitZ();
