@@ -113,4 +113,15 @@ int MatchingPiece(const Piece& now, const Eigen::Vector3f& shift,
   return best;
 }
 
+void KeepFormerIds(const Eigen::Vector3f& shift,
+                   const std::vector<Piece>& before, std::vector<Piece>& now) {
+  for (Piece& p : now) {
+    if (p.former_id != 0) continue;
+    const int was = MatchingPiece(p, shift, before);
+    if (was < 0) continue;
+    p.former_id = before[was].former_id;
+    p.former_frames_seen = before[was].former_frames_seen;
+  }
+}
+
 }  // namespace fovea

@@ -64,6 +64,11 @@ Piece PieceOf(const SegmentedObject& object,
 int MatchingPiece(const Piece& now, const Eigen::Vector3f& shift,
                   const std::vector<Piece>& before);
 
+// The pieces keep the identities they had before being joined: each piece
+// of `now` without one takes that of its MatchingPiece in `before`.
+void KeepFormerIds(const Eigen::Vector3f& shift,
+                   const std::vector<Piece>& before, std::vector<Piece>& now);
+
 }  // namespace fovea
 
 #endif  // FOVEA_CORE_TRACK_OBJECT_OPS_H_

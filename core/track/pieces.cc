@@ -115,10 +115,8 @@ void Tracker::JoinAndSplit(
         }
         // j is the track's own first piece: it keeps the identity, and k
         // splits off with its piece's.
-        const Eigen::Vector3f moved =
-            world[j] - shift - t.pieces[piece].world_centroid;
-        state[j] = moved.norm() > options_.moved_m ? TrackState::kMoved
-                                                   : TrackState::kKept;
+        state[j] =
+            StateOfMotion(world[j] - shift - t.pieces[piece].world_centroid);
         track_of[j] = track_of[k];
         track_of[k] = -1;
         split_from[k] = t.pieces[k_piece];

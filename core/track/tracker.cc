@@ -410,8 +410,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
     state.assign(found.size(), TrackState::kAppeared);
     for (size_t j = 0; j < found.size(); ++j) {
       if (track_of[j] < 0) continue;
-      state[j] = displacement[j].norm() > options_.moved_m ? TrackState::kMoved
-                                                           : TrackState::kKept;
+      state[j] = StateOfMotion(displacement[j]);
     }
     JoinAndSplit(camera_to_world, a, tracks, out);
     const std::vector<bool>& absorbed = a.absorbed;
@@ -439,15 +438,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
         t.last_seen_frame = frame_index_;
         t.composite = t.composite || composite[j];
         if (t.composite) {
-          // The pieces keep the identities they had before being joined.
-          for (Piece& p : pieces[j]) {
-            const int before =
-                p.former_id == 0 ? MatchingPiece(p, shift, t.pieces) : -1;
-            if (before >= 0) {
-              p.former_id = t.pieces[before].former_id;
-              p.former_frames_seen = t.pieces[before].former_frames_seen;
-            }
-          }
+          KeepFormerIds(shift, t.pieces, pieces[j]);
           t.pieces = std::move(pieces[j]);
         }
         ++t.frames_seen;
@@ -465,10 +456,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
           t.id = split_from[j]->former_id;
           t.frames_seen = split_from[j]->former_frames_seen + 1;
           result.state =
-              (world[j] - shift - split_from[j]->world_centroid).norm() >
-                      options_.moved_m
-                  ? TrackState::kMoved
-                  : TrackState::kKept;
+              StateOfMotion(world[j] - shift - split_from[j]->world_centroid);
         }
         if (t.id == 0) t.id = next_id_++;
         t.object = found[j];

@@ -205,6 +205,11 @@ class Tracker {
                     TrackedFrame& out) const;
   // The report of `track` leaving view.
   static TrackedObject Gone(const Track& track);
+  // kMoved when `motion` is longer than moved_m, else kKept.
+  TrackState StateOfMotion(const Eigen::Vector3f& motion) const {
+    return motion.norm() > options_.moved_m ? TrackState::kMoved
+                                            : TrackState::kKept;
+  }
   // The fraction of pixels that changed from the reference frame;
   // `changed` gets them (CV_8UC1, 255 where changed).
   double ChangedFraction(const RgbdFrame& frame, cv::Mat& changed) const;
