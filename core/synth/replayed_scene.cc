@@ -227,6 +227,53 @@ void TakeAway(int id, const Eigen::Vector4f& plane, LabelledFrame& scene) {
   }
 }
 
+// `labels` with the parts of one object (labels >= 20 of one ObjectId) that
+// touch, directly or through each other, within kPartTouchPx given the
+// lowest label of them. mOSD labels apart an object's faces across a depth
+// edge (a mug's inside and outside, a tin's lid and side), which touch, as
+// well as the parts an occluder separates, which lie 8 px or more apart in
+// every scene.
+constexpr int kPartTouchPx = 2;
+
+cv::Mat TouchingPartsJoined(const cv::Mat& labels) {
+  std::map<int, cv::Mat> parts;
+  for (int v = 0; v < labels.rows; ++v) {
+    const int* l = labels.ptr<int>(v);
+    for (int u = 0; u < labels.cols; ++u) {
+      if (l[u] >= 20 && parts.find(l[u]) == parts.end()) {
+        parts.emplace(l[u], labels == l[u]);
+      }
+    }
+  }
+  std::map<int, int> root;
+  for (const auto& [label, mask] : parts) root[label] = label;
+  const auto find = [&root](int label) {
+    while (root[label] != label) label = root[label];
+    return label;
+  };
+  const cv::Mat near = cv::getStructuringElement(
+      cv::MORPH_RECT, cv::Size(2 * kPartTouchPx + 1, 2 * kPartTouchPx + 1));
+  for (auto a = parts.begin(); a != parts.end(); ++a) {
+    cv::Mat grown;
+    for (auto b = std::next(a); b != parts.end(); ++b) {
+      if (ObjectId(b->first) != ObjectId(a->first)) continue;
+      if (grown.empty()) cv::dilate(a->second, grown, near);
+      if (cv::countNonZero(grown & b->second) == 0) continue;
+      const int ra = find(a->first);
+      const int rb = find(b->first);
+      root[std::max(ra, rb)] = std::min(ra, rb);
+    }
+  }
+  cv::Mat out = labels.clone();
+  for (int v = 0; v < out.rows; ++v) {
+    int* l = out.ptr<int>(v);
+    for (int u = 0; u < out.cols; ++u) {
+      if (l[u] >= 20) l[u] = find(l[u]);
+    }
+  }
+  return out;
+}
+
 // The k-th present part (label >= 20, in label order) relabelled
 // 10 * (k + 2), as RenderScene's labels; `ids` gets the parts' labels.
 cv::Mat SequenceLabels(const cv::Mat& labels, std::vector<int>& ids) {
@@ -264,10 +311,12 @@ absl::Span<const NamedValue<ReplayKind>> ReplayKinds() {
   return kTable;
 }
 
-Sequence ReplayAsSequence(const LabelledFrame& scene, ReplayKind kind,
+Sequence ReplayAsSequence(const LabelledFrame& labelled, ReplayKind kind,
                           uint64_t seed, int frames) {
   FOVEA_CHECK(frames >= 2);
-  FOVEA_CHECK(scene.labels.size() == scene.frame.depth.size());
+  FOVEA_CHECK(labelled.labels.size() == labelled.frame.depth.size());
+  LabelledFrame scene = labelled;
+  scene.labels = TouchingPartsJoined(labelled.labels);
   std::mt19937_64 rng(seed * 7919 + static_cast<uint64_t>(kind));
   std::uniform_real_distribution<float> phase(0.0f, 2.0f * kPi);
   const float phase_x = phase(rng);

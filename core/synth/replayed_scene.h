@@ -21,15 +21,19 @@ enum class ReplayKind {
 // "noise", "shift", "remove".
 absl::Span<const NamedValue<ReplayKind>> ReplayKinds();
 
-// Plays `scene` (labels as LoadOsdPcd's; table labels 1-9 needed for
+// Plays `labelled` (labels as LoadOsdPcd's; table labels 1-9 needed for
 // kRemove) as `kind` over `frames` (>= 2) frames. Every frame, the first
 // included, gets fresh Kinect v1 noise on top of the sensor's own: axial
 // Gaussian noise of sigma 1.43e-3 z^2 quantised to its disparity steps,
 // dropouts at depth edges, colour noise. The ground-truth objects are the
-// scene's labelled parts (each label >= 20, as mOSD labels the disjoint
-// parts of an occluded object apart); SequenceFrame::object_ids holds their
-// labels. The world is the first frame's camera: camera_to_world is the
-// identity except for kShift.
+// scene's objects, except that the disjoint parts of an occluded object
+// count apart: one truth is the parts of one object (labels >= 20 of one
+// ObjectId) that touch within 2 px, directly or through each other, and
+// SequenceFrame::object_ids holds their lowest label. (mOSD labels apart
+// both an object's faces across a depth edge, such as a mug's inside and
+// outside, which touch, and the parts an occluder separates.) The world is
+// the first frame's camera: camera_to_world is the identity except for
+// kShift.
 //   kShift: each frame is the scene's points seen from the moved camera,
 //   nearest point winning, one-pixel cracks filled; what the first view did
 //   not see has no depth.
@@ -38,7 +42,7 @@ absl::Span<const NamedValue<ReplayKind>> ReplayKinds();
 //   colour inpainted from around; an object resting on another is taken
 //   first. One object stays.
 // Deterministic in (scene, kind, seed, frames).
-Sequence ReplayAsSequence(const LabelledFrame& scene, ReplayKind kind,
+Sequence ReplayAsSequence(const LabelledFrame& labelled, ReplayKind kind,
                           uint64_t seed, int frames = 12);
 
 }  // namespace fovea::synth

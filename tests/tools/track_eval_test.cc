@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
 #include <vector>
 
 namespace fovea::eval {
@@ -70,6 +71,10 @@ TEST(MatchFrame, AMaskMatchesTheObjectItCoversAtIouOneHalf) {
   EXPECT_EQ(f.tracks, 2);  // the gone track has no mask
   ASSERT_EQ(f.matched.size(), 1u);
   EXPECT_EQ(f.matched[0], std::make_pair(3, 11));
+  // The half mask is named with the object it lies on: all 16 of its
+  // pixels on object 5 (its sequence id), IoU 16/40.
+  EXPECT_EQ(f.unmatched,
+            std::vector<std::string>{"track 12 16 px, 1.00 on 5 (IoU 0.40)"});
 }
 
 TEST(MatchFrame, AMaskOfAnObjectTooSmallToCountIsIgnored) {
@@ -90,6 +95,8 @@ TEST(MatchFrame, AMaskOfAnObjectTooSmallToCountIsIgnored) {
   EXPECT_EQ(f.truths, 1);
   EXPECT_EQ(f.tracks, 1);  // the stray; the sliver is neither
   EXPECT_TRUE(f.matched.empty());
+  EXPECT_EQ(f.unmatched,
+            std::vector<std::string>{"track 3 8 px, 0.00 on 0 (IoU 0.00)"});
 }
 
 TEST(ChangedTruths, WhatMovedOrAppearedAndNotWhatLostPixels) {

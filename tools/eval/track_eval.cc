@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "core/base/stage_clock.h"
 #include "core/base/status_macros.h"
 #include "core/eval/hungarian.h"
@@ -86,6 +88,11 @@ void PrintSequence(const std::string& name,
                name.c_str(), static_cast<long long>(c.idtp),
                static_cast<long long>(c.idfp), static_cast<long long>(c.idfn),
                static_cast<long long>(c.switches));
+  if (!identities.empty()) {
+    for (const std::string& mask : identities.front().unmatched) {
+      std::fprintf(stderr, "  frame 0, unmatched: %s\n", mask.c_str());
+    }
+  }
   if (c.switches == 0) return;
   for (size_t t = 0; t < identities.size(); ++t) {
     std::fprintf(stderr, "  frame %zu: %d truths, %d tracks", t,
@@ -218,7 +225,24 @@ FrameIdentities MatchFrame(const synth::SequenceFrame& frame,
         std::any_of(small.begin(), small.end(), [&](const cv::Mat& m) {
           return Iou(m, o.object.mask) >= 0.5;
         });
-    if (!ignored) ++out.tracks;
+    if (ignored) continue;
+    ++out.tracks;
+    if (found) continue;
+    const int pixels = cv::countNonZero(o.object.mask);
+    int on = 0;
+    int most = 0;
+    double iou = 0.0;
+    for (const auto& [id, mask] : truths) {
+      const int both = cv::countNonZero(mask & o.object.mask);
+      if (both > most) {
+        most = both;
+        on = id;
+        iou = Iou(mask, o.object.mask);
+      }
+    }
+    out.unmatched.push_back(absl::StrFormat(
+        "track %d %d px, %.2f on %d (IoU %.2f)", o.track_id, pixels,
+        pixels > 0 ? static_cast<double>(most) / pixels : 0.0, on, iou));
   }
   return out;
 }
@@ -271,6 +295,14 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
     const std::string& kind, int count,
     const std::function<synth::Sequence(int)>& sequence_at,
     const TrackEvalOptions& options, const LoadedModels& models) {
+  if (!options.out_dir.empty()) {
+    std::error_code error;
+    std::filesystem::create_directories(options.out_dir, error);
+    if (error) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "--out: cannot create ", options.out_dir, ": ", error.message()));
+    }
+  }
   TrackFigures figures;
   figures.kind = kind;
   std::vector<double> track_ms;

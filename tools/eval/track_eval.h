@@ -23,6 +23,10 @@ struct FrameIdentities {
   int truths = 0;
   int tracks = 0;
   std::vector<std::pair<int, int>> matched;
+  // Each counted mask that matched no truth, for --verbose: "track <id>
+  // <pixels> px, <share> on <truth id> (IoU <iou>)", the truth it lies on
+  // most (0: none).
+  std::vector<std::string> unmatched;
 };
 
 // The identity figures of one sequence (Ristani et al. 2016): the truth

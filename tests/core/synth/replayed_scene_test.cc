@@ -85,6 +85,31 @@ TEST(ReplayedSceneTest, NoiseIsFreshEveryFrameAndSmall) {
             0.0);
 }
 
+// mOSD labels a can's lid apart from its side, and an occluded box's far part
+// apart from its near part. The lid touches the side: one truth object. The
+// far part lies 6 px from the rest: a truth object of its own.
+TEST(ReplayedSceneTest, TouchingPartsAreOneObjectAndSeparatedPartsAreTwo) {
+  LabelledFrame scene = SmallScene();
+  for (int v = 25; v < 29; ++v) {
+    for (int u = 50; u < 65; ++u) scene.labels.at<int>(v, u) = 41;
+  }
+  for (int v = 45; v < 52; ++v) {
+    for (int u = 10; u < 20; ++u) {
+      scene.labels.at<int>(v, u) = 21;
+      scene.frame.depth.at<float>(v, u) = TableDepth(v) - 0.10f;
+    }
+  }
+  for (const ReplayKind kind : {ReplayKind::kNoise, ReplayKind::kShift}) {
+    const Sequence s = ReplayAsSequence(scene, kind, 3, 4);
+    for (const SequenceFrame& frame : s.frames) {
+      EXPECT_EQ(frame.object_ids, (std::vector<int>{20, 21, 30, 40}));
+    }
+    // The can's lid and side: about its 15 x 16 pixels (a few dropped).
+    EXPECT_GT(PixelsOf(s.frames[0], 40), 200);
+    EXPECT_GT(PixelsOf(s.frames[0], 21), 50);
+  }
+}
+
 TEST(ReplayedSceneTest, ShiftedCameraSeesTheSamePointsWhereThePoseSays) {
   const LabelledFrame scene = SmallScene();
   const Sequence s = ReplayAsSequence(scene, ReplayKind::kShift, 3, 6);
