@@ -35,14 +35,19 @@ struct BodyFitOptions {
   float sigma_per_z2 = 1.43e-3f;
   // Each surface is sampled down to at most this many points for the fit.
   int max_fit_points = 400;
+  // An upright cone is a body too (a tapered mug, a tub, a flower pot) when
+  // its radius changes by at most this much per metre of height (0.3: 17
+  // degrees off vertical); 0: cylinders only.
+  float max_taper = 0.3f;
 };
 
 absl::Status Validate(const BodyFitOptions& options);
 
 struct BodyFit {
   Eigen::Vector3f center = Eigen::Vector3f::Zero();  // a point on the axis
-  float radius = 0.0f;                               // metres
-  float rms = 0.0f;                                  // metres
+  float radius = 0.0f;  // metres; a cone's at the height of `center`
+  float rms = 0.0f;     // metres
+  float taper = 0.0f;   // a cone's radius change per metre along `up`
 };
 
 // The least-squares sphere through `points` (algebraic fit: |p|^2 + D.p + F
@@ -56,8 +61,16 @@ std::optional<BodyFit> FitSphere(const std::vector<Eigen::Vector3f>& points);
 std::optional<BodyFit> FitUprightCylinder(
     const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& up);
 
+// The least-squares cone of axis `up` through `points`: the radius r0 +
+// taper h at height h along `up` above `center` (the points' mean height),
+// by Gauss-Newton on the points' distances from the cylinder's fit.
+// nullopt for fewer than 5 points or a degenerate fit.
+std::optional<BodyFit> FitUprightCone(
+    const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& up);
+
 // Whether `a` and `b` (camera frame: z is depth) lie together on one
-// sphere or one cylinder of axis `up` within `options`.
+// sphere, one cylinder or one cone (options.max_taper) of axis `up` within
+// `options`.
 bool OnOneBody(const std::vector<Eigen::Vector3f>& a,
                const std::vector<Eigen::Vector3f>& b, const Eigen::Vector3f& up,
                const BodyFitOptions& options);

@@ -70,7 +70,7 @@ struct IncOptions {
   };
   ConvexJoin convex_join;
   // One curved body (body_fit.h) beside the SVM: two neighbouring surfaces
-  // whose points lie together on one sphere or one upright cylinder (a
+  // whose points lie together on one sphere, upright cylinder or cone (a
   // bowl's or a mug's inside and outside, seen across a depth jump at the
   // rim; a can's side cut in strips) have p(same) at least
   // `joined_probability`. Reads the surfaces' points, which the scene

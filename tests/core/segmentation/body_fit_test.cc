@@ -1,7 +1,7 @@
 // One curved body on hand-made point sets whose answer is geometry: a
 // bowl's inside and outside lie on one sphere, a mug's inside and side on
-// one upright cylinder; a cup in a bowl, two cans side by side and two
-// planes do not.
+// one upright cylinder, a tapered mug's on one upright cone; a cup in a
+// bowl, two cans side by side and two planes do not.
 
 #include "core/segmentation/body_fit.h"
 
@@ -66,6 +66,24 @@ std::vector<Eigen::Vector3f> CylinderPatch(const Eigen::Vector3f& c, float r,
       sigma, seed);
 }
 
+// Points of the upright cone of axis through c whose radius is r + taper z
+// at height z above c, over heights [z0, z1] and azimuths [phi0, phi1],
+// noise along the radius.
+std::vector<Eigen::Vector3f> ConePatch(const Eigen::Vector3f& c, float r,
+                                       float taper, float z0, float z1,
+                                       float phi0, float phi1, float sigma,
+                                       unsigned seed) {
+  return Grid(
+      [&](float s, float t, float e) {
+        const float z = z0 + (z1 - z0) * s;
+        const float phi = phi0 + (phi1 - phi0) * t;
+        const float radius = r + taper * z + e;
+        return Eigen::Vector3f(c + Eigen::Vector3f(radius * std::cos(phi),
+                                                   radius * std::sin(phi), z));
+      },
+      sigma, seed);
+}
+
 const Eigen::Vector3f kUp = Eigen::Vector3f::UnitZ();
 // Bodies 1 m from the camera (z is depth): the Kinect's noise there is
 // 1.4 mm, so a fit may miss by hypot(2 mm, 1.4 mm) = 2.5 mm.
@@ -125,6 +143,49 @@ TEST(BodyFitTest, AMugsInsideAndSideAreOneBodyTwoCansAreNot) {
       CylinderPatch(c + Eigen::Vector3f(0.09f, 0.0f, 0.0f), 0.04f, 0.0f, 0.1f,
                     0.3f, 2.8f, 0.001f, 8);
   EXPECT_FALSE(OnOneBody(side, other, kUp, BodyFitOptions{}));
+}
+
+TEST(BodyFitTest, ATaperedMugsInsideAndSideAreOneConeTwoCupsAreNot) {
+  // A mug 3.5 cm in radius at the bottom, 5 cm at the rim 10 cm up (taper
+  // 0.15, 8.5 degrees), walls 3 mm, 1 mm of noise.
+  const Eigen::Vector3f c = kAway + Eigen::Vector3f(-0.2f, 0.1f, 0.0f);
+  const std::vector<Eigen::Vector3f> side =
+      ConePatch(c, 0.035f, 0.15f, 0.0f, 0.1f, 0.3f, 2.8f, 0.001f, 13);
+  const std::vector<Eigen::Vector3f> inside =
+      ConePatch(c, 0.032f, 0.15f, 0.04f, 0.1f, 3.5f, 6.0f, 0.001f, 14);
+  const std::optional<BodyFit> cone = FitUprightCone(side, kUp);
+  ASSERT_TRUE(cone.has_value());
+  EXPECT_NEAR(cone->taper, 0.15f, 0.01f);
+  EXPECT_NEAR(cone->radius, 0.035f + 0.15f * 0.05f, 0.001f);  // mid-height
+  EXPECT_LT((cone->center - c).head<2>().norm(), 0.001f);
+  EXPECT_TRUE(OnOneBody(side, inside, kUp, BodyFitOptions{}));
+  // No cylinder holds both: without cones they are two bodies.
+  BodyFitOptions cylinders;
+  cylinders.max_taper = 0.0f;
+  EXPECT_FALSE(OnOneBody(side, inside, kUp, cylinders));
+  // A flower pot flaring at 25 degrees is past max_taper (0.3).
+  const std::vector<Eigen::Vector3f> pot_side =
+      ConePatch(c, 0.03f, 0.47f, 0.0f, 0.08f, 0.3f, 2.8f, 0.001f, 15);
+  const std::vector<Eigen::Vector3f> pot_inside =
+      ConePatch(c, 0.027f, 0.47f, 0.03f, 0.08f, 3.5f, 6.0f, 0.001f, 16);
+  EXPECT_FALSE(OnOneBody(pot_side, pot_inside, kUp, BodyFitOptions{}));
+  BodyFitOptions steep;
+  steep.max_taper = 0.5f;
+  EXPECT_TRUE(OnOneBody(pot_side, pot_inside, kUp, steep));
+  // A second mug of the same shape 11 cm to the side, and the same mug
+  // upside down beside it, are not one body with the first.
+  EXPECT_FALSE(
+      OnOneBody(side,
+                ConePatch(c + Eigen::Vector3f(0.11f, 0.0f, 0.0f), 0.035f, 0.15f,
+                          0.0f, 0.1f, 0.3f, 2.8f, 0.001f, 17),
+                kUp, BodyFitOptions{}));
+  EXPECT_FALSE(OnOneBody(side,
+                         ConePatch(c + Eigen::Vector3f(0.0f, 0.0f, 0.1f), 0.05f,
+                                   -0.15f, 0.0f, 0.1f, 3.5f, 6.0f, 0.001f, 18),
+                         kUp, BodyFitOptions{}));
+  BodyFitOptions negative;
+  negative.max_taper = -0.1f;
+  EXPECT_FALSE(Validate(negative).ok());
 }
 
 TEST(BodyFitTest, PlanesAndSmallSurfacesAreNotBodies) {
