@@ -216,8 +216,9 @@ class Metrics {
         track_frames_family_(
             prometheus::BuildCounter()
                 .Name("fovea_track_frames_total")
-                .Help("Frames of Track streams by outcome: segmented, reused "
-                      "(the scene had not changed), skipped (a newer frame "
+                .Help("Frames of Track streams by outcome: segmented, refined "
+                      "(a still scene's mean of frames segmented), reused (the "
+                      "scene had not changed), skipped (a newer frame "
                       "replaced it before it was processed, or the server was "
                       "busy).")
                 .Register(*registry_)),
@@ -302,7 +303,8 @@ class Metrics {
                                  "idle_stream", "stream_limit", "busy"}) {
         Shed(reason);
       }
-      for (const char* outcome : {"segmented", "reused", "skipped"}) {
+      for (const char* outcome :
+           {"segmented", "refined", "reused", "skipped"}) {
         TrackFrames(outcome);
       }
       for (size_t c = 0; c < kAllStatusCodes.size(); ++c) {

@@ -291,7 +291,9 @@ class TrackReactor final
     }
     v1::TrackResponse response =
         ToTrackResponse(tracked, request_id_, wire.sequence(), skipped);
-    RecordTrackFrame(tracked.reused ? "reused" : "segmented",
+    RecordTrackFrame(tracked.reused    ? "reused"
+                     : tracked.refined ? "refined"
+                                       : "segmented",
                      SecondsSince(pending.arrived));
     std::unique_ptr<v1::TrackResponse> recorded;
     if (record_stream_ != 0) {
@@ -459,6 +461,7 @@ v1::TrackResponse ToTrackResponse(const TrackedFrame& frame,
   out.set_changed_fraction(frame.changed_fraction);
   out.set_joined(static_cast<uint32_t>(frame.joined));
   out.set_split(static_cast<uint32_t>(frame.split));
+  out.set_refined(frame.refined);
   out.set_frames_skipped(skipped);
   out.set_seconds(frame.seconds);
   for (const StageTiming& timing : frame.timings) {

@@ -84,7 +84,57 @@ absl::Status Validate(const TrackerOptions& options) {
   if (options.remember_frames < 0) {
     return absl::InvalidArgumentError("track.remember_frames: must be >= 0");
   }
+  if (options.refine_frames < 0 || options.refine_frames > 64) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "track.refine_frames: ", options.refine_frames, " is not in [0, 64]"));
+  }
   return absl::OkStatus();
+}
+
+bool Tracker::AddStill(const RgbdFrame& frame, RgbdFrame& mean) {
+  const bool colors = !frame.color.empty() && frame.color.type() == CV_8UC3 &&
+                      frame.color.size() == frame.depth.size();
+  if (still_.frames == 0) {
+    still_.depth = cv::Mat(frame.depth.size(), CV_32FC1, cv::Scalar(0));
+    still_.count = cv::Mat(frame.depth.size(), CV_8UC1, cv::Scalar(0));
+    still_.color =
+        colors ? cv::Mat(frame.depth.size(), CV_16UC3, cv::Scalar::all(0))
+               : cv::Mat();
+  }
+  for (int v = 0; v < frame.depth.rows; ++v) {
+    const float* z = frame.depth.ptr<float>(v);
+    float* sum = still_.depth.ptr<float>(v);
+    uint8_t* count = still_.count.ptr<uint8_t>(v);
+    for (int u = 0; u < frame.depth.cols; ++u) {
+      if (z[u] > 0.0f && std::isfinite(z[u])) {
+        sum[u] += z[u];
+        ++count[u];
+      }
+    }
+  }
+  if (!still_.color.empty() && colors)
+    cv::add(still_.color, frame.color, still_.color, cv::noArray(), CV_16UC3);
+  ++still_.frames;
+  if (still_.frames < options_.refine_frames) return false;
+  mean.intrinsics = frame.intrinsics;
+  mean.depth = cv::Mat(frame.depth.size(), CV_32FC1, cv::Scalar(0));
+  for (int v = 0; v < mean.depth.rows; ++v) {
+    const float* sum = still_.depth.ptr<float>(v);
+    const uint8_t* count = still_.count.ptr<uint8_t>(v);
+    float* z = mean.depth.ptr<float>(v);
+    for (int u = 0; u < mean.depth.cols; ++u) {
+      if (2 * count[u] >= still_.frames && count[u] > 0) {
+        z[u] = sum[u] / static_cast<float>(count[u]);
+      }
+    }
+  }
+  if (!still_.color.empty()) {
+    still_.color.convertTo(mean.color, CV_8UC3, 1.0 / still_.frames);
+  } else {
+    mean.color = frame.color;
+  }
+  still_ = StillSum();
+  return true;
 }
 
 Tracker::Tracker(const TrackerOptions& options, const RbfSvm* relation_svm)
@@ -304,7 +354,21 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
   out.changed_fraction = still ? ChangedFraction(frame, changed) : 1.0;
   clock.Lap("change");
 
-  const bool reuse = still && out.changed_fraction <= options_.static_fraction;
+  bool reuse = still && out.changed_fraction <= options_.static_fraction;
+  // The frame segmented: this one, or the mean of a still period's.
+  RgbdFrame mean;
+  if (reuse && options_.refine_frames > 0 && !refined_) {
+    if (still_.frames == 0) AddStill(reference_, mean);
+    if (AddStill(frame, mean)) {
+      reuse = false;
+      refined_ = true;
+      out.refined = true;
+    }
+  } else if (!reuse) {
+    still_ = StillSum();
+    refined_ = false;
+  }
+  const RgbdFrame& input = out.refined ? mean : frame;
   if (reuse) {
     out.reused = true;
     for (Track& t : tracks) {
@@ -324,9 +388,11 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
     std::vector<SegmentedObject>& found = a.found;
     // What changed is where attention goes first.
     IncrementalOptions segment = options_.segment;
-    if (still && segment.change_weight > 0.0f) segment.change = changed;
+    if (still && !out.refined && segment.change_weight > 0.0f) {
+      segment.change = changed;
+    }
     FOVEA_ASSIGN_OR_RETURN(out.support_kept,
-                           Segment(frame, std::move(segment), camera_to_world,
+                           Segment(input, std::move(segment), camera_to_world,
                                    out.changed_fraction, found, interrupt));
     clock.Lap("segment");
 
@@ -393,7 +459,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
     }
 
     if (options_.reidentify_distance > 0.0f) {
-      Reidentify(frame.color, found, world, shift, tracks, candidates, match);
+      Reidentify(input.color, found, world, shift, tracks, candidates, match);
     }
 
     std::vector<int>& track_of = a.track_of;
@@ -433,7 +499,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
                 ? TrackState::kMoved
                 : TrackState::kKept;
         t.object = found[j];
-        t.appearance = Appearance(frame.color, found[j]);
+        t.appearance = Appearance(input.color, found[j]);
         t.world_centroid = world[j];
         t.last_seen_frame = frame_index_;
         t.composite = t.composite || composite[j];
@@ -460,7 +526,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
         }
         if (t.id == 0) t.id = next_id_++;
         t.object = found[j];
-        t.appearance = Appearance(frame.color, found[j]);
+        t.appearance = Appearance(input.color, found[j]);
         t.world_centroid = world[j];
         t.last_seen_frame = frame_index_;
         result.track_id = t.id;
@@ -488,8 +554,8 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
                                                  options_.remember_frames;
                                 }),
                  tracks.end());
-    reference_.color = frame.color.clone();
-    reference_.depth = frame.depth.clone();
+    reference_.color = input.color.clone();
+    reference_.depth = input.depth.clone();
     reference_.intrinsics = frame.intrinsics;
     reference_pose_ = camera_to_world;
     ++segmentations_;

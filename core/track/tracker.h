@@ -90,6 +90,14 @@ struct TrackerOptions {
   bool reuse_support = true;
   double reuse_support_changed = 0.1;
   double support_fit = 0.8;
+  // A still scene is looked at again: once refine_frames frames in a row
+  // are unchanged (the one last segmented among them), their mean is
+  // segmented, once per still period: each pixel's depth over the frames
+  // with depth there (in at least half of them, else none), and its colour.
+  // The sensor's noise that differs frame to frame falls by sqrt(n), and the
+  // tracks are associated as with any frame. Its buffers live only while
+  // the frames are summed. 0: never; at most 64.
+  int refine_frames = 6;
   // A gone track may come back (same identity) within this many frames.
   int remember_frames = 30;
   // Re-identification: an object that matched no track (outside the gate:
@@ -122,6 +130,9 @@ struct TrackedFrame {
   std::vector<TrackedObject> objects;
   // The scene did not change: the last segmentation was reused.
   bool reused = false;
+  // The scene did not change for TrackerOptions::refine_frames frames, and
+  // their mean was segmented.
+  bool refined = false;
   // See TrackerOptions::static_fraction; 1 when the pose says the camera
   // moved (the pixels are then not compared).
   double changed_fraction = 0.0;
@@ -239,6 +250,20 @@ class Tracker {
   int next_id_ = 1;
   int frame_index_ = 0;
   int segmentations_ = 0;
+  // TrackerOptions::refine_frames: the unchanged frames summed since the
+  // last segmentation (empty once refined, or before the first unchanged
+  // frame), and whether this still period was refined.
+  struct StillSum {
+    int frames = 0;
+    cv::Mat depth;  // CV_32FC1, the sum where there is depth
+    cv::Mat count;  // CV_8UC1, the frames with depth
+    cv::Mat color;  // CV_16UC3, the sum; empty without colour
+  };
+  // Adds `frame` to still_; once it holds refine_frames frames, their mean
+  // goes to `mean`, the buffers are freed and true is returned.
+  bool AddStill(const RgbdFrame& frame, RgbdFrame& mean);
+  StillSum still_;
+  bool refined_ = false;
 };
 
 }  // namespace fovea
