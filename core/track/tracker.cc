@@ -84,57 +84,64 @@ absl::Status Validate(const TrackerOptions& options) {
   if (options.remember_frames < 0) {
     return absl::InvalidArgumentError("track.remember_frames: must be >= 0");
   }
-  if (options.refine_frames < 0 || options.refine_frames > 64) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "track.refine_frames: ", options.refine_frames, " is not in [0, 64]"));
+  if (options.refine_frames < 0 || options.refine_frames == 1 ||
+      options.refine_frames > 64) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("track.refine_frames: ", options.refine_frames,
+                     " is not 0 or in [2, 64]"));
   }
   return absl::OkStatus();
 }
 
-bool Tracker::AddStill(const RgbdFrame& frame, RgbdFrame& mean) {
+void Tracker::AddStill(const RgbdFrame& frame, StillSum& sum) {
   const bool colors = !frame.color.empty() && frame.color.type() == CV_8UC3 &&
                       frame.color.size() == frame.depth.size();
-  if (still_.frames == 0) {
-    still_.depth = cv::Mat(frame.depth.size(), CV_32FC1, cv::Scalar(0));
-    still_.count = cv::Mat(frame.depth.size(), CV_8UC1, cv::Scalar(0));
-    still_.color =
-        colors ? cv::Mat(frame.depth.size(), CV_16UC3, cv::Scalar::all(0))
-               : cv::Mat();
+  if (sum.frames == 0) {
+    sum.intrinsics = frame.intrinsics;
+    sum.depth = cv::Mat(frame.depth.size(), CV_32FC1, cv::Scalar(0));
+    sum.count = cv::Mat(frame.depth.size(), CV_8UC1, cv::Scalar(0));
+    sum.color = colors
+                    ? cv::Mat(frame.depth.size(), CV_16UC3, cv::Scalar::all(0))
+                    : cv::Mat();
   }
   for (int v = 0; v < frame.depth.rows; ++v) {
     const float* z = frame.depth.ptr<float>(v);
-    float* sum = still_.depth.ptr<float>(v);
-    uint8_t* count = still_.count.ptr<uint8_t>(v);
+    float* total = sum.depth.ptr<float>(v);
+    uint8_t* count = sum.count.ptr<uint8_t>(v);
     for (int u = 0; u < frame.depth.cols; ++u) {
       if (z[u] > 0.0f && std::isfinite(z[u])) {
-        sum[u] += z[u];
+        total[u] += z[u];
         ++count[u];
       }
     }
   }
-  if (!still_.color.empty() && colors)
-    cv::add(still_.color, frame.color, still_.color, cv::noArray(), CV_16UC3);
-  ++still_.frames;
-  if (still_.frames < options_.refine_frames) return false;
-  mean.intrinsics = frame.intrinsics;
-  mean.depth = cv::Mat(frame.depth.size(), CV_32FC1, cv::Scalar(0));
+  if (!sum.color.empty()) {
+    // A frame without colour adds the mean so far, not black.
+    cv::Mat color = frame.color;
+    if (!colors) sum.color.convertTo(color, CV_8UC3, 1.0 / sum.frames);
+    cv::add(sum.color, color, sum.color, cv::noArray(), CV_16UC3);
+  }
+  ++sum.frames;
+}
+
+RgbdFrame Tracker::StillMean(const StillSum& sum) {
+  RgbdFrame mean;
+  mean.intrinsics = sum.intrinsics;
+  mean.depth = cv::Mat(sum.depth.size(), CV_32FC1, cv::Scalar(0));
   for (int v = 0; v < mean.depth.rows; ++v) {
-    const float* sum = still_.depth.ptr<float>(v);
-    const uint8_t* count = still_.count.ptr<uint8_t>(v);
+    const float* total = sum.depth.ptr<float>(v);
+    const uint8_t* count = sum.count.ptr<uint8_t>(v);
     float* z = mean.depth.ptr<float>(v);
     for (int u = 0; u < mean.depth.cols; ++u) {
-      if (2 * count[u] >= still_.frames && count[u] > 0) {
-        z[u] = sum[u] / static_cast<float>(count[u]);
+      if (count[u] > 0 && 2 * count[u] >= sum.frames) {
+        z[u] = total[u] / static_cast<float>(count[u]);
       }
     }
   }
-  if (!still_.color.empty()) {
-    still_.color.convertTo(mean.color, CV_8UC3, 1.0 / still_.frames);
-  } else {
-    mean.color = frame.color;
+  if (!sum.color.empty()) {
+    sum.color.convertTo(mean.color, CV_8UC3, 1.0 / sum.frames);
   }
-  still_ = StillSum();
-  return true;
+  return mean;
 }
 
 Tracker::Tracker(const TrackerOptions& options, const RbfSvm* relation_svm)
@@ -356,17 +363,30 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
 
   bool reuse = still && out.changed_fraction <= options_.static_fraction;
   // The frame segmented: this one, or the mean of a still period's.
+  // Until the segmentation succeeds, still_ is left as it was (the
+  // refining frame sums a copy).
   RgbdFrame mean;
   if (reuse && options_.refine_frames > 0 && !refined_) {
-    if (still_.frames == 0) AddStill(reference_, mean);
-    if (AddStill(frame, mean)) {
+    const int summed = std::max(still_.frames, 1);  // reference_ counts
+    if (summed + 1 < options_.refine_frames) {
+      if (still_.frames == 0) AddStill(reference_, still_);
+      AddStill(frame, still_);
+    } else {
+      StillSum sum;
+      if (still_.frames == 0) {
+        AddStill(reference_, sum);
+      } else {
+        sum = still_;
+        sum.depth = still_.depth.clone();
+        sum.count = still_.count.clone();
+        sum.color = still_.color.clone();
+      }
+      AddStill(frame, sum);
+      mean = StillMean(sum);
+      if (mean.color.empty()) mean.color = frame.color;
       reuse = false;
-      refined_ = true;
       out.refined = true;
     }
-  } else if (!reuse) {
-    still_ = StillSum();
-    refined_ = false;
   }
   const RgbdFrame& input = out.refined ? mean : frame;
   if (reuse) {
@@ -557,6 +577,9 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
     reference_.color = input.color.clone();
     reference_.depth = input.depth.clone();
     reference_.intrinsics = frame.intrinsics;
+    // A changed scene starts a still period; a refined one has ended its.
+    still_ = StillSum();
+    refined_ = out.refined;
     reference_pose_ = camera_to_world;
     ++segmentations_;
     clock.Lap("associate");

@@ -96,7 +96,7 @@ struct TrackerOptions {
   // with depth there (in at least half of them, else none), and its colour.
   // The sensor's noise that differs frame to frame falls by sqrt(n), and the
   // tracks are associated as with any frame. Its buffers live only while
-  // the frames are summed. 0: never; at most 64.
+  // the frames are summed. 0: never; else 2 to 64.
   int refine_frames = 6;
   // A gone track may come back (same identity) within this many frames.
   int remember_frames = 30;
@@ -255,13 +255,15 @@ class Tracker {
   // frame), and whether this still period was refined.
   struct StillSum {
     int frames = 0;
+    Intrinsics intrinsics;
     cv::Mat depth;  // CV_32FC1, the sum where there is depth
     cv::Mat count;  // CV_8UC1, the frames with depth
     cv::Mat color;  // CV_16UC3, the sum; empty without colour
   };
-  // Adds `frame` to still_; once it holds refine_frames frames, their mean
-  // goes to `mean`, the buffers are freed and true is returned.
-  bool AddStill(const RgbdFrame& frame, RgbdFrame& mean);
+  // Adds `frame` to `sum` (allocated at its first frame).
+  static void AddStill(const RgbdFrame& frame, StillSum& sum);
+  // The mean of `sum`: depth where at least half its frames had some.
+  static RgbdFrame StillMean(const StillSum& sum);
   StillSum still_;
   bool refined_ = false;
 };

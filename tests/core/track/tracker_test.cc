@@ -163,6 +163,30 @@ TEST(Tracker, AStillSceneIsCutAgainOnceOnTheMeanOfItsFrames) {
   for (size_t t = 1; t < frames.size(); ++t) EXPECT_TRUE(frames[t].reused);
   off.refine_frames = 65;
   EXPECT_FALSE(Validate(off).ok());
+  off.refine_frames = 1;
+  EXPECT_FALSE(Validate(off).ok());
+}
+
+TEST(Tracker, ARefinedCutThatFailsLeavesTheStillPeriodAsItWas) {
+  // The sixth frame's refined cut is interrupted: the call fails, and the
+  // same frame sent again is refined (the sums were not consumed).
+  ASSERT_NE(Models(), nullptr);
+  const Sequence sequence = GenerateSequence(SequenceKind::kStatic, 2, 6);
+  Tracker tracker(TrackerOptions{}, &*Models()->inc);
+  for (int t = 0; t < 5; ++t) {
+    ASSERT_TRUE(tracker.Process(sequence.frames[t].frame.frame, std::nullopt)
+                    .ok());
+  }
+  const absl::StatusOr<TrackedFrame> stopped =
+      tracker.Process(sequence.frames[5].frame.frame, std::nullopt,
+                      [] { return absl::CancelledError("stop"); });
+  EXPECT_EQ(stopped.status().code(), absl::StatusCode::kCancelled);
+  EXPECT_EQ(tracker.segmentations(), 1);
+  const absl::StatusOr<TrackedFrame> again =
+      tracker.Process(sequence.frames[5].frame.frame, std::nullopt);
+  ASSERT_TRUE(again.ok()) << again.status();
+  EXPECT_TRUE(again->refined);
+  EXPECT_EQ(tracker.segmentations(), 2);
 }
 
 TEST(Tracker, AnObjectTakenAwayIsGoneOnceAndTheOthersKeepTheirIdentities) {
