@@ -174,8 +174,8 @@ TEST(Tracker, ARefinedCutThatFailsLeavesTheStillPeriodAsItWas) {
   const Sequence sequence = GenerateSequence(SequenceKind::kStatic, 2, 6);
   Tracker tracker(TrackerOptions{}, &*Models()->inc);
   for (int t = 0; t < 5; ++t) {
-    ASSERT_TRUE(tracker.Process(sequence.frames[t].frame.frame, std::nullopt)
-                    .ok());
+    ASSERT_TRUE(
+        tracker.Process(sequence.frames[t].frame.frame, std::nullopt).ok());
   }
   const absl::StatusOr<TrackedFrame> stopped =
       tracker.Process(sequence.frames[5].frame.frame, std::nullopt,
