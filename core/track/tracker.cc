@@ -93,55 +93,17 @@ absl::Status Validate(const TrackerOptions& options) {
   return absl::OkStatus();
 }
 
-void Tracker::AddStill(const RgbdFrame& frame, StillSum& sum) {
-  const bool colors = !frame.color.empty() && frame.color.type() == CV_8UC3 &&
-                      frame.color.size() == frame.depth.size();
-  if (sum.frames == 0) {
-    sum.intrinsics = frame.intrinsics;
-    sum.depth = cv::Mat(frame.depth.size(), CV_32FC1, cv::Scalar(0));
-    sum.count = cv::Mat(frame.depth.size(), CV_8UC1, cv::Scalar(0));
-    sum.color = colors
-                    ? cv::Mat(frame.depth.size(), CV_16UC3, cv::Scalar::all(0))
-                    : cv::Mat();
-  }
-  for (int v = 0; v < frame.depth.rows; ++v) {
-    const float* z = frame.depth.ptr<float>(v);
-    float* total = sum.depth.ptr<float>(v);
-    uint8_t* count = sum.count.ptr<uint8_t>(v);
-    for (int u = 0; u < frame.depth.cols; ++u) {
-      if (z[u] > 0.0f && std::isfinite(z[u])) {
-        total[u] += z[u];
-        ++count[u];
-      }
+void Tracker::AverageInto(const cv::Mat& depth, cv::Mat& mean, cv::Mat& count) {
+  for (int v = 0; v < depth.rows; ++v) {
+    const float* z = depth.ptr<float>(v);
+    float* m = mean.ptr<float>(v);
+    uint8_t* n = count.ptr<uint8_t>(v);
+    for (int u = 0; u < depth.cols; ++u) {
+      if (!(z[u] > 0.0f && std::isfinite(z[u]))) continue;
+      ++n[u];
+      m[u] = n[u] == 1 ? z[u] : m[u] + (z[u] - m[u]) / static_cast<float>(n[u]);
     }
   }
-  if (!sum.color.empty()) {
-    // A frame without colour adds the mean so far, not black.
-    cv::Mat color = frame.color;
-    if (!colors) sum.color.convertTo(color, CV_8UC3, 1.0 / sum.frames);
-    cv::add(sum.color, color, sum.color, cv::noArray(), CV_16UC3);
-  }
-  ++sum.frames;
-}
-
-RgbdFrame Tracker::StillMean(const StillSum& sum) {
-  RgbdFrame mean;
-  mean.intrinsics = sum.intrinsics;
-  mean.depth = cv::Mat(sum.depth.size(), CV_32FC1, cv::Scalar(0));
-  for (int v = 0; v < mean.depth.rows; ++v) {
-    const float* total = sum.depth.ptr<float>(v);
-    const uint8_t* count = sum.count.ptr<uint8_t>(v);
-    float* z = mean.depth.ptr<float>(v);
-    for (int u = 0; u < mean.depth.cols; ++u) {
-      if (count[u] > 0 && 2 * count[u] >= sum.frames) {
-        z[u] = total[u] / static_cast<float>(count[u]);
-      }
-    }
-  }
-  if (!sum.color.empty()) {
-    sum.color.convertTo(mean.color, CV_8UC3, 1.0 / sum.frames);
-  }
-  return mean;
 }
 
 Tracker::Tracker(const TrackerOptions& options, const RbfSvm* relation_svm)
@@ -362,28 +324,28 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
   clock.Lap("change");
 
   bool reuse = still && out.changed_fraction <= options_.static_fraction;
-  // The frame segmented: this one, or the mean of a still period's.
-  // Until the segmentation succeeds, still_ is left as it was (the
-  // refining frame sums a copy).
+  // The frame segmented: this one, or the mean of a still period's. Until
+  // the segmentation succeeds, the mean so far is left as it was (the
+  // refining frame averages into a copy).
   RgbdFrame mean;
   if (reuse && options_.refine_frames > 0 && !refined_) {
-    const int summed = std::max(still_.frames, 1);  // reference_ counts
-    if (summed + 1 < options_.refine_frames) {
-      if (still_.frames == 0) AddStill(reference_, still_);
-      AddStill(frame, still_);
+    if (still_frames_ == 0) {
+      still_count_ = cv::Mat(reference_.depth.size(), CV_8UC1, cv::Scalar(0));
+      cv::Mat first = reference_.depth.clone();
+      AverageInto(first, reference_.depth, still_count_);
+      still_frames_ = 1;
+    }
+    if (still_frames_ + 1 < options_.refine_frames) {
+      AverageInto(frame.depth, reference_.depth, still_count_);
+      ++still_frames_;
     } else {
-      StillSum sum;
-      if (still_.frames == 0) {
-        AddStill(reference_, sum);
-      } else {
-        sum = still_;
-        sum.depth = still_.depth.clone();
-        sum.count = still_.count.clone();
-        sum.color = still_.color.clone();
-      }
-      AddStill(frame, sum);
-      mean = StillMean(sum);
-      if (mean.color.empty()) mean.color = frame.color;
+      mean.intrinsics = frame.intrinsics;
+      mean.color = reference_.color;
+      mean.depth = reference_.depth.clone();
+      cv::Mat count = still_count_.clone();
+      AverageInto(frame.depth, mean.depth, count);
+      // Depth only where at least half the frames had some.
+      mean.depth.setTo(0.0f, count * 2 < still_frames_ + 1);
       reuse = false;
       out.refined = true;
     }
@@ -578,7 +540,8 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
     reference_.depth = input.depth.clone();
     reference_.intrinsics = frame.intrinsics;
     // A changed scene starts a still period; a refined one has ended its.
-    still_ = StillSum();
+    still_frames_ = 0;
+    still_count_.release();
     refined_ = out.refined;
     reference_pose_ = camera_to_world;
     ++segmentations_;

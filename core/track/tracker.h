@@ -92,11 +92,13 @@ struct TrackerOptions {
   double support_fit = 0.8;
   // A still scene is looked at again: once refine_frames frames in a row
   // are unchanged (the one last segmented among them), their mean is
-  // segmented, once per still period: each pixel's depth over the frames
-  // with depth there (in at least half of them, else none), and its colour.
-  // The sensor's noise that differs frame to frame falls by sqrt(n), and the
-  // tracks are associated as with any frame. Its buffers live only while
-  // the frames are summed. 0: never; else 2 to 64.
+  // segmented, once per still period: each pixel's depth averaged over the
+  // frames with depth there (in at least half of them, else none), with the
+  // colour of the frame last segmented. The sensor's depth noise that
+  // differs frame to frame falls by sqrt(n), and the tracks are associated
+  // as with any frame. The mean is kept in place of the frame last
+  // segmented (which the change test compares with), plus a count per
+  // pixel. 0: never; else 2 to 64.
   int refine_frames = 6;
   // A gone track may come back (same identity) within this many frames.
   int remember_frames = 30;
@@ -250,22 +252,16 @@ class Tracker {
   int next_id_ = 1;
   int frame_index_ = 0;
   int segmentations_ = 0;
-  // TrackerOptions::refine_frames: the unchanged frames summed since the
-  // last segmentation (empty once refined, or before the first unchanged
-  // frame), and whether this still period was refined.
-  struct StillSum {
-    int frames = 0;
-    Intrinsics intrinsics;
-    cv::Mat depth;  // CV_32FC1, the sum where there is depth
-    cv::Mat count;  // CV_8UC1, the frames with depth
-    cv::Mat color;  // CV_16UC3, the sum; empty without colour
-  };
-  // Adds `frame` to `sum` (allocated at its first frame).
-  static void AddStill(const RgbdFrame& frame, StillSum& sum);
-  // The mean of `sum`: depth where at least half its frames had some.
-  static RgbdFrame StillMean(const StillSum& sum);
-  StillSum still_;
+  // TrackerOptions::refine_frames: the unchanged frames whose depth is
+  // averaged into reference_.depth since the last segmentation (0: none
+  // yet), how many of them had depth at each pixel (CV_8UC1; empty while
+  // none), and whether this still period was refined.
+  int still_frames_ = 0;
+  cv::Mat still_count_;
   bool refined_ = false;
+  // Averages `depth` into `mean` (CV_32FC1) where it has depth; `count`
+  // (CV_8UC1) counts the frames averaged at each pixel.
+  static void AverageInto(const cv::Mat& depth, cv::Mat& mean, cv::Mat& count);
 };
 
 }  // namespace fovea
