@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "core/base/status_macros.h"
 
@@ -19,6 +20,16 @@ void Sample(const std::vector<Eigen::Vector3f>& points, int limit,
   const size_t stride =
       std::max<size_t>(1, (points.size() + limit - 1) / std::max(1, limit));
   for (size_t i = 0; i < points.size(); i += stride) out.push_back(points[i]);
+}
+
+// Two unit axes normal to the unit `n` and to each other.
+std::pair<Eigen::Vector3d, Eigen::Vector3d> AxesAcross(
+    const Eigen::Vector3d& n) {
+  const Eigen::Vector3d helper = std::abs(n.x()) < 0.9
+                                     ? Eigen::Vector3d::UnitX()
+                                     : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d u = n.cross(helper).normalized();
+  return {u, n.cross(u)};
 }
 
 // The least-squares solution of |q|^2 + g . q + f = 0 over `q` (rows of
@@ -93,13 +104,7 @@ std::optional<BodyFit> FitSphere(const std::vector<Eigen::Vector3f>& points) {
 
 std::optional<BodyFit> FitUprightCylinder(
     const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& up) {
-  // Two axes normal to `up`.
-  const Eigen::Vector3d n = up.cast<double>().normalized();
-  const Eigen::Vector3d helper = std::abs(n.x()) < 0.9
-                                     ? Eigen::Vector3d::UnitX()
-                                     : Eigen::Vector3d::UnitY();
-  const Eigen::Vector3d u = n.cross(helper).normalized();
-  const Eigen::Vector3d v = n.cross(u);
+  const auto [u, v] = AxesAcross(up.cast<double>().normalized());
   std::vector<Eigen::Vector2d> q;
   q.reserve(points.size());
   for (const Eigen::Vector3f& p : points) {
@@ -114,12 +119,15 @@ std::optional<BodyFit> FitUprightCylinder(
   return fit;
 }
 
-std::optional<BodyFit> FitUprightCone(
-    const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& up) {
-  std::optional<BodyFit> fit = FitUprightCylinder(points, up);
-  if (!fit.has_value() || points.size() < 5) return std::nullopt;
+namespace {
+
+// FitUprightCone from `cylinder`, the points' FitUprightCylinder.
+std::optional<BodyFit> ConeFromCylinder(
+    const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& up,
+    const BodyFit& cylinder) {
+  if (points.size() < 5) return std::nullopt;
   const Eigen::Vector3d n = up.cast<double>().normalized();
-  const Eigen::Vector3d center = fit->center.cast<double>();
+  const Eigen::Vector3d center = cylinder.center.cast<double>();
   // Each point: its offset from the cylinder's axis across `up` and its
   // height along it, centred.
   std::vector<Eigen::Vector3d> across;
@@ -138,12 +146,8 @@ std::optional<BodyFit> FitUprightCone(
   // Gauss-Newton on the distance to the cone: the axis' offset (two
   // coordinates across `up`), the radius at the mean height and the taper,
   // from the cylinder.
-  const Eigen::Vector3d helper = std::abs(n.x()) < 0.9
-                                     ? Eigen::Vector3d::UnitX()
-                                     : Eigen::Vector3d::UnitY();
-  const Eigen::Vector3d u = n.cross(helper).normalized();
-  const Eigen::Vector3d v = n.cross(u);
-  Eigen::Vector4d x(0.0, 0.0, fit->radius, 0.0);
+  const auto [u, v] = AxesAcross(n);
+  Eigen::Vector4d x(0.0, 0.0, cylinder.radius, 0.0);
   // The normal equations J^T J step = -J^T e of the residuals at `at`;
   // returns the sum of squared residuals.
   const auto accumulate = [&](const Eigen::Vector4d& at, Eigen::Matrix4d* jtj,
@@ -181,6 +185,15 @@ std::optional<BodyFit> FitUprightCone(
   return cone;
 }
 
+}  // namespace
+
+std::optional<BodyFit> FitUprightCone(
+    const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& up) {
+  const std::optional<BodyFit> cylinder = FitUprightCylinder(points, up);
+  if (!cylinder.has_value()) return std::nullopt;
+  return ConeFromCylinder(points, up, *cylinder);
+}
+
 bool OnOneBody(const std::vector<Eigen::Vector3f>& a,
                const std::vector<Eigen::Vector3f>& b, const Eigen::Vector3f& up,
                const BodyFitOptions& options) {
@@ -210,7 +223,7 @@ bool OnOneBody(const std::vector<Eigen::Vector3f>& a,
       cylinder->rms > kConeSearchRms * max_rms) {
     return false;
   }
-  const std::optional<BodyFit> cone = FitUprightCone(both, up);
+  const std::optional<BodyFit> cone = ConeFromCylinder(both, up, *cylinder);
   return fits(cone) && std::abs(cone->taper) <= options.max_taper;
 }
 

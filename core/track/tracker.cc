@@ -331,8 +331,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
   if (reuse && options_.refine_frames > 0 && !refined_) {
     if (still_frames_ == 0) {
       still_count_ = cv::Mat(reference_.depth.size(), CV_8UC1, cv::Scalar(0));
-      cv::Mat first = reference_.depth.clone();
-      AverageInto(first, reference_.depth, still_count_);
+      AverageInto(reference_.depth, reference_.depth, still_count_);
       still_frames_ = 1;
     }
     if (still_frames_ + 1 < options_.refine_frames) {

@@ -260,7 +260,8 @@ class Tracker {
   cv::Mat still_count_;
   bool refined_ = false;
   // Averages `depth` into `mean` (CV_32FC1) where it has depth; `count`
-  // (CV_8UC1) counts the frames averaged at each pixel.
+  // (CV_8UC1) counts the frames averaged at each pixel. `depth` may be
+  // `mean` itself (with `count` 0: counts its pixels with depth).
   static void AverageInto(const cv::Mat& depth, cv::Mat& mean, cv::Mat& count);
 };
 

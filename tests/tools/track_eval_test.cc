@@ -6,15 +6,25 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace fovea::eval {
 namespace {
 
+// A frame's identities: truths, tracks and the matched (truth, track) pairs.
+FrameIdentities Frame(int truths, int tracks,
+                      std::vector<std::pair<int, int>> matched) {
+  FrameIdentities f;
+  f.truths = truths;
+  f.tracks = tracks;
+  f.matched = std::move(matched);
+  return f;
+}
+
 TEST(CountIdentities, AFlawlessSequenceScoresOne) {
   // Two objects, tracks 7 and 9, matched in all three frames.
-  std::vector<FrameIdentities> frames(3,
-                                      FrameIdentities{2, 2, {{0, 7}, {1, 9}}});
+  std::vector<FrameIdentities> frames(3, Frame(2, 2, {{0, 7}, {1, 9}}));
   const IdentityCounts c = CountIdentities(frames);
   EXPECT_EQ(c.idtp, 6);
   EXPECT_EQ(c.idfp, 0);
@@ -27,7 +37,8 @@ TEST(CountIdentities, AFlawlessSequenceScoresOne) {
 TEST(CountIdentities, ASwitchCostsTheFramesAfterItAndCountsOnce) {
   // Object 0 is track 1 for two frames, then track 2 for two frames.
   std::vector<FrameIdentities> frames = {
-      {1, 1, {{0, 1}}}, {1, 1, {{0, 1}}}, {1, 1, {{0, 2}}}, {1, 1, {{0, 2}}}};
+      Frame(1, 1, {{0, 1}}), Frame(1, 1, {{0, 1}}), Frame(1, 1, {{0, 2}}),
+      Frame(1, 1, {{0, 2}})};
   const IdentityCounts c = CountIdentities(frames);
   EXPECT_EQ(c.switches, 1);
   // One identity pairing keeps 2 of the 4 frames: IDTP 2, IDFN 2, IDFP 2.
@@ -39,7 +50,8 @@ TEST(CountIdentities, ASwitchCostsTheFramesAfterItAndCountsOnce) {
 
 TEST(CountIdentities, MissesAndExtraTracksLowerIdf1WithoutSwitches) {
   // One object seen in 2 frames, found in 1; a stray track in frame 2.
-  std::vector<FrameIdentities> frames = {{1, 1, {{0, 4}}}, {1, 1, {}}};
+  std::vector<FrameIdentities> frames = {Frame(1, 1, {{0, 4}}),
+                                         Frame(1, 1, {})};
   const IdentityCounts c = CountIdentities(frames);
   EXPECT_EQ(c.switches, 0);
   EXPECT_EQ(c.idtp, 1);
