@@ -26,7 +26,6 @@
 namespace fovea::client {
 namespace {
 
-using server::testing::FreePort;
 using server::testing::HealthStatus;
 using server::testing::MakeSyntheticRequest;
 using server::testing::WaitFor;
@@ -230,7 +229,7 @@ class RoundRobinTest : public ::testing::Test {
   void SetUp() override {
     for (Replica& replica : replicas_) {
       server::ServerConfig config;
-      config.listen = absl::StrCat("127.0.0.1:", FreePort());
+      config.listen = "127.0.0.1:0";  // the kernel picks; see server_fixture.cc
       config.concurrency = 2;
       config.queue = 4;
       config.warm_up = false;  // SERVING at once

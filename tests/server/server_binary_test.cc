@@ -395,25 +395,43 @@ TEST(ServerBinaryTest, MutualTlsServesOnlyClientsWithACertificate) {
 #endif
   const std::string dir = MakeCertificates();
   if (dir.empty()) GTEST_SKIP() << "openssl could not make certificates";
-  const int port = FreePort();
-  const std::string target = "127.0.0.1:" + std::to_string(port);
-  const pid_t pid = Spawn(
-      {"--listen=" + target, "--metrics_listen=", "--concurrency=1",
-       "--tls_cert=" + dir + "/server.pem", "--tls_key=" + dir + "/server.key",
-       "--tls_client_ca=" + dir + "/ca.pem"});
-  ASSERT_GT(pid, 0);
   grpc::SslCredentialsOptions with_cert;
   with_cert.pem_root_certs = ReadAll(dir + "/ca.pem");
   with_cert.pem_cert_chain = ReadAll(dir + "/client.pem");
   with_cert.pem_private_key = ReadAll(dir + "/client.key");
   grpc::SslCredentialsOptions without_cert;
   without_cert.pem_root_certs = with_cert.pem_root_certs;
-  EXPECT_TRUE(WaitFor(
-      [&] {
-        return DetectWith(target, grpc::SslCredentials(with_cert)) ==
-               grpc::StatusCode::OK;
-      },
-      std::chrono::seconds(60)));
+  // Started again on a fresh port if it exits early: the port FreePort()
+  // found can be taken before the child binds it (see StartServing).
+  std::string target;
+  pid_t pid = -1;
+  bool served = false;
+  bool exited = false;
+  for (int attempt = 0; attempt < 3 && !served; ++attempt) {
+    target = "127.0.0.1:" + std::to_string(FreePort());
+    pid = Spawn({"--listen=" + target, "--metrics_listen=", "--concurrency=1",
+                 "--tls_cert=" + dir + "/server.pem",
+                 "--tls_key=" + dir + "/server.key",
+                 "--tls_client_ca=" + dir + "/ca.pem"});
+    ASSERT_GT(pid, 0);
+    exited = false;
+    served = WaitFor(
+                 [&] {
+                   exited = waitpid(pid, nullptr, WNOHANG) == pid;
+                   return exited ||
+                          DetectWith(target, grpc::SslCredentials(with_cert)) ==
+                              grpc::StatusCode::OK;
+                 },
+                 std::chrono::seconds(60)) &&
+             !exited;
+    if (!exited && !served) break;
+  }
+  if (!served && !exited) {
+    kill(pid, SIGKILL);
+    waitpid(pid, nullptr, 0);
+  }
+  ASSERT_TRUE(served) << "the mutual-TLS server never served a client with a "
+                         "certificate";
   EXPECT_NE(DetectWith(target, grpc::SslCredentials(without_cert)),
             grpc::StatusCode::OK);
   EXPECT_NE(DetectWith(target, grpc::InsecureChannelCredentials()),

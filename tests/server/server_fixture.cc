@@ -38,8 +38,11 @@ void Gate::Pass() {
 }
 
 void ServerTest::StartServer(ServerConfig config, bool wait_serving) {
-  config.listen = "127.0.0.1:" + std::to_string(FreePort());
-  config.metrics_listen = "127.0.0.1:" + std::to_string(FreePort());
+  // Port 0: the server binds a port the kernel picks. A port FreePort()
+  // found free can be taken, before the server binds it, as the source
+  // port of another test's connection (CI failed so: EADDRINUSE).
+  config.listen = "127.0.0.1:0";
+  config.metrics_listen = "127.0.0.1:0";
   config.before_detect_job = [this] {
     gate_.Pass();
     ThrowIfAsked();
@@ -100,6 +103,10 @@ std::future<grpc::Status> ServerTest::StartHeldDetect(
 }
 
 std::string ServerTest::Scrape() {
+  if (server_ == nullptr) {
+    ADD_FAILURE() << "no server to scrape";
+    return "";
+  }
   std::optional<std::string> text =
       HttpGet(server_->metrics_port(), "/metrics");
   EXPECT_TRUE(text.has_value());

@@ -66,22 +66,16 @@ struct ServerProcess {
 
 // Starts fovea-server and waits (up to 60 s) for health SERVING on both
 // names. Fails the test (ADD_FAILURE) and returns pid -1 when it exits
-// early or never serves.
+// early or never serves. A port FreePort() found free can be taken before
+// the child binds it (as the source port of another test's connection):
+// a child that exits early is started again on fresh ports, twice at most.
 inline ServerProcess StartServing(const std::vector<std::string>& flags,
                                   int nofile = 0) {
+  constexpr int kAttempts = 3;
   ServerProcess server;
-  const int port = FreePort();
-  server.metrics_port = FreePort();
-  server.target = "127.0.0.1:" + std::to_string(port);
-  std::vector<std::string> args = flags;
-  args.push_back("--listen=" + server.target);
-  args.push_back("--metrics_listen=127.0.0.1:" +
-                 std::to_string(server.metrics_port));
-  server.pid = Spawn(args, nofile);
-  if (server.pid <= 0) {
-    ADD_FAILURE() << "fork failed";
-    return server;
-  }
+  int status = 0;
+  bool exited = false;
+  bool serving = false;
   // A fresh channel per attempt: a channel that tried before the server
   // listened may wait out gRPC's reconnect backoff (seconds).
   auto health = [&server](const std::string& service) {
@@ -89,16 +83,30 @@ inline ServerProcess StartServing(const std::vector<std::string>& flags,
         grpc::CreateChannel(server.target, grpc::InsecureChannelCredentials()),
         service);
   };
-  int status = 0;
-  bool exited = false;
-  const bool serving = WaitFor(
-      [&] {
-        exited = waitpid(server.pid, &status, WNOHANG) == server.pid;
-        return exited || health("fovea.v1.Perception") == "SERVING";
-      },
-      std::chrono::seconds(60));
+  for (int attempt = 0; attempt < kAttempts; ++attempt) {
+    server.metrics_port = FreePort();
+    server.target = "127.0.0.1:" + std::to_string(FreePort());
+    std::vector<std::string> args = flags;
+    args.push_back("--listen=" + server.target);
+    args.push_back("--metrics_listen=127.0.0.1:" +
+                   std::to_string(server.metrics_port));
+    server.pid = Spawn(args, nofile);
+    if (server.pid <= 0) {
+      ADD_FAILURE() << "fork failed";
+      return server;
+    }
+    exited = false;
+    serving = WaitFor(
+        [&] {
+          exited = waitpid(server.pid, &status, WNOHANG) == server.pid;
+          return exited || health("fovea.v1.Perception") == "SERVING";
+        },
+        std::chrono::seconds(60));
+    if (!exited) break;
+  }
   if (exited || !serving || health("") != "SERVING") {
-    ADD_FAILURE() << (exited ? "exited early, wait status " +
+    ADD_FAILURE() << (exited ? "exited early " + std::to_string(kAttempts) +
+                                   " times, last wait status " +
                                    std::to_string(status)
                              : std::string("not SERVING within 60 s"));
     if (!exited) {

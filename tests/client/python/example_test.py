@@ -14,8 +14,6 @@ import os
 import struct
 import tempfile
 import zlib
-import signal
-import socket
 import subprocess
 import sys
 import time
@@ -28,6 +26,8 @@ try:
 except ImportError as e:
     print(f"skipped: {e}")
     sys.exit(77)
+
+import server_process  # noqa: E402  (beside this script)
 
 ARGS = None  # set in __main__
 
@@ -52,46 +52,26 @@ def write_png(path, pixels, bit_depth, color_type):
         f.write(chunk(b"IEND", b""))
 
 
-def free_port():
-    """A TCP port on 127.0.0.1 that was free a moment ago."""
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 class ExampleTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.target = f"127.0.0.1:{free_port()}"
-        cls.server = subprocess.Popen(
-            [ARGS.server_binary, f"--listen={cls.target}", "--metrics_listen=",
-             f"--models_dir={ARGS.models_dir}", "--concurrency=1"])
-        deadline = time.monotonic() + 60
-        status = None
-        while time.monotonic() < deadline and cls.server.poll() is None:
+        def is_serving(target):
             # A fresh channel per attempt: one that tried before the server
             # listened may wait out gRPC's reconnect backoff.
-            with FoveaClient(cls.target) as client:
+            with FoveaClient(target) as client:
                 try:
-                    status = client.health(timeout=1.0)
+                    return client.health(timeout=1.0) == "SERVING"
                 except grpc.RpcError:
-                    status = None
-            if status == "SERVING":
-                return
-            time.sleep(0.1)
-        cls.tearDownClass()
-        raise AssertionError(f"fovea-server not SERVING within 60 s "
-                             f"(exit code {cls.server.returncode})")
+                    return False
+
+        cls.server, cls.target = server_process.start_serving(
+            [ARGS.server_binary, "--metrics_listen=",
+             f"--models_dir={ARGS.models_dir}", "--concurrency=1"],
+            is_serving)
 
     @classmethod
     def tearDownClass(cls):
-        if cls.server.poll() is None:
-            cls.server.send_signal(signal.SIGTERM)
-            try:
-                cls.server.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                cls.server.kill()
-                cls.server.wait()
+        server_process.stop(cls.server)
 
     def test_capabilities_list_cos(self):
         with FoveaClient(self.target) as client:

@@ -10,12 +10,9 @@ Python modules or openssl.
 import argparse
 import os
 import shutil
-import signal
-import socket
 import subprocess
 import sys
 import tempfile
-import time
 import unittest
 
 try:
@@ -28,13 +25,9 @@ if shutil.which("openssl") is None:
     print("skipped: no openssl")
     sys.exit(77)
 
+import server_process  # noqa: E402  (beside this script)
+
 ARGS = None  # set in __main__
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def make_certificates(folder):
@@ -63,34 +56,33 @@ class TlsTest(unittest.TestCase):
     def setUpClass(cls):
         cls.folder = tempfile.mkdtemp(prefix="fovea_tls_")
         make_certificates(cls.folder)
-        cls.target = f"127.0.0.1:{free_port()}"
-        cls.server = subprocess.Popen(
-            [ARGS.server_binary, f"--listen={cls.target}", "--metrics_listen=",
-             f"--models_dir={ARGS.models_dir}", "--concurrency=1",
-             f"--tls_cert={cls.folder}/server.pem",
-             f"--tls_key={cls.folder}/server.key",
-             f"--tls_client_ca={cls.folder}/ca.pem"])
         cls.ca = read(cls.folder, "ca.pem")
         cls.cert = read(cls.folder, "client.pem")
         cls.key = read(cls.folder, "client.key")
-        deadline = time.monotonic() + 60
-        while time.monotonic() < deadline and cls.server.poll() is None:
-            with FoveaClient(cls.target, tls_ca=cls.ca, tls_cert=cls.cert,
+
+        def is_serving(target):
+            with FoveaClient(target, tls_ca=cls.ca, tls_cert=cls.cert,
                              tls_key=cls.key) as client:
                 try:
-                    if client.health(timeout=1.0) == "SERVING":
-                        return
+                    return client.health(timeout=1.0) == "SERVING"
                 except grpc.RpcError:
-                    pass
-            time.sleep(0.2)
-        cls.tearDownClass()
-        raise AssertionError("fovea-server with TLS not SERVING within 60 s")
+                    return False
+
+        try:
+            cls.server, cls.target = server_process.start_serving(
+                [ARGS.server_binary, "--metrics_listen=",
+                 f"--models_dir={ARGS.models_dir}", "--concurrency=1",
+                 f"--tls_cert={cls.folder}/server.pem",
+                 f"--tls_key={cls.folder}/server.key",
+                 f"--tls_client_ca={cls.folder}/ca.pem"],
+                is_serving)
+        except AssertionError:
+            shutil.rmtree(cls.folder, ignore_errors=True)
+            raise
 
     @classmethod
     def tearDownClass(cls):
-        if cls.server.poll() is None:
-            cls.server.send_signal(signal.SIGTERM)
-            cls.server.wait(timeout=30)
+        server_process.stop(cls.server)
         shutil.rmtree(cls.folder, ignore_errors=True)
 
     def test_client_with_a_certificate_is_served(self):
