@@ -1,7 +1,9 @@
 #include "core/track/object_ops.h"
 
 #include <algorithm>
+#include <cmath>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 
 namespace fovea {
 
@@ -121,6 +123,38 @@ void KeepFormerIds(const Eigen::Vector3f& shift,
     if (was < 0) continue;
     p.former_id = before[was].former_id;
     p.former_frames_seen = before[was].former_frames_seen;
+  }
+}
+
+namespace {
+
+// The centroid of `object`'s mask in pixels; nullopt when it has none.
+std::optional<cv::Point2d> PixelCentroid(const SegmentedObject& object) {
+  const cv::Rect box =
+      object.box & cv::Rect(0, 0, object.mask.cols, object.mask.rows);
+  if (box.empty()) return std::nullopt;
+  const cv::Moments m = cv::moments(object.mask(box), true);
+  if (m.m00 <= 0.0) return std::nullopt;
+  return cv::Point2d(box.x + m.m10 / m.m00, box.y + m.m01 / m.m00);
+}
+
+}  // namespace
+
+void CarryPieces(const SegmentedObject& was, const Eigen::Vector3f& was_world,
+                 const SegmentedObject& now, const Eigen::Vector3f& now_world,
+                 std::vector<Piece>& pieces) {
+  const std::optional<cv::Point2d> from = PixelCentroid(was);
+  const std::optional<cv::Point2d> to = PixelCentroid(now);
+  const cv::Point shift =
+      from && to ? cv::Point(static_cast<int>(std::lround(to->x - from->x)),
+                             static_cast<int>(std::lround(to->y - from->y)))
+                 : cv::Point(0, 0);
+  const double scale =
+      was.area > 0 ? static_cast<double>(now.area) / was.area : 1.0;
+  for (Piece& p : pieces) {
+    p.world_centroid += now_world - was_world;
+    p.box += shift;
+    p.area = static_cast<int>(std::lround(p.area * scale));
   }
 }
 

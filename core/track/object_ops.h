@@ -69,6 +69,16 @@ int MatchingPiece(const Piece& now, const Eigen::Vector3f& shift,
 void KeepFormerIds(const Eigen::Vector3f& shift,
                    const std::vector<Piece>& before, std::vector<Piece>& now);
 
+// The pieces of a joined object that came whole this frame (`was` last
+// frame, `now` in this one, their centroids in the world beside them),
+// carried along with it: each piece moved by the whole's motion, in the
+// world and (its box) in the image, and its area scaled as the whole's.
+// A part that later moves apart is still told by its piece, and gets back
+// the identity it had before it was joined.
+void CarryPieces(const SegmentedObject& was, const Eigen::Vector3f& was_world,
+                 const SegmentedObject& now, const Eigen::Vector3f& now_world,
+                 std::vector<Piece>& pieces);
+
 }  // namespace fovea
 
 #endif  // FOVEA_CORE_TRACK_OBJECT_OPS_H_

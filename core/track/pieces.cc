@@ -131,6 +131,39 @@ void Tracker::JoinAndSplit(
     }
   }
 
+  // A joined track seen last frame that matched no object, while objects
+  // without a track are its pieces: its parts moved apart, and its
+  // centroid, between them, was near neither. Each such part takes its
+  // piece's identity: the track's own (the first piece matched of those
+  // without a former identity), or the one it had before it was joined.
+  for (size_t i = 0; i < tracks.size(); ++i) {
+    const Track& t = tracks[i];
+    if (!t.composite || t.id == 0 || t.pieces.size() < 2 ||
+        t.last_seen_frame != frame_index_ - 1 ||
+        std::find(track_of.begin(), track_of.end(), static_cast<int>(i)) !=
+            track_of.end()) {
+      continue;
+    }
+    std::vector<bool> taken(t.pieces.size(), false);
+    bool own_taken = false;
+    for (size_t j = 0; j < found.size(); ++j) {
+      if (absorbed[j] || track_of[j] >= 0 || split_from[j]) continue;
+      const int p = MatchingPiece(pieces[j].front(), shift, t.pieces);
+      if (p < 0 || taken[p]) continue;
+      const Piece& piece = t.pieces[p];
+      if (piece.former_id == 0) {
+        if (own_taken) continue;
+        own_taken = true;
+        track_of[j] = static_cast<int>(i);
+        state[j] = StateOfMotion(world[j] - shift - piece.world_centroid);
+      } else {
+        split_from[j] = piece;
+        ++out.split;
+      }
+      taken[p] = true;
+    }
+  }
+
   // A track seen last frame and matched to nothing, whose last mask is
   // mostly under one object's mask now, was a piece of that object: its
   // identity joins the object's (the pieces of an object INC cut in two

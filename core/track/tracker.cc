@@ -70,6 +70,9 @@ absl::Status Validate(const TrackerOptions& options) {
         absl::StrCat("track.static_fraction: ", options.static_fraction,
                      " is not in [0, 1)"));
   }
+  if (!(options.match_area_ratio >= 1.0f)) {
+    return absl::InvalidArgumentError("track.match_area_ratio: must be >= 1");
+  }
   if (!(options.match_extent_fraction >= 0.0f)) {
     return absl::InvalidArgumentError(
         "track.match_extent_fraction: must be >= 0");
@@ -397,6 +400,12 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
     for (size_t i = 0; i < candidates.size(); ++i) {
       const Track& t = tracks[candidates[i]];
       for (size_t j = 0; j < found.size(); ++j) {
+        const int smaller = std::min(t.object.area, found[j].area);
+        const int larger = std::max(t.object.area, found[j].area);
+        if (static_cast<float>(larger) >
+            options_.match_area_ratio * static_cast<float>(smaller)) {
+          continue;  // a fragment is not the whole it lies beside
+        }
         gate[i][j] = std::max(
             options_.match_m,
             options_.match_extent_fraction *
@@ -479,15 +488,29 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
             state[j] == TrackState::kMoved && joined_move > options_.moved_m
                 ? TrackState::kMoved
                 : TrackState::kKept;
+        // A joined track that INC cut whole this time keeps its pieces,
+        // carried along: they tell its parts apart when they move apart.
+        // Whole: nearer the pieces' sum in area than the largest of them.
+        int pieces_area = 0;
+        int largest_piece = 0;
+        for (const Piece& p : t.pieces) {
+          pieces_area += p.area;
+          largest_piece = std::max(largest_piece, p.area);
+        }
+        const bool came_whole = t.composite && !composite[j] &&
+                                t.pieces.size() > 1 &&
+                                2 * found[j].area > pieces_area + largest_piece;
+        if (came_whole) {
+          CarryPieces(t.object, t.world_centroid, found[j], world[j], t.pieces);
+        } else if (t.composite || composite[j]) {
+          KeepFormerIds(shift, t.pieces, pieces[j]);
+          t.pieces = std::move(pieces[j]);
+        }
+        t.composite = t.composite || composite[j];
         t.object = found[j];
         t.appearance = Appearance(input.color, found[j]);
         t.world_centroid = world[j];
         t.last_seen_frame = frame_index_;
-        t.composite = t.composite || composite[j];
-        if (t.composite) {
-          KeepFormerIds(shift, t.pieces, pieces[j]);
-          t.pieces = std::move(pieces[j]);
-        }
         ++t.frames_seen;
         result.track_id = t.id;
         result.frames_seen = t.frames_seen;

@@ -45,7 +45,10 @@ namespace fovea {
 //     identity stays. A joined object keeps its pieces: when INC cuts it
 //     again, a part that moved more than joint_motion_m apart from the
 //     rest (the two were separate objects swept along together) splits
-//     off with an identity of its own.
+//     off with an identity of its own. The pieces are carried along while
+//     INC cuts the object whole; when the joined track matches no object
+//     (its parts moved apart, its centroid between them), each part that
+//     is one of its pieces takes that piece's identity.
 
 enum class TrackState {
   kAppeared,  // first seen in this frame: a new track_id
@@ -78,6 +81,10 @@ struct TrackerOptions {
   // not the same object.
   float match_m = 0.06f;
   float match_extent_fraction = 0.5f;
+  // Nor are a track and an object whose areas (pixels) differ by more than
+  // this factor: a small fragment beside a whole object that moved is not
+  // that object (the pieces' rules below give the whole its identity).
+  float match_area_ratio = 4.0f;
   float moved_m = 0.02f;
   float joint_motion_m = 0.01f;
   // The support while it fits: the plane of the last frame segmented is

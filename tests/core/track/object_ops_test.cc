@@ -102,5 +102,40 @@ TEST(ObjectOps, APieceIsTheOverlappingOneOfItsSizeNearest) {
   EXPECT_EQ(MatchingPiece(away, Eigen::Vector3f::Zero(), before), -1);
 }
 
+TEST(ObjectOps, PiecesOfAWholeAreCarriedAlongWithIt) {
+  // Two 4x4 pieces side by side, joined: an 8x4 whole at (0,0). It comes
+  // whole next frame, 5 px right and 5 px down, 3 cm along x in the world,
+  // and 1.5 times its area (the camera came closer).
+  const std::vector<Piece> was = {
+      PieceOf(Square(0, 0, 4, Eigen::Vector3f(0.00f, 0, 1)),
+              Eigen::Vector3f(0.00f, 0, 1)),
+      PieceOf(Square(4, 0, 4, Eigen::Vector3f(0.02f, 0, 1)),
+              Eigen::Vector3f(0.02f, 0, 1))};
+  SegmentedObject whole = Square(0, 0, 4, Eigen::Vector3f(0.01f, 0, 1));
+  Join(Square(4, 0, 4, Eigen::Vector3f(0.02f, 0, 1)), whole);
+  SegmentedObject now;
+  now.mask = cv::Mat(20, 20, CV_8UC1, cv::Scalar(0));
+  now.box = cv::Rect(3, 5, 12, 4);  // 48 px, centroid (8.5, 6.5)
+  now.mask(now.box).setTo(255);
+  now.area = 48;
+  std::vector<Piece> pieces = was;
+  CarryPieces(whole, Eigen::Vector3f(0.01f, 0, 1), now,
+              Eigen::Vector3f(0.04f, 0, 1), pieces);
+  // The whole's centroid went from (3.5, 1.5) to (8.5, 6.5).
+  EXPECT_EQ(pieces[0].box, cv::Rect(5, 5, 4, 4));
+  EXPECT_EQ(pieces[1].box, cv::Rect(9, 5, 4, 4));
+  EXPECT_TRUE(pieces[0].world_centroid.isApprox(Eigen::Vector3f(0.03f, 0, 1)));
+  EXPECT_TRUE(pieces[1].world_centroid.isApprox(Eigen::Vector3f(0.05f, 0, 1)));
+  EXPECT_EQ(pieces[0].area, 24);  // 16 x 48 / 32
+  EXPECT_EQ(pieces[1].mask.size(), cv::Size(4, 4));
+  // Each part of the whole, where the whole went, is still its own piece.
+  const Piece left = PieceOf(Square(5, 5, 5, Eigen::Vector3f(0.03f, 0, 1)),
+                             Eigen::Vector3f(0.03f, 0, 1));
+  const Piece right = PieceOf(Square(9, 5, 5, Eigen::Vector3f(0.05f, 0, 1)),
+                              Eigen::Vector3f(0.05f, 0, 1));
+  EXPECT_EQ(MatchingPiece(left, Eigen::Vector3f::Zero(), pieces), 0);
+  EXPECT_EQ(MatchingPiece(right, Eigen::Vector3f::Zero(), pieces), 1);
+}
+
 }  // namespace
 }  // namespace fovea

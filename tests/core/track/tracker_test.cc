@@ -3,7 +3,9 @@
 // mean of its frames once they are enough, an object taken away
 // is reported gone once, a drifting camera keeps every identity, an object
 // put down elsewhere keeps its own, objects swept along together and then
-// pulled apart split.
+// pulled apart split and get back their identities (whether INC cut the
+// pair whole meanwhile, or the joined track matched neither part), and a
+// fragment does not take a moved object's identity.
 
 #include "core/track/tracker.h"
 
@@ -15,6 +17,7 @@
 #include <map>
 #include <opencv2/core.hpp>
 #include <set>
+#include <utility>
 #include <vector>
 
 #include "core/pipeline/models.h"
@@ -347,6 +350,27 @@ int MasksOfTwoObjects(const synth::SequenceFrame& truth,
   return two;
 }
 
+// Tracks joined and parts split over `frames`.
+std::pair<int, int> JoinedAndSplit(const std::vector<TrackedFrame>& frames) {
+  std::pair<int, int> events = {0, 0};
+  for (const TrackedFrame& f : frames) {
+    events.first += f.joined;
+    events.second += f.split;
+  }
+  return events;
+}
+
+// Each of the two in `pair` had one identity, its own, over the sequence.
+void ExpectOneIdentityEach(const std::map<int, std::set<int>>& tracks,
+                           const std::vector<int>& pair) {
+  ASSERT_EQ(pair.size(), 2u);
+  for (int truth : pair) {
+    ASSERT_TRUE(tracks.count(truth)) << "truth " << truth;
+    EXPECT_EQ(tracks.at(truth).size(), 1u) << "truth " << truth;
+  }
+  EXPECT_NE(*tracks.at(pair[0]).begin(), *tracks.at(pair[1]).begin());
+}
+
 TEST(Tracker, PartsSweptTogetherSplitWhenTheyMoveApart) {
   ASSERT_NE(Models(), nullptr);
   // Two objects side by side swept along together (frames 0-5), then one
@@ -371,12 +395,7 @@ TEST(Tracker, PartsSweptTogetherSplitWhenTheyMoveApart) {
 
   std::vector<TrackedFrame> frames;
   const std::map<int, std::set<int>> tracks = Play(sequence, true, &frames);
-  int joined = 0;
-  int split = 0;
-  for (const TrackedFrame& f : frames) {
-    joined += f.joined;
-    split += f.split;
-  }
+  const auto [joined, split] = JoinedAndSplit(frames);
   EXPECT_GT(joined, 0);  // what moved as one was one object
   EXPECT_GT(split, 0);
   // Apart, they are two objects again, each with its own mask.
@@ -396,11 +415,75 @@ TEST(Tracker, PartsSweptTogetherSplitWhenTheyMoveApart) {
   EXPECT_EQ(tracks.at(stays).size(), 1u);
 }
 
+// The two that push-apart sweeps along together and then pulls apart: the
+// truths whose centroid moved by the middle frame.
+std::vector<int> SweptPair(const Sequence& sequence) {
+  const std::map<int, cv::Point2d> first = TruthCentroids(sequence.frames[0]);
+  const std::map<int, cv::Point2d> middle =
+      TruthCentroids(sequence.frames[sequence.frames.size() / 2]);
+  std::vector<int> pair;
+  for (const auto& [id, at] : first) {
+    if (cv::norm(middle.at(id) - at) >= 5.0) pair.push_back(id);
+  }
+  return pair;
+}
+
+TEST(Tracker, AJoinedPairCutWholeKeepsItsPartsIdentitiesForTheSplit) {
+  ASSERT_NE(Models(), nullptr);
+  // Seed 5: the pair is cut in two, joined, then cut whole (frame 5): the
+  // joined track keeps its pieces, carried along, so that when the two
+  // are pulled apart each part gets back the identity it had. When the
+  // whole replaced the pieces, the part that had been joined in took the
+  // joined track's identity and the other a new one (2 switches).
+  const Sequence sequence = GenerateSequence(SequenceKind::kPushApart, 5, 12);
+  const std::vector<int> pair = SweptPair(sequence);
+  ASSERT_EQ(pair.size(), 2u);
+  std::vector<TrackedFrame> frames;
+  const std::map<int, std::set<int>> tracks = Play(sequence, true, &frames);
+  const auto [joined, split] = JoinedAndSplit(frames);
+  EXPECT_GT(joined, 0);
+  EXPECT_GT(split, 0);
+  ExpectOneIdentityEach(tracks, pair);
+}
+
+TEST(Tracker, AFragmentBesideAMovedObjectDoesNotTakeItsIdentity) {
+  ASSERT_NE(Models(), nullptr);
+  // Seed 22: while the pair is swept along, INC cuts small fragments off
+  // it. At frame 5 the nearest track to the moved first object was such a
+  // fragment's (a few hundred pixels against thousands), which took the
+  // object's identity; an area ratio over match_area_ratio is no match.
+  // Truth 0 is one of the two swept along.
+  const Sequence sequence = GenerateSequence(SequenceKind::kPushApart, 22, 12);
+  const std::vector<int> moved = SweptPair(sequence);
+  ASSERT_NE(std::find(moved.begin(), moved.end(), 0), moved.end());
+  const std::map<int, std::set<int>> tracks = Play(sequence, true);
+  ASSERT_TRUE(tracks.count(0));
+  EXPECT_EQ(tracks.at(0).size(), 1u);
+}
+
+TEST(Tracker, PartsThatMovedApartFromAnUnmatchedJoinedTrackTakeTheirPieces) {
+  ASSERT_NE(Models(), nullptr);
+  // Seed 21: when one of the pair is pulled away, the joined track's
+  // centroid, between the two, is near neither, and it matches no object.
+  // Each part is one of its pieces and takes that piece's identity: the
+  // track's own, and the one the other had before it was joined. Without
+  // this both parts got new identities (4 switches).
+  const Sequence sequence = GenerateSequence(SequenceKind::kPushApart, 21, 12);
+  const std::vector<int> pair = SweptPair(sequence);
+  ASSERT_EQ(pair.size(), 2u);
+  const std::map<int, std::set<int>> tracks = Play(sequence, true);
+  ExpectOneIdentityEach(tracks, pair);
+}
+
 TEST(Tracker, BadOptionsAreNamed) {
   TrackerOptions options;
   options.static_fraction = 1.5;
   EXPECT_EQ(Validate(options).code(), absl::StatusCode::kInvalidArgument);
   EXPECT_NE(Validate(options).message().find("track.static_fraction"),
+            std::string::npos);
+  options = TrackerOptions{};
+  options.match_area_ratio = 0.5f;
+  EXPECT_NE(Validate(options).message().find("track.match_area_ratio"),
             std::string::npos);
   options = TrackerOptions{};
   options.match_m = 0.0f;
