@@ -128,17 +128,44 @@ void KeepFormerIds(const Eigen::Vector3f& shift,
 
 namespace {
 
-// The centroid of `object`'s mask in pixels; nullopt when it has none.
+// The centroid of `object`'s mask (at the frame's size, or cropped to its
+// box) in pixels; nullopt when it has none.
 std::optional<cv::Point2d> PixelCentroid(const SegmentedObject& object) {
+  const bool cropped = object.mask.size() == object.box.size();
   const cv::Rect box =
-      object.box & cv::Rect(0, 0, object.mask.cols, object.mask.rows);
+      cropped ? object.box
+              : object.box & cv::Rect(0, 0, object.mask.cols, object.mask.rows);
   if (box.empty()) return std::nullopt;
-  const cv::Moments m = cv::moments(object.mask(box), true);
+  const cv::Moments m =
+      cv::moments(cropped ? object.mask : object.mask(box), true);
   if (m.m00 <= 0.0) return std::nullopt;
   return cv::Point2d(box.x + m.m10 / m.m00, box.y + m.m01 / m.m00);
 }
 
 }  // namespace
+
+void CropMaskToBox(SegmentedObject& object) {
+  object.box &= cv::Rect(0, 0, object.mask.cols, object.mask.rows);
+  object.mask =
+      object.box.empty() ? cv::Mat() : object.mask(object.box).clone();
+}
+
+cv::Mat MaskAtSize(const SegmentedObject& held, cv::Size size) {
+  cv::Mat mask(size, CV_8UC1, cv::Scalar(0));
+  const cv::Rect box = held.box & cv::Rect(cv::Point(0, 0), size);
+  if (!box.empty() && held.mask.size() == held.box.size()) {
+    held.mask(box - held.box.tl()).copyTo(mask(box));
+  }
+  return mask;
+}
+
+int OverlapWithHeld(const cv::Mat& mask, const SegmentedObject& held) {
+  const cv::Rect box = held.box & cv::Rect(0, 0, mask.cols, mask.rows);
+  if (box.empty() || held.mask.size() != held.box.size()) return 0;
+  cv::Mat both;
+  cv::bitwise_and(mask(box), held.mask(box - held.box.tl()), both);
+  return cv::countNonZero(both);
+}
 
 void CarryPieces(const SegmentedObject& was, const Eigen::Vector3f& was_world,
                  const SegmentedObject& now, const Eigen::Vector3f& now_world,

@@ -69,8 +69,21 @@ int MatchingPiece(const Piece& now, const Eigen::Vector3f& shift,
 void KeepFormerIds(const Eigen::Vector3f& shift,
                    const std::vector<Piece>& before, std::vector<Piece>& now);
 
+// An object as a track holds it between frames: its mask cropped to its
+// box (CV_8UC1 of the box's size, the box clipped to the frame), so that an
+// open stream holds its objects' pixels rather than a frame per object.
+void CropMaskToBox(SegmentedObject& object);
+
+// The mask of `held` (cropped, CropMaskToBox) at the frame's `size`.
+cv::Mat MaskAtSize(const SegmentedObject& held, cv::Size size);
+
+// How many pixels of `mask` (at the frame's size) lie on `held`'s cropped
+// mask.
+int OverlapWithHeld(const cv::Mat& mask, const SegmentedObject& held);
+
 // The pieces of a joined object that came whole this frame (`was` last
-// frame, `now` in this one, their centroids in the world beside them),
+// frame, its mask at the frame's size or cropped to its box; `now` in this
+// one; their centroids in the world beside them),
 // carried along with it: each piece moved by the whole's motion, in the
 // world and (its box) in the image, and its area scaled as the whole's.
 // A part that later moves apart is still told by its piece, and gets back

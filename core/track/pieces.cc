@@ -100,10 +100,7 @@ void Tracker::JoinAndSplit(
     for (size_t k = 0; k < found.size(); ++k) {
       if (k == j || absorbed[k] || track_of[k] < 0) continue;
       const Track& t = tracks[track_of[k]];
-      if (!t.composite || t.object.mask.empty() ||
-          t.object.mask.size() != found[j].mask.size()) {
-        continue;
-      }
+      if (!t.composite || t.object.mask.empty()) continue;
       int piece = -1;
       int k_piece = -1;
       const int with = moved_with(j, k, t, &piece, &k_piece);
@@ -122,9 +119,8 @@ void Tracker::JoinAndSplit(
         split_from[k] = t.pieces[k_piece];
         break;
       }
-      cv::Mat inside;
-      cv::bitwise_and(found[j].mask, t.object.mask, inside);
-      if (with == 1 || cv::countNonZero(inside) * 2 > found[j].area) {
+      if (with == 1 ||
+          OverlapWithHeld(found[j].mask, t.object) * 2 > found[j].area) {
         join(j, k);
         break;
       }
@@ -179,13 +175,8 @@ void Tracker::JoinAndSplit(
       continue;
     }
     for (size_t k = 0; k < found.size(); ++k) {
-      if (absorbed[k] || track_of[k] < 0 ||
-          found[k].mask.size() != t.object.mask.size()) {
-        continue;
-      }
-      cv::Mat under;
-      cv::bitwise_and(t.object.mask, found[k].mask, under);
-      if (2 * cv::countNonZero(under) > t.object.area) {
+      if (absorbed[k] || track_of[k] < 0) continue;
+      if (2 * OverlapWithHeld(found[k].mask, t.object) > t.object.area) {
         // The object goes on under the identity of its larger piece.
         Track& whole = tracks[track_of[k]];
         if (t.object.area > whole.object.area) {

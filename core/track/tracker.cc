@@ -363,6 +363,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
       kept.track_id = t.id;
       kept.state = TrackState::kKept;
       kept.object = t.object;
+      kept.object.mask = MaskAtSize(t.object, frame.depth.size());
       kept.world_centroid = t.world_centroid;
       kept.frames_seen = t.frames_seen;
       out.objects.push_back(std::move(kept));
@@ -508,6 +509,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
         }
         t.composite = t.composite || composite[j];
         t.object = found[j];
+        CropMaskToBox(t.object);
         t.appearance = Appearance(input.color, found[j]);
         t.world_centroid = world[j];
         t.last_seen_frame = frame_index_;
@@ -530,6 +532,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
         }
         if (t.id == 0) t.id = next_id_++;
         t.object = found[j];
+        CropMaskToBox(t.object);
         t.appearance = Appearance(input.color, found[j]);
         t.world_centroid = world[j];
         t.last_seen_frame = frame_index_;

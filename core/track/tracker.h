@@ -177,8 +177,9 @@ class Tracker {
  private:
   struct Track {
     int id = 0;
-    SegmentedObject object;  // as last seen
-    cv::Mat appearance;      // Appearance() as last seen; empty: no colour
+    // As last seen, its mask cropped to its box (CropMaskToBox).
+    SegmentedObject object;
+    cv::Mat appearance;  // Appearance() as last seen; empty: no colour
     Eigen::Vector3f world_centroid = Eigen::Vector3f::Zero();
     int frames_seen = 0;
     int last_seen_frame = 0;

@@ -137,5 +137,39 @@ TEST(ObjectOps, PiecesOfAWholeAreCarriedAlongWithIt) {
   EXPECT_EQ(MatchingPiece(right, Eigen::Vector3f::Zero(), pieces), 1);
 }
 
+TEST(ObjectOps, AHeldObjectKeepsOnlyItsBoxAndOverlapsAsBefore) {
+  // A 4x4 square at (6,3) in a 20x20 frame, held cropped: 16 bytes, not
+  // 400, and the same pixels at the frame's size again.
+  const SegmentedObject square = Square(6, 3, 4, Eigen::Vector3f(0, 0, 1));
+  SegmentedObject held = square;
+  CropMaskToBox(held);
+  EXPECT_EQ(held.mask.size(), cv::Size(4, 4));
+  EXPECT_EQ(held.box, cv::Rect(6, 3, 4, 4));
+  EXPECT_EQ(cv::countNonZero(MaskAtSize(held, cv::Size(20, 20)) != square.mask),
+            0);
+  // A 4x4 square 2 px right overlaps it on 2 x 4 pixels; one far away on
+  // none; the whole frame on all 16.
+  EXPECT_EQ(OverlapWithHeld(Square(8, 3, 4, {}).mask, held), 8);
+  EXPECT_EQ(OverlapWithHeld(Square(14, 14, 4, {}).mask, held), 0);
+  EXPECT_EQ(OverlapWithHeld(cv::Mat(20, 20, CV_8UC1, cv::Scalar(255)), held),
+            16);
+  // A box reaching past the frame is clipped to it.
+  SegmentedObject edge = Square(16, 16, 4, {});
+  edge.box = cv::Rect(16, 16, 6, 6);
+  CropMaskToBox(edge);
+  EXPECT_EQ(edge.box, cv::Rect(16, 16, 4, 4));
+  EXPECT_EQ(OverlapWithHeld(Square(16, 16, 4, {}).mask, edge), 16);
+  // Its pieces are carried as from the mask at the frame's size.
+  SegmentedObject moved = Square(9, 5, 4, Eigen::Vector3f(0.01f, 0, 1));
+  std::vector<Piece> from_held = {PieceOf(square, Eigen::Vector3f(0, 0, 1))};
+  std::vector<Piece> from_full = from_held;
+  CarryPieces(held, Eigen::Vector3f(0, 0, 1), moved,
+              Eigen::Vector3f(0.01f, 0, 1), from_held);
+  CarryPieces(square, Eigen::Vector3f(0, 0, 1), moved,
+              Eigen::Vector3f(0.01f, 0, 1), from_full);
+  EXPECT_EQ(from_held[0].box, cv::Rect(9, 5, 4, 4));
+  EXPECT_EQ(from_held[0].box, from_full[0].box);
+}
+
 }  // namespace
 }  // namespace fovea
