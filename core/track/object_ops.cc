@@ -167,6 +167,17 @@ int OverlapWithHeld(const cv::Mat& mask, const SegmentedObject& held) {
   return cv::countNonZero(both);
 }
 
+bool IsWhole(int area, const std::vector<Piece>& pieces) {
+  if (pieces.size() < 2) return false;
+  int sum = 0;
+  int largest = 0;
+  for (const Piece& p : pieces) {
+    sum += p.area;
+    largest = std::max(largest, p.area);
+  }
+  return 2 * area > sum + largest;
+}
+
 void CarryPieces(const SegmentedObject& was, const Eigen::Vector3f& was_world,
                  const SegmentedObject& now, const Eigen::Vector3f& now_world,
                  std::vector<Piece>& pieces) {

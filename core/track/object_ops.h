@@ -81,6 +81,10 @@ cv::Mat MaskAtSize(const SegmentedObject& held, cv::Size size);
 // mask.
 int OverlapWithHeld(const cv::Mat& mask, const SegmentedObject& held);
 
+// Whether an object of `area` pixels is the whole of `pieces` (at least
+// two) rather than one of them: nearer their summed area than the largest's.
+bool IsWhole(int area, const std::vector<Piece>& pieces);
+
 // The pieces of a joined object that came whole this frame (`was` last
 // frame, its mask at the frame's size or cropped to its box; `now` in this
 // one; their centroids in the world beside them),

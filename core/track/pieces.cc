@@ -127,6 +127,12 @@ void Tracker::JoinAndSplit(
     }
   }
 
+  // The tracks some object has now (the two rules below keep it up to date).
+  std::vector<bool> matched_track(tracks.size(), false);
+  for (size_t j = 0; j < found.size(); ++j) {
+    if (track_of[j] >= 0) matched_track[track_of[j]] = true;
+  }
+
   // A joined track seen last frame that matched no object, while objects
   // without a track are its pieces: its parts moved apart, and its
   // centroid, between them, was near neither. Each such part takes its
@@ -134,10 +140,8 @@ void Tracker::JoinAndSplit(
   // without a former identity), or the one it had before it was joined.
   for (size_t i = 0; i < tracks.size(); ++i) {
     const Track& t = tracks[i];
-    if (!t.composite || t.id == 0 || t.pieces.size() < 2 ||
-        t.last_seen_frame != frame_index_ - 1 ||
-        std::find(track_of.begin(), track_of.end(), static_cast<int>(i)) !=
-            track_of.end()) {
+    if (matched_track[i] || !t.composite || t.id == 0 || t.pieces.size() < 2 ||
+        t.last_seen_frame != frame_index_ - 1) {
       continue;
     }
     std::vector<bool> taken(t.pieces.size(), false);
@@ -151,6 +155,7 @@ void Tracker::JoinAndSplit(
         if (own_taken) continue;
         own_taken = true;
         track_of[j] = static_cast<int>(i);
+        matched_track[i] = true;
         state[j] = StateOfMotion(world[j] - shift - piece.world_centroid);
       } else {
         split_from[j] = piece;
@@ -164,10 +169,6 @@ void Tracker::JoinAndSplit(
   // mostly under one object's mask now, was a piece of that object: its
   // identity joins the object's (the pieces of an object INC cut in two
   // become one object when it comes whole).
-  std::vector<bool> matched_track(tracks.size(), false);
-  for (size_t j = 0; j < found.size(); ++j) {
-    if (track_of[j] >= 0) matched_track[track_of[j]] = true;
-  }
   for (size_t i = 0; i < tracks.size(); ++i) {
     Track& t = tracks[i];
     if (matched_track[i] || t.id == 0 ||

@@ -491,17 +491,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
                 : TrackState::kKept;
         // A joined track that INC cut whole this time keeps its pieces,
         // carried along: they tell its parts apart when they move apart.
-        // Whole: nearer the pieces' sum in area than the largest of them.
-        int pieces_area = 0;
-        int largest_piece = 0;
-        for (const Piece& p : t.pieces) {
-          pieces_area += p.area;
-          largest_piece = std::max(largest_piece, p.area);
-        }
-        const bool came_whole = t.composite && !composite[j] &&
-                                t.pieces.size() > 1 &&
-                                2 * found[j].area > pieces_area + largest_piece;
-        if (came_whole) {
+        if (t.composite && !composite[j] && IsWhole(found[j].area, t.pieces)) {
           CarryPieces(t.object, t.world_centroid, found[j], world[j], t.pieces);
         } else if (t.composite || composite[j]) {
           KeepFormerIds(shift, t.pieces, pieces[j]);

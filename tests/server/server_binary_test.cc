@@ -33,13 +33,12 @@ namespace fovea::server {
 namespace {
 
 using ::fovea::server::testing::ExpectCleanExitOnSigterm;
-using ::fovea::server::testing::FreePort;
 using ::fovea::server::testing::HttpGet;
 using ::fovea::server::testing::MakeSyntheticRequest;
 using ::fovea::server::testing::MetricValue;
 using ::fovea::server::testing::ServerProcess;
-using ::fovea::server::testing::Spawn;
 using ::fovea::server::testing::StartServing;
+using ::fovea::server::testing::StartUntil;
 using ::fovea::server::testing::WaitFor;
 using ::testing::HasSubstr;
 
@@ -401,42 +400,22 @@ TEST(ServerBinaryTest, MutualTlsServesOnlyClientsWithACertificate) {
   with_cert.pem_private_key = ReadAll(dir + "/client.key");
   grpc::SslCredentialsOptions without_cert;
   without_cert.pem_root_certs = with_cert.pem_root_certs;
-  // Started again on a fresh port if it exits early: the port FreePort()
-  // found can be taken before the child binds it (see StartServing).
-  std::string target;
-  pid_t pid = -1;
-  bool served = false;
-  bool exited = false;
-  for (int attempt = 0; attempt < 3 && !served; ++attempt) {
-    target = "127.0.0.1:" + std::to_string(FreePort());
-    pid = Spawn({"--listen=" + target, "--metrics_listen=", "--concurrency=1",
-                 "--tls_cert=" + dir + "/server.pem",
-                 "--tls_key=" + dir + "/server.key",
-                 "--tls_client_ca=" + dir + "/ca.pem"});
-    ASSERT_GT(pid, 0);
-    exited = false;
-    served = WaitFor(
-                 [&] {
-                   exited = waitpid(pid, nullptr, WNOHANG) == pid;
-                   return exited ||
-                          DetectWith(target, grpc::SslCredentials(with_cert)) ==
-                              grpc::StatusCode::OK;
-                 },
-                 std::chrono::seconds(60)) &&
-             !exited;
-    if (!exited && !served) break;
-  }
-  if (!served && !exited) {
-    kill(pid, SIGKILL);
-    waitpid(pid, nullptr, 0);
-  }
-  ASSERT_TRUE(served) << "the mutual-TLS server never served a client with a "
-                         "certificate";
+  const ServerProcess server = StartUntil(
+      {"--metrics_listen=", "--concurrency=1",
+       "--tls_cert=" + dir + "/server.pem", "--tls_key=" + dir + "/server.key",
+       "--tls_client_ca=" + dir + "/ca.pem"},
+      [&](const std::string& target) {
+        return DetectWith(target, grpc::SslCredentials(with_cert)) ==
+               grpc::StatusCode::OK;
+      });
+  ASSERT_GT(server.pid, 0) << "the mutual-TLS server never served a client "
+                              "with a certificate";
+  const std::string& target = server.target;
   EXPECT_NE(DetectWith(target, grpc::SslCredentials(without_cert)),
             grpc::StatusCode::OK);
   EXPECT_NE(DetectWith(target, grpc::InsecureChannelCredentials()),
             grpc::StatusCode::OK);
-  ExpectCleanExitOnSigterm(pid);
+  ExpectCleanExitOnSigterm(server.pid);
   std::filesystem::remove_all(dir);
 }
 

@@ -13,7 +13,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -64,32 +66,34 @@ struct ServerProcess {
   int metrics_port = 0;
 };
 
-// Starts fovea-server and waits (up to 60 s) for health SERVING on both
-// names. Fails the test (ADD_FAILURE) and returns pid -1 when it exits
-// early or never serves. A port FreePort() found free can be taken before
-// the child binds it (as the source port of another test's connection):
-// a child that exits early is started again on fresh ports, twice at most.
-inline ServerProcess StartServing(const std::vector<std::string>& flags,
-                                  int nofile = 0) {
+// Starts fovea-server with `flags` plus --listen on a free port (and
+// --metrics_listen on another, unless `flags` set it) and waits up to 60 s
+// until `ready(target)`. A port FreePort() found free can be taken before
+// the child binds it (as the source port of another test's connection): a
+// child that exits early is started again on fresh ports, twice at most.
+// Fails the test (ADD_FAILURE) and returns pid -1 when it never gets ready.
+inline ServerProcess StartUntil(
+    const std::vector<std::string>& flags,
+    const std::function<bool(const std::string& target)>& ready,
+    int nofile = 0) {
   constexpr int kAttempts = 3;
+  const bool metrics_set =
+      std::any_of(flags.begin(), flags.end(), [](const std::string& flag) {
+        return flag.rfind("--metrics_listen=", 0) == 0;
+      });
   ServerProcess server;
   int status = 0;
   bool exited = false;
   bool serving = false;
-  // A fresh channel per attempt: a channel that tried before the server
-  // listened may wait out gRPC's reconnect backoff (seconds).
-  auto health = [&server](const std::string& service) {
-    return HealthStatus(
-        grpc::CreateChannel(server.target, grpc::InsecureChannelCredentials()),
-        service);
-  };
   for (int attempt = 0; attempt < kAttempts; ++attempt) {
-    server.metrics_port = FreePort();
     server.target = "127.0.0.1:" + std::to_string(FreePort());
     std::vector<std::string> args = flags;
     args.push_back("--listen=" + server.target);
-    args.push_back("--metrics_listen=127.0.0.1:" +
-                   std::to_string(server.metrics_port));
+    if (!metrics_set) {
+      server.metrics_port = FreePort();
+      args.push_back("--metrics_listen=127.0.0.1:" +
+                     std::to_string(server.metrics_port));
+    }
     server.pid = Spawn(args, nofile);
     if (server.pid <= 0) {
       ADD_FAILURE() << "fork failed";
@@ -99,20 +103,46 @@ inline ServerProcess StartServing(const std::vector<std::string>& flags,
     serving = WaitFor(
         [&] {
           exited = waitpid(server.pid, &status, WNOHANG) == server.pid;
-          return exited || health("fovea.v1.Perception") == "SERVING";
+          return exited || ready(server.target);
         },
         std::chrono::seconds(60));
     if (!exited) break;
   }
-  if (exited || !serving || health("") != "SERVING") {
+  if (exited || !serving) {
     ADD_FAILURE() << (exited ? "exited early " + std::to_string(kAttempts) +
                                    " times, last wait status " +
                                    std::to_string(status)
-                             : std::string("not SERVING within 60 s"));
+                             : std::string("not ready within 60 s"));
     if (!exited) {
       kill(server.pid, SIGKILL);
       waitpid(server.pid, &status, 0);
     }
+    server.pid = -1;
+  }
+  return server;
+}
+
+// StartUntil health is SERVING on both names.
+inline ServerProcess StartServing(const std::vector<std::string>& flags,
+                                  int nofile = 0) {
+  // A fresh channel per attempt: a channel that tried before the server
+  // listened may wait out gRPC's reconnect backoff (seconds).
+  const auto health = [](const std::string& target,
+                         const std::string& service) {
+    return HealthStatus(
+        grpc::CreateChannel(target, grpc::InsecureChannelCredentials()),
+        service);
+  };
+  ServerProcess server = StartUntil(
+      flags,
+      [&](const std::string& target) {
+        return health(target, "fovea.v1.Perception") == "SERVING";
+      },
+      nofile);
+  if (server.pid > 0 && health(server.target, "") != "SERVING") {
+    ADD_FAILURE() << "\"\" not SERVING";
+    kill(server.pid, SIGKILL);
+    waitpid(server.pid, nullptr, 0);
     server.pid = -1;
   }
   return server;
