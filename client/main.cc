@@ -371,10 +371,15 @@ int RunTrack() {
       std::cout << ToJson(response) << std::endl;
       return;
     }
+    std::string how = response.reused() ? "reused" : "segmented";
+    if (response.has_segmented_region()) {
+      const fovea::v1::BoundingBox& r = response.segmented_region();
+      how = absl::StrFormat("segmented %dx%d at (%d, %d), the rest kept",
+                            r.width(), r.height(), r.u(), r.v());
+    }
     std::string line = absl::StrFormat(
         "frame %d: %d objects, %s, %.1f ms", response.sequence(),
-        response.objects_size(), response.reused() ? "reused" : "segmented",
-        response.seconds() * 1e3);
+        response.objects_size(), how, response.seconds() * 1e3);
     for (const fovea::v1::TrackedObject& o : response.objects()) {
       absl::StrAppend(
           &line, absl::StrFormat(

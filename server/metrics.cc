@@ -216,7 +216,9 @@ class Metrics {
         track_frames_family_(
             prometheus::BuildCounter()
                 .Name("fovea_track_frames_total")
-                .Help("Frames of Track streams by outcome: segmented, refined "
+                .Help("Frames of Track streams by outcome: segmented, region "
+                      "(only the part that changed segmented, the rest kept), "
+                      "refined "
                       "(a still scene's mean of frames segmented), reused (the "
                       "scene had not changed), skipped (a newer frame "
                       "replaced it before it was processed, or the server was "
@@ -304,7 +306,7 @@ class Metrics {
         Shed(reason);
       }
       for (const char* outcome :
-           {"segmented", "refined", "reused", "skipped"}) {
+           {"segmented", "region", "refined", "reused", "skipped"}) {
         TrackFrames(outcome);
       }
       for (size_t c = 0; c < kAllStatusCodes.size(); ++c) {

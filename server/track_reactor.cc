@@ -291,9 +291,10 @@ class TrackReactor final
     }
     v1::TrackResponse response =
         ToTrackResponse(tracked, request_id_, wire.sequence(), skipped);
-    RecordTrackFrame(tracked.reused    ? "reused"
-                     : tracked.refined ? "refined"
-                                       : "segmented",
+    RecordTrackFrame(tracked.reused            ? "reused"
+                     : tracked.refined         ? "refined"
+                     : !tracked.region.empty() ? "region"
+                                               : "segmented",
                      SecondsSince(pending.arrived));
     std::unique_ptr<v1::TrackResponse> recorded;
     if (record_stream_ != 0) {
@@ -462,6 +463,13 @@ v1::TrackResponse ToTrackResponse(const TrackedFrame& frame,
   out.set_joined(static_cast<uint32_t>(frame.joined));
   out.set_split(static_cast<uint32_t>(frame.split));
   out.set_refined(frame.refined);
+  if (!frame.region.empty()) {
+    v1::BoundingBox* region = out.mutable_segmented_region();
+    region->set_u(static_cast<uint32_t>(frame.region.x));
+    region->set_v(static_cast<uint32_t>(frame.region.y));
+    region->set_width(static_cast<uint32_t>(frame.region.width));
+    region->set_height(static_cast<uint32_t>(frame.region.height));
+  }
   out.set_frames_skipped(skipped);
   out.set_seconds(frame.seconds);
   for (const StageTiming& timing : frame.timings) {

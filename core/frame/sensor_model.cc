@@ -65,25 +65,28 @@ SensorModel SensorModelFor(SensorKind kind, const Intrinsics& intrinsics) {
       model.max_range_m = kStereoMaxRange;
       model.min_range_m = kStereoMinRange;
       break;
-    case SensorKind::kGeneric: {
-      // The focal length a 640-pixel-wide frame of this camera would have,
-      // the width being the longer side (a camera rolled a quarter turn
-      // sends its 640 pixels as rows).
-      const double width = 2.0 * (std::max(intrinsics.cx, intrinsics.cy) + 0.5);
-      const double fx640 = width > 0.0 && intrinsics.fx > 0.0
-                               ? intrinsics.fx * 640.0 / width
-                               : 0.0;
-      if (fx640 >= kPrimeSenseFx640Min && fx640 <= kPrimeSenseFx640Max) {
-        model = SensorModelFor(SensorKind::kKinectV1, intrinsics);
-      } else {
-        model = SensorModelFor(SensorKind::kActiveStereo, intrinsics);
+    case SensorKind::kGeneric:
+      model = SensorModelFor(NoiseKind(kind, intrinsics), intrinsics);
+      if (model.kind == SensorKind::kActiveStereo) {
         model.max_range_m = kGenericMaxRange;
       }
       model.kind = SensorKind::kGeneric;
       break;
-    }
   }
   return model;
+}
+
+SensorKind NoiseKind(SensorKind kind, const Intrinsics& intrinsics) {
+  if (kind != SensorKind::kGeneric) return kind;
+  // The focal length a 640-pixel-wide frame of this camera would have, the
+  // width being the longer side (a camera rolled a quarter turn sends its
+  // 640 pixels as rows).
+  const double width = 2.0 * (std::max(intrinsics.cx, intrinsics.cy) + 0.5);
+  const double fx640 =
+      width > 0.0 && intrinsics.fx > 0.0 ? intrinsics.fx * 640.0 / width : 0.0;
+  return fx640 >= kPrimeSenseFx640Min && fx640 <= kPrimeSenseFx640Max
+             ? SensorKind::kKinectV1
+             : SensorKind::kActiveStereo;
 }
 
 }  // namespace fovea

@@ -65,6 +65,13 @@ struct SensorModel {
 // noisier one, with a 3 m range.
 SensorModel SensorModelFor(SensorKind kind, const Intrinsics& intrinsics);
 
+// The kind whose noise SensorModelFor gives `kind` with these intrinsics:
+// `kind` itself, or for kGeneric kKinectV1 or kActiveStereo as chosen
+// above (whose range is then the generic 3 m, not the stereo one). For a
+// part of the frame cut out (its principal point moved), whose own
+// intrinsics would choose otherwise.
+SensorKind NoiseKind(SensorKind kind, const Intrinsics& intrinsics);
+
 }  // namespace fovea
 
 #endif  // FOVEA_CORE_FRAME_SENSOR_MODEL_H_

@@ -167,6 +167,14 @@ int OverlapWithHeld(const cv::Mat& mask, const SegmentedObject& held) {
   return cv::countNonZero(both);
 }
 
+bool HeldTouch(const SegmentedObject& a, const SegmentedObject& b,
+               cv::Size size, int radius) {
+  const cv::Rect grown(a.box.x - radius, a.box.y - radius,
+                       a.box.width + 2 * radius, a.box.height + 2 * radius);
+  if ((grown & b.box).empty()) return false;
+  return Touch(MaskAtSize(a, size), a.box, MaskAtSize(b, size), b.box, radius);
+}
+
 bool IsWhole(int area, const std::vector<Piece>& pieces) {
   if (pieces.size() < 2) return false;
   int sum = 0;

@@ -81,6 +81,11 @@ cv::Mat MaskAtSize(const SegmentedObject& held, cv::Size size);
 // mask.
 int OverlapWithHeld(const cv::Mat& mask, const SegmentedObject& held);
 
+// Whether two held objects (CropMaskToBox) of a frame of `size` touch, as
+// Touch's.
+bool HeldTouch(const SegmentedObject& a, const SegmentedObject& b,
+               cv::Size size, int radius);
+
 // Whether an object of `area` pixels is the whole of `pieces` (at least
 // two) rather than one of them: nearer their summed area than the largest's.
 bool IsWhole(int area, const std::vector<Piece>& pieces);

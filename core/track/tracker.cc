@@ -87,6 +87,22 @@ absl::Status Validate(const TrackerOptions& options) {
   if (options.remember_frames < 0) {
     return absl::InvalidArgumentError("track.remember_frames: must be >= 0");
   }
+  if (options.region.margin_px < 0) {
+    return absl::InvalidArgumentError("track.region.margin_px: must be >= 0");
+  }
+  if (options.region.min_size.width <= 0 ||
+      options.region.min_size.height <= 0) {
+    return absl::InvalidArgumentError("track.region.min_size: must be > 0");
+  }
+  if (!(options.region.max_fraction > 0.0 &&
+        options.region.max_fraction <= 1.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("track.region.max_fraction: ", options.region.max_fraction,
+                     " is not in (0, 1]"));
+  }
+  if (options.region_whole_every < 1) {
+    return absl::InvalidArgumentError("track.region_whole_every: must be >= 1");
+  }
   if (options.refine_frames < 0 || options.refine_frames == 1 ||
       options.refine_frames > 64) {
     return absl::InvalidArgumentError(
@@ -96,77 +112,10 @@ absl::Status Validate(const TrackerOptions& options) {
   return absl::OkStatus();
 }
 
-void Tracker::AverageInto(const cv::Mat& depth, cv::Mat& mean, cv::Mat& count) {
-  for (int v = 0; v < depth.rows; ++v) {
-    const float* z = depth.ptr<float>(v);
-    float* m = mean.ptr<float>(v);
-    uint8_t* n = count.ptr<uint8_t>(v);
-    for (int u = 0; u < depth.cols; ++u) {
-      if (!(z[u] > 0.0f && std::isfinite(z[u]))) continue;
-      ++n[u];
-      m[u] = n[u] == 1 ? z[u] : m[u] + (z[u] - m[u]) / static_cast<float>(n[u]);
-    }
-  }
-}
-
 Tracker::Tracker(const TrackerOptions& options, const RbfSvm* relation_svm)
     : options_(options),
       valid_(Validate(options)),
       relation_svm_(relation_svm) {}
-
-double Tracker::ChangedFraction(const RgbdFrame& frame,
-                                cv::Mat& changed) const {
-  const bool colors = !frame.color.empty() && !reference_.color.empty() &&
-                      frame.color.size() == reference_.color.size() &&
-                      frame.color.type() == CV_8UC3 &&
-                      reference_.color.type() == CV_8UC3;
-  changed = cv::Mat(frame.depth.size(), CV_8UC1, cv::Scalar(0));
-  int64_t valid = 0;
-  for (int v = 0; v < frame.depth.rows; ++v) {
-    const float* z = frame.depth.ptr<float>(v);
-    const float* z0 = reference_.depth.ptr<float>(v);
-    const cv::Vec3b* c = colors ? frame.color.ptr<cv::Vec3b>(v) : nullptr;
-    const cv::Vec3b* c0 = colors ? reference_.color.ptr<cv::Vec3b>(v) : nullptr;
-    uint8_t* out = changed.ptr<uint8_t>(v);
-    for (int u = 0; u < frame.depth.cols; ++u) {
-      const bool has = z[u] > 0.0f;  // false for NaN
-      const bool had = z0[u] > 0.0f;
-      if (!has && !had) continue;
-      ++valid;
-      // Depth that came or went counts as a change: an object placed on a
-      // dark table, or taken away, may show as exactly that.
-      bool moved = has != had;
-      if (!moved) {
-        const float limit =
-            std::max(options_.change_min_m,
-                     options_.change_sigmas * sensor_.DepthSigma(z0[u]));
-        moved = std::abs(z[u] - z0[u]) > limit;
-      }
-      if (!moved && colors) {
-        for (int k = 0; k < 3; ++k) {
-          moved |= std::abs(static_cast<int>(c[u][k]) - c0[u][k]) >
-                   options_.color_change;
-        }
-      }
-      out[u] = moved ? 255 : 0;
-    }
-  }
-  // Noise changes single pixels and the rims of depth edges (dropouts come
-  // and go there); a real change is a region: what survives an opening.
-  cv::morphologyEx(changed, changed, cv::MORPH_OPEN,
-                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5)));
-  return valid == 0 ? 1.0
-                    : static_cast<double>(cv::countNonZero(changed)) / valid;
-}
-
-bool Tracker::CameraStill(const std::optional<Eigen::Isometry3f>& pose) const {
-  if (pose.has_value() != reference_pose_.has_value()) return false;
-  if (!pose) return true;  // the pixels decide
-  const Eigen::Isometry3f delta = reference_pose_->inverse() * *pose;
-  const float angle = Eigen::AngleAxisf(delta.rotation()).angle();
-  return delta.translation().norm() <= options_.still_m &&
-         std::abs(angle) <= options_.still_rad;
-}
 
 void Tracker::Reidentify(const cv::Mat& color,
                          const std::vector<SegmentedObject>& found,
@@ -223,67 +172,6 @@ void Tracker::Reidentify(const cv::Mat& color,
       match[free_tracks[a]] = free_objects[pairs[a]];
     }
   }
-}
-
-absl::StatusOr<bool> Tracker::Segment(
-    const RgbdFrame& frame, IncrementalOptions segment,
-    const std::optional<Eigen::Isometry3f>& pose, double changed_fraction,
-    std::vector<SegmentedObject>& found, const InterruptCheck& interrupt) {
-  std::optional<SupportPlane> support;
-  SegmentSinks sinks;
-  sinks.support = [&support](const SupportPlane& plane) {
-    support = plane;
-    return absl::OkStatus();
-  };
-  sinks.object = [&found](SegmentedObject object) {
-    found.push_back(std::move(object));
-    return absl::OkStatus();
-  };
-  std::optional<Eigen::Vector4f>& hint = segment.detect.scene.support.plane;
-  const bool asked = hint.has_value();
-  bool kept = false;
-  if (!asked && options_.reuse_support && support_ &&
-      (pose || changed_fraction <= options_.reuse_support_changed)) {
-    // The world's plane in this camera: n_c = R^T n_w, d_c = d_w + n_w . t.
-    hint = *support_;
-    if (pose) {
-      hint->head<3>() = pose->linear().transpose() * support_->head<3>();
-      (*hint)[3] =
-          (*support_)[3] + support_->head<3>().dot(pose->translation());
-    }
-    kept = true;
-  }
-  absl::Status status =
-      RunSegmentIncremental(frame, segment, relation_svm_, sinks, interrupt)
-          .status();
-  const bool fits =
-      status.ok() && support.has_value() &&
-      support->inlier_count >= options_.support_fit * support_inliers_;
-  if (kept && (status.ok() ? !fits : absl::IsNotFound(status))) {
-    // It no longer fits (or has nothing on it): search afresh.
-    found.clear();
-    support.reset();
-    hint.reset();
-    kept = false;
-    status =
-        RunSegmentIncremental(frame, segment, relation_svm_, sinks, interrupt)
-            .status();
-  }
-  FOVEA_RETURN_IF_ERROR(status);
-  if (!support.has_value()) {
-    support_.reset();
-    return kept;
-  }
-  if (!kept) support_inliers_ = support->inlier_count;
-  // Kept in the world: n_w = R n_c, d_w = d_c - n_w . t.
-  Eigen::Vector4f plane(support->normal.x(), support->normal.y(),
-                        support->normal.z(), support->d);
-  if (pose) {
-    plane.head<3>() = pose->linear() * support->normal;
-    plane[3] = support->d - plane.head<3>().dot(pose->translation());
-  }
-  support_ = plane;
-  return kept;
 }
 
 TrackedObject Tracker::Gone(const Track& track) {
@@ -376,9 +264,58 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
     if (still && !out.refined && segment.change_weight > 0.0f) {
       segment.change = changed;
     }
-    FOVEA_ASSIGN_OR_RETURN(out.support_kept,
-                           Segment(input, std::move(segment), camera_to_world,
-                                   out.changed_fraction, found, interrupt));
+    // Only what changed, when the rest can be kept as it was.
+    std::optional<cv::Rect> region;
+    if (options_.reuse_regions && options_.reuse_support && still &&
+        !out.refined && support_ &&
+        regions_in_a_row_ < options_.region_whole_every &&
+        out.changed_fraction <= options_.reuse_support_changed &&
+        segment.attention_points.empty() &&
+        segment.object_points.format != ObjectPointsFormat::kIndices) {
+      std::vector<const SegmentedObject*> last;
+      std::vector<cv::Rect> held;
+      for (const Track& t : tracks) {
+        if (t.last_seen_frame != frame_index_ - 1) continue;
+        last.push_back(&t.object);
+        held.push_back(t.object.box);
+      }
+      // Objects that touch may be pieces of one: cut again with what
+      // changed, as the whole frame would cut them again, so that a whole
+      // cut can join them.
+      cv::Mat around = changed.clone();
+      for (size_t i = 0; i < last.size(); ++i) {
+        for (size_t k = i + 1; k < last.size(); ++k) {
+          if (HeldTouch(*last[i], *last[k], frame.depth.size(), 3)) {
+            around(last[i]->box).setTo(255);
+            around(last[k]->box).setTo(255);
+          }
+        }
+      }
+      region = RegionToSegment(around, held, options_.region);
+    }
+    bool partial = false;
+    if (region) {
+      const SteadyClock::time_point region_start = SteadyClock::now();
+      FOVEA_ASSIGN_OR_RETURN(
+          partial, SegmentRegion(input, segment, camera_to_world, *region,
+                                 changed, tracks, found, interrupt));
+      // The whole frame's cut, instead, has what is left of the frame's
+      // time budget.
+      if (!partial && segment.time_budget_seconds > 0.0) {
+        segment.time_budget_seconds = std::max(
+            1e-3, segment.time_budget_seconds - SecondsSince(region_start));
+      }
+    }
+    if (partial) {
+      out.region = *region;
+      out.support_kept = true;
+      ++regions_in_a_row_;
+    } else {
+      regions_in_a_row_ = 0;
+      FOVEA_ASSIGN_OR_RETURN(out.support_kept,
+                             Segment(input, std::move(segment), camera_to_world,
+                                     out.changed_fraction, found, interrupt));
+    }
     clock.Lap("segment");
 
     // Candidates: tracks seen within remember_frames.

@@ -126,6 +126,62 @@ TEST_F(ServerTest, TrackKeepsIdentitiesOverAStillScene) {
       std::chrono::seconds(10)));
 }
 
+// An object pushed across a still scene: the frames after the first are
+// segmented only in the region around it, which the response gives, and
+// the objects outside it come back as they were, mask for mask.
+TEST_F(ServerTest, TrackSegmentsOnlyTheRegionThatChanged) {
+  StartServer();
+  const synth::Sequence sequence =
+      synth::GenerateSequence(synth::SequenceKind::kPush, 5, 3);
+  auto context = Context();
+  std::unique_ptr<Stream> stream = stub_->Track(context.get());
+  ASSERT_TRUE(stream->Write(Options("push")));
+  std::vector<v1::TrackResponse> responses;
+  for (size_t t = 0; t < sequence.frames.size(); ++t) {
+    ASSERT_TRUE(stream->Write(FrameMessage(sequence.frames[t], t)));
+    v1::TrackResponse response;
+    ASSERT_TRUE(stream->Read(&response));
+    responses.push_back(response);
+  }
+  stream->WritesDone();
+  ASSERT_TRUE(stream->Finish().ok());
+  ASSERT_EQ(responses.size(), 3u);
+  EXPECT_FALSE(responses[0].has_segmented_region());
+  const int width = sequence.frames[0].frame.frame.width();
+  const int height = sequence.frames[0].frame.frame.height();
+  int kept_outside = 0;
+  for (size_t t = 1; t < responses.size(); ++t) {
+    ASSERT_TRUE(responses[t].has_segmented_region()) << "frame " << t;
+    const v1::BoundingBox& region = responses[t].segmented_region();
+    EXPECT_GT(region.width(), 0u);
+    EXPECT_LE(static_cast<int>(region.u() + region.width()), width);
+    EXPECT_LE(static_cast<int>(region.v() + region.height()), height);
+    EXPECT_LT(region.width() * region.height(),
+              static_cast<uint32_t>(width * height / 2));
+    for (const v1::TrackedObject& o : responses[t].objects()) {
+      const v1::BoundingBox& box = o.object().box();
+      const bool outside = box.u() + box.width() <= region.u() ||
+                           region.u() + region.width() <= box.u() ||
+                           box.v() + box.height() <= region.v() ||
+                           region.v() + region.height() <= box.v();
+      if (!outside) continue;
+      ++kept_outside;
+      EXPECT_EQ(o.state(), v1::TRACK_STATE_KEPT);
+      bool same = false;
+      for (const v1::TrackedObject& b : responses[t - 1].objects()) {
+        if (b.track_id() != o.track_id()) continue;
+        same = b.object().mask().SerializeAsString() ==
+               o.object().mask().SerializeAsString();
+      }
+      EXPECT_TRUE(same) << "track " << o.track_id() << ", frame " << t;
+    }
+  }
+  EXPECT_GT(kept_outside, 0);
+  EXPECT_EQ(
+      MetricValue(Scrape(), "fovea_track_frames_total", {"outcome=\"region\""}),
+      2);
+}
+
 // Frames that arrive while one is processed wait in one slot; a newer one
 // replaces the waiting one. With the first frame's job held, frames 2-4
 // arrive: 2 and 3 are skipped, 4 is answered after 1.

@@ -181,6 +181,14 @@ ABSL_FLAG(double, reidentify_distance,
           fovea::TrackerOptions().reidentify_distance,
           "track: the tracker's re-identification threshold (Bhattacharyya "
           "distance of colour histograms); 0 turns re-identification off.");
+ABSL_FLAG(bool, reuse_regions, fovea::TrackerOptions().reuse_regions,
+          "track: segment only the region that changed when the camera is "
+          "still, keeping the objects outside it (TrackerOptions::"
+          "reuse_regions); false segments every changed frame whole");
+ABSL_FLAG(int, region_whole_every, fovea::TrackerOptions().region_whole_every,
+          "track: after this many region-only segmentations in a row the "
+          "next changed frame is segmented whole (TrackerOptions::"
+          "region_whole_every).");
 ABSL_FLAG(double, change_weight, fovea::IncrementalOptions().change_weight,
           "track: the weight of the temporal cue (what changed since the "
           "last frame) in INC's saliency; 0 turns it off.");

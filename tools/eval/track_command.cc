@@ -27,6 +27,8 @@ ABSL_DECLARE_FLAG(std::string, out);
 ABSL_DECLARE_FLAG(bool, verbose);
 ABSL_DECLARE_FLAG(double, reidentify_distance);
 ABSL_DECLARE_FLAG(double, change_weight);
+ABSL_DECLARE_FLAG(bool, reuse_regions);
+ABSL_DECLARE_FLAG(int, region_whole_every);
 
 namespace fovea::eval {
 
@@ -97,6 +99,8 @@ int RunTrackCommand() {
   options.verbose = absl::GetFlag(FLAGS_verbose);
   options.tracker.reidentify_distance =
       static_cast<float>(absl::GetFlag(FLAGS_reidentify_distance));
+  options.tracker.reuse_regions = absl::GetFlag(FLAGS_reuse_regions);
+  options.tracker.region_whole_every = absl::GetFlag(FLAGS_region_whole_every);
   options.tracker.segment.change_weight =
       static_cast<float>(absl::GetFlag(FLAGS_change_weight));
   if (absl::Status valid = Validate(options.tracker); !valid.ok()) {
@@ -112,7 +116,8 @@ int RunTrackCommand() {
   std::printf(
       "| kind | sequences | frames | IDF1 (bound) | switches / 100 "
       "object-frames | "
-      "overlap F (track / single frame) | joined / split | reused | ms per "
+      "overlap F (track / single frame) | joined / split | reused / region | "
+      "ms per "
       "frame (track / fresh) | cost | changed first (track / fresh) "
       "|\n|---|---|---|---|---|---|---|---|---|---|---|\n");
   // Runs and prints one kind's figures; false on error.
@@ -128,13 +133,14 @@ int RunTrackCommand() {
             : 100.0 * f->identities.switches / f->identities.truth_frames;
     std::printf(
         "| %s | %d | %d | %.3f (%.3f) | %.2f | %.3f / %.3f | %lld / %lld | "
-        "%.2f | "
+        "%.2f / %.2f | "
         "%.1f / "
         "%.1f | %.2fx | %s |\n",
         f->kind.c_str(), f->sequences, f->frames, Idf1(f->identities),
         DetectionF1(*f), switches, f->overlap_f, f->single_frame_f,
         static_cast<long long>(f->joined), static_cast<long long>(f->split),
-        f->reused_fraction, f->median_track_ms, f->median_fresh_ms,
+        f->reused_fraction, f->region_fraction, f->median_track_ms,
+        f->median_fresh_ms,
         f->median_fresh_ms > 0 ? f->median_track_ms / f->median_fresh_ms : 0.0,
         f->change_frames == 0
             ? "-"
@@ -148,14 +154,16 @@ int RunTrackCommand() {
           "\"detection_f1\":%.4f,\"switches_per_100\":%.3f,\"overlap_f\":%.4f,"
           "\"single_frame_f\":"
           "%.4f,\"joined\":%lld,\"split\":%lld,\"reused\":%.3f,"
+          "\"region\":%.3f,"
           "\"track_ms\":%.2f,"
           "\"fresh_ms\":%.2f,\"change_frames\":%d,\"changed_first\":%d,"
           "\"fresh_changed_first\":%d}\n",
           f->kind.c_str(), f->sequences, f->frames, Idf1(f->identities),
           DetectionF1(*f), switches, f->overlap_f, f->single_frame_f,
           static_cast<long long>(f->joined), static_cast<long long>(f->split),
-          f->reused_fraction, f->median_track_ms, f->median_fresh_ms,
-          f->change_frames, f->changed_first, f->fresh_changed_first);
+          f->reused_fraction, f->region_fraction, f->median_track_ms,
+          f->median_fresh_ms, f->change_frames, f->changed_first,
+          f->fresh_changed_first);
     }
     return true;
   };

@@ -51,7 +51,8 @@ double Median(std::vector<double> v) {
 }
 
 // colour | depth (0-2 m) | the tracks' masks, each track in its own
-// colour, as <out_dir>/<frame name>.png.
+// colour (and the region segmented again, in white), as
+// <out_dir>/<frame name>.png.
 absl::Status WriteTrackedPng(const synth::SequenceFrame& frame,
                              const TrackedFrame& tracked,
                              const std::string& out_dir) {
@@ -67,6 +68,10 @@ absl::Status WriteTrackedPng(const synth::SequenceFrame& frame,
     masks.setTo(cv::Scalar((o.track_id * 67) % 255, (o.track_id * 131) % 255,
                            (o.track_id * 199) % 255),
                 o.object.mask);
+  }
+  // The region segmented again, when only it was (TrackedFrame::region).
+  if (!tracked.region.empty()) {
+    cv::rectangle(masks, tracked.region, cv::Scalar(255, 255, 255), 1);
   }
   cv::Mat row;
   cv::hconcat(std::vector<cv::Mat>{bgr, depth, masks}, row);
@@ -312,6 +317,7 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
   std::map<std::string, double> stage_seconds;  // the fresh calls
   std::map<std::string, double> track_stage_seconds;
   int reused = 0;
+  int regions = 0;
   for (int s = 0; s < count; ++s) {
     const synth::Sequence sequence = sequence_at(s);
     Tracker tracker(options.tracker, models.inc ? &*models.inc : nullptr);
@@ -331,6 +337,7 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
         track_stage_seconds[t.stage] += t.seconds;
       }
       reused += tracked.reused ? 1 : 0;
+      regions += tracked.region.empty() ? 0 : 1;
       figures.joined += tracked.joined;
       figures.split += tracked.split;
       events.emplace_back(tracked.joined, tracked.split);
@@ -391,6 +398,7 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
     figures.overlap_f = f_sum / figures.frames;
     figures.single_frame_f = fresh_f_sum / figures.frames;
     figures.reused_fraction = static_cast<double>(reused) / figures.frames;
+    figures.region_fraction = static_cast<double>(regions) / figures.frames;
   }
   if (options.verbose && figures.frames > 0) {
     PrintStages(figures.kind, "a fresh call's", stage_seconds, figures.frames);

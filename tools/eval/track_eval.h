@@ -87,6 +87,9 @@ struct TrackFigures {
   int64_t detections_matched = 0;
   int64_t detections = 0;
   double reused_fraction = 0.0;  // of the frames
+  // Of the frames: those segmented only in the region that changed
+  // (TrackedFrame::region).
+  double region_fraction = 0.0;
   double median_track_ms = 0.0;
   double median_fresh_ms = 0.0;
   // Frames of a still camera (the same pose as the frame before) where

@@ -68,5 +68,21 @@ TEST(SensorModelTest, GenericPicksTheModelFromTheFocalLength) {
   }
 }
 
+TEST(SensorModelTest, NoiseKindIsTheModelGenericChoseForTheWholeFrame) {
+  EXPECT_EQ(NoiseKind(SensorKind::kGeneric, kKinectV1Intrinsics),
+            SensorKind::kKinectV1);
+  EXPECT_EQ(
+      NoiseKind(SensorKind::kGeneric, Intrinsics{612.9, 613.2, 322.5, 248.2}),
+      SensorKind::kActiveStereo);
+  // A named kind is itself, whatever the intrinsics.
+  EXPECT_EQ(NoiseKind(SensorKind::kActiveStereo, kKinectV1Intrinsics),
+            SensorKind::kActiveStereo);
+  // A 200 x 150 cut-out of the Kinect's frame (its principal point moved
+  // by the corner, 220, 165) would pass for another camera: the reason a
+  // part of a frame takes the whole frame's kind.
+  const Intrinsics cut{525.0, 525.0, 99.5, 74.5};
+  EXPECT_EQ(NoiseKind(SensorKind::kGeneric, cut), SensorKind::kActiveStereo);
+}
+
 }  // namespace
 }  // namespace fovea

@@ -5,7 +5,8 @@
 // put down elsewhere keeps its own, objects swept along together and then
 // pulled apart split and get back their identities (whether INC cut the
 // pair whole meanwhile, or the joined track matched neither part), and a
-// fragment does not take a moved object's identity.
+// fragment does not take a moved object's identity, and a pushed object is
+// cut again in the region around it while the rest is kept as it was.
 
 #include "core/track/tracker.h"
 
@@ -16,6 +17,7 @@
 #include <filesystem>
 #include <map>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <set>
 #include <utility>
 #include <vector>
@@ -475,6 +477,72 @@ TEST(Tracker, PartsThatMovedApartFromAnUnmatchedJoinedTrackTakeTheirPieces) {
   ExpectOneIdentityEach(tracks, pair);
 }
 
+// The identity of the object of `sequence` whose pixels' centroid moved
+// most from the first frame to the last: the one pushed.
+int PushedObject(const Sequence& sequence) {
+  const auto centroids = [](const synth::SequenceFrame& f) {
+    std::map<int, cv::Point2d> at;
+    for (size_t k = 0; k < f.object_ids.size(); ++k) {
+      const cv::Moments m =
+          cv::moments(f.frame.labels == 10 * (static_cast<int>(k) + 2), true);
+      if (m.m00 > 0) at[f.object_ids[k]] = {m.m10 / m.m00, m.m01 / m.m00};
+    }
+    return at;
+  };
+  const std::map<int, cv::Point2d> first = centroids(sequence.frames.front());
+  const std::map<int, cv::Point2d> last = centroids(sequence.frames.back());
+  int pushed = -1;
+  double most = 0.0;
+  for (const auto& [id, at] : first) {
+    if (last.count(id) == 0) continue;
+    const double moved = cv::norm(last.at(id) - at);
+    if (moved > most) {
+      most = moved;
+      pushed = id;
+    }
+  }
+  return pushed;
+}
+
+TEST(Tracker, APushedObjectIsCutAgainInItsRegionAndTheRestIsKeptAsItWas) {
+  ASSERT_NE(Models(), nullptr);
+  const Sequence sequence = GenerateSequence(SequenceKind::kPush, 3, 8);
+  const int pushed = PushedObject(sequence);
+  ASSERT_GE(pushed, 0);
+  std::vector<TrackedFrame> frames;
+  const std::map<int, std::set<int>> tracks = Play(sequence, false, &frames);
+  int regions = 0;
+  for (size_t t = 1; t < frames.size(); ++t) {
+    const cv::Rect region = frames[t].region;
+    if (region.empty()) continue;
+    ++regions;
+    EXPECT_LT(region.area(), frames[t].objects.front().object.mask.total() / 2);
+    int masks_of_pushed = 0;
+    for (const TrackedObject& o : frames[t].objects) {
+      if (o.state == TrackState::kGone) continue;
+      masks_of_pushed += TruthOf(sequence.frames[t], o.object.mask) == pushed;
+      if (!(o.object.box & region).empty()) continue;
+      // Outside the region: the last frame's object, pixel for pixel.
+      EXPECT_EQ(o.state, TrackState::kKept);
+      const auto before = std::find_if(
+          frames[t - 1].objects.begin(), frames[t - 1].objects.end(),
+          [&](const TrackedObject& b) { return b.track_id == o.track_id; });
+      ASSERT_NE(before, frames[t - 1].objects.end()) << "track " << o.track_id;
+      EXPECT_EQ(cv::countNonZero(before->object.mask != o.object.mask), 0)
+          << "track " << o.track_id << ", frame " << t;
+    }
+    // The pushed object comes back as one mask.
+    EXPECT_EQ(masks_of_pushed, 1) << "frame " << t;
+  }
+  // Of the 7 frames after the first, where it moved, all but every third
+  // (TrackerOptions::region_whole_every, 2): 5, and 4 should one of them
+  // have been cut whole for cause.
+  EXPECT_GE(regions, 4);
+  // With one identity all along.
+  ASSERT_EQ(tracks.count(pushed), 1u);
+  EXPECT_EQ(tracks.at(pushed).size(), 1u);
+}
+
 TEST(Tracker, BadOptionsAreNamed) {
   TrackerOptions options;
   options.static_fraction = 1.5;
@@ -484,6 +552,10 @@ TEST(Tracker, BadOptionsAreNamed) {
   options = TrackerOptions{};
   options.match_area_ratio = 0.5f;
   EXPECT_NE(Validate(options).message().find("track.match_area_ratio"),
+            std::string::npos);
+  options = TrackerOptions{};
+  options.region.max_fraction = 0.0;
+  EXPECT_NE(Validate(options).message().find("track.region.max_fraction"),
             std::string::npos);
   options = TrackerOptions{};
   options.match_m = 0.0f;
