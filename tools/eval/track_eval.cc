@@ -327,8 +327,33 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
     for (const synth::SequenceFrame& frame : sequence.frames) {
       std::optional<Eigen::Isometry3f> pose;
       if (options.with_pose) pose = frame.camera_to_world;
+      // The fresh call on the same frame, timed before the tracker's on
+      // every other frame and after it on the rest: whichever runs second
+      // finds the thread pool awake and the frame in cache, which on an
+      // idle machine made the second 1.7x faster.
+      std::vector<cv::Mat> fresh;
+      const auto run_fresh = [&]() -> absl::Status {
+        SegmentSinks sinks;
+        sinks.object = [&fresh](SegmentedObject object) {
+          fresh.push_back(std::move(object.mask));
+          return absl::OkStatus();
+        };
+        const SteadyClock::time_point start = SteadyClock::now();
+        FOVEA_ASSIGN_OR_RETURN(
+            SegmentSummary summary,
+            RunSegmentIncremental(frame.frame.frame, options.tracker.segment,
+                                  models.inc ? &*models.inc : nullptr, sinks));
+        fresh_ms.push_back(SecondsSince(start) * 1e3);
+        for (const StageTiming& t : summary.timings) {
+          stage_seconds[t.stage] += t.seconds;
+        }
+        return absl::OkStatus();
+      };
+      const bool fresh_first = (fresh_ms.size() % 2) == 1;
+      if (fresh_first) FOVEA_RETURN_IF_ERROR(run_fresh());
       FOVEA_ASSIGN_OR_RETURN(TrackedFrame tracked,
                              tracker.Process(frame.frame.frame, pose));
+      if (!fresh_first) FOVEA_RETURN_IF_ERROR(run_fresh());
       if (!options.out_dir.empty() && s < options.out_sequences) {
         FOVEA_RETURN_IF_ERROR(WriteTrackedPng(frame, tracked, options.out_dir));
       }
@@ -351,21 +376,6 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
       }
       f_sum += MeanBestF(frame, masks);
 
-      std::vector<cv::Mat> fresh;
-      SegmentSinks sinks;
-      sinks.object = [&fresh](SegmentedObject object) {
-        fresh.push_back(std::move(object.mask));
-        return absl::OkStatus();
-      };
-      const SteadyClock::time_point start = SteadyClock::now();
-      FOVEA_ASSIGN_OR_RETURN(
-          SegmentSummary summary,
-          RunSegmentIncremental(frame.frame.frame, options.tracker.segment,
-                                models.inc ? &*models.inc : nullptr, sinks));
-      fresh_ms.push_back(SecondsSince(start) * 1e3);
-      for (const StageTiming& t : summary.timings) {
-        stage_seconds[t.stage] += t.seconds;
-      }
       fresh_f_sum += MeanBestF(frame, fresh);
       // Counted with a still camera only: the cue is given only then.
       if (previous != nullptr &&
