@@ -33,7 +33,7 @@ void AddGapNeighbours(const cv::Mat& labels, const cv::Rect& box, float fx,
       const int a = row[u];
       if (a < 0) continue;
       // Right and down, across pixels without a surface only.
-      for (const auto [du, dv] : {std::pair{1, 0}, std::pair{0, 1}}) {
+      for (const auto& [du, dv] : {std::pair{1, 0}, std::pair{0, 1}}) {
         for (int step = 1; step <= gap + 1; ++step) {
           const int x = u + du * step;
           const int y = v + dv * step;

@@ -23,6 +23,7 @@ namespace {
 using ::fovea::server::testing::MakeSyntheticRequest;
 using ::fovea::server::testing::MetricValue;
 using ::fovea::server::testing::ServerTest;
+using ::fovea::server::testing::WaitFor;
 using ::testing::AnyOf;
 using ::testing::Eq;
 using ::testing::HasSubstr;
@@ -326,6 +327,15 @@ TEST_F(HostileRequestTest, MemoryQuotaRefusesWhatDoesNotFit) {
     refused += code != grpc::StatusCode::OK ? 1 : 0;
   }
   EXPECT_GE(refused, 1);
+  // A refused call's status reaches the client before the server has let go
+  // of what it had taken in: the quota frees up soon after, and the server
+  // serves again.
+  EXPECT_TRUE(WaitFor(
+      [&] {
+        v1::DetectResponse response;
+        return Detect(ShRequest(), &response).ok();
+      },
+      std::chrono::seconds(10)));
   ExpectStillServing();
 }
 

@@ -6,9 +6,12 @@
 #include <unistd.h>
 
 #include <cstring>
+#include <map>
 #include <sstream>
 #include <thread>
+#include <utility>
 
+#include "core/base/mutex.h"
 #include "core/synth/synth_scene.h"
 #include "server/convert.h"
 
@@ -128,7 +131,9 @@ std::string HealthStatus(const std::shared_ptr<grpc::Channel>& channel,
       response.status());
 }
 
-SyntheticRequest MakeSyntheticRequest(uint64_t seed, bool depth_16uc1) {
+namespace {
+
+SyntheticRequest RenderSyntheticRequest(uint64_t seed, bool depth_16uc1) {
   synth::SynthScene scene = synth::GenerateScene(seed);
   SyntheticRequest out;
   out.request.set_request_id("synthetic-" + std::to_string(seed));
@@ -146,6 +151,22 @@ SyntheticRequest MakeSyntheticRequest(uint64_t seed, bool depth_16uc1) {
     }
   }
   return out;
+}
+
+}  // namespace
+
+SyntheticRequest MakeSyntheticRequest(uint64_t seed, bool depth_16uc1) {
+  // Rendered once per process and copied: a test that builds several
+  // requests of one scene spent most of its time rendering it again
+  // (29 s of HostileRequestTest.NonFiniteIntrinsicsAreInvalidArgument-
+  // NamingThem under ThreadSanitizer).
+  static Mutex mu;
+  static auto* rendered =
+      new std::map<std::pair<uint64_t, bool>, SyntheticRequest>();
+  MutexLock lock(&mu);
+  auto [it, added] = rendered->try_emplace({seed, depth_16uc1});
+  if (added) it->second = RenderSyntheticRequest(seed, depth_16uc1);
+  return it->second;
 }
 
 }  // namespace fovea::server::testing
