@@ -141,7 +141,14 @@ TEST_F(HostileRequestTest, HundredThousandRepeatedOperatorsAreRefusedQuickly) {
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(status.error_message(), HasSubstr("'ph'"));
   EXPECT_THAT(status.error_message(), HasSubstr("more than once"));
+  // Refused while parsing the options, far inside the deadline; under
+  // ThreadSanitizer parsing the 100000 entries alone took 1.4 s of a 2.0 s
+  // call beside another test (ctest -j2).
+#if defined(__SANITIZE_THREAD__)
+  EXPECT_LT(elapsed, std::chrono::seconds(5));
+#else
   EXPECT_LT(elapsed, std::chrono::seconds(2));
+#endif
   ExpectStillServing();
 }
 
