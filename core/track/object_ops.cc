@@ -24,10 +24,7 @@ Eigen::Vector3f CoordinateMedian(std::vector<Eigen::Vector3f> v) {
 
 bool Touch(const cv::Mat& a, const cv::Rect& a_box, const cv::Mat& b,
            const cv::Rect& b_box, int radius) {
-  const cv::Rect grown =
-      cv::Rect(a_box.x - radius, a_box.y - radius, a_box.width + 2 * radius,
-               a_box.height + 2 * radius) &
-      cv::Rect(0, 0, a.cols, a.rows);
+  const cv::Rect grown = Grown(a_box, radius) & cv::Rect(0, 0, a.cols, a.rows);
   const cv::Rect both = grown & b_box;
   if (both.empty()) return false;
   cv::Mat dilated;
@@ -169,9 +166,8 @@ int OverlapWithHeld(const cv::Mat& mask, const SegmentedObject& held) {
 
 bool HeldTouch(const SegmentedObject& a, const SegmentedObject& b,
                cv::Size size, int radius) {
-  const cv::Rect grown(a.box.x - radius, a.box.y - radius,
-                       a.box.width + 2 * radius, a.box.height + 2 * radius);
-  if ((grown & b.box).empty()) return false;
+  // Masks at the frame's size only for boxes that come near.
+  if ((Grown(a.box, radius) & b.box).empty()) return false;
   return Touch(MaskAtSize(a, size), a.box, MaskAtSize(b, size), b.box, radius);
 }
 

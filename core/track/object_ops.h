@@ -24,6 +24,11 @@ inline Eigen::Vector3f ToWorld(const std::optional<Eigen::Isometry3f>& pose,
 // The median of each coordinate of `v` (zero when empty).
 Eigen::Vector3f CoordinateMedian(std::vector<Eigen::Vector3f> v);
 
+// `r` grown by `by` pixels on every side (not clipped).
+inline cv::Rect Grown(const cv::Rect& r, int by) {
+  return {r.x - by, r.y - by, r.width + 2 * by, r.height + 2 * by};
+}
+
 // Whether masks `a` and `b` (CV_8UC1, same size; `a_box` and `b_box` their
 // bounding boxes) touch: `a` grown by `radius` pixels overlaps `b`.
 bool Touch(const cv::Mat& a, const cv::Rect& a_box, const cv::Mat& b,

@@ -4,14 +4,9 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
+#include "core/track/object_ops.h"
+
 namespace fovea {
-namespace {
-
-cv::Rect Grown(const cv::Rect& r, int by) {
-  return {r.x - by, r.y - by, r.width + 2 * by, r.height + 2 * by};
-}
-
-}  // namespace
 
 std::optional<cv::Rect> RegionToSegment(const cv::Mat& changed,
                                         const std::vector<cv::Rect>& held,
