@@ -43,6 +43,7 @@ std::string DefaultSaliencyStageLabel() {
 using ::fovea::server::testing::HealthStatus;
 using ::fovea::server::testing::kCallTimeout;
 using ::fovea::server::testing::MakeSyntheticRequest;
+using ::fovea::server::testing::MetricIncrease;
 using ::fovea::server::testing::MetricValue;
 using ::fovea::server::testing::ServerTest;
 using ::fovea::server::testing::SyntheticRequest;
@@ -395,11 +396,6 @@ TEST_F(ServerTest, CallsWhoseDeadlinePassedInTheQueueFreeTheirSlotAtOnce) {
   const double deadline_exceeded =
       Handled(before, "Detect", "DeadlineExceeded");
   const double exhausted = Handled(before, "Detect", "ResourceExhausted");
-  auto abandoned = [](const std::string& text) {
-    return MetricValue(text, "fovea_calls_shed_total",
-                       {"reason=\"abandoned_in_queue\""})
-        .value_or(0);
-  };
   std::future<grpc::Status> running = StartHeldDetect(request);
   for (int i = 0; i < 8; ++i) {
     v1::DetectResponse response;
@@ -425,7 +421,9 @@ TEST_F(ServerTest, CallsWhoseDeadlinePassedInTheQueueFreeTheirSlotAtOnce) {
   EXPECT_TRUE(running.get().ok());
   const std::string metrics = Scrape();
   EXPECT_EQ(Handled(metrics, "Detect", "ResourceExhausted"), exhausted);
-  EXPECT_EQ(abandoned(metrics) - abandoned(before), 8);
+  EXPECT_EQ(MetricIncrease(before, metrics, "fovea_calls_shed_total",
+                           {"reason=\"abandoned_in_queue\""}),
+            8);
 }
 
 TEST_F(ServerTest, Sym3dOnAnIttiPyramidWithTJunctionsFindsObjects) {

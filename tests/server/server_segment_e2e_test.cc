@@ -37,6 +37,7 @@ namespace {
 using ::fovea::server::testing::HealthStatus;
 using ::fovea::server::testing::kCallTimeout;
 using ::fovea::server::testing::MakeSyntheticRequest;
+using ::fovea::server::testing::MetricIncrease;
 using ::fovea::server::testing::MetricValue;
 using ::fovea::server::testing::ServerTest;
 using ::fovea::server::testing::SyntheticRequest;
@@ -129,11 +130,6 @@ TEST_F(ServerTest, SegmentStreamsPointsThenObjectsThenTheSummary) {
   v1::SegmentRequest request;
   request.set_request_id("seg-1");
   *request.mutable_frame() = MakeSyntheticRequest(3, false).request.frame();
-  // The metrics are the process's: other tests of this binary may have
-  // counted Segment calls before this one.
-  auto count = [](const std::string& text, const std::string& name) {
-    return MetricValue(text, name, {"grpc_method=\"Segment\""}).value_or(0);
-  };
   const std::string before = Scrape();
   const SegmentCall call = CallSegment(*stub_, request);
   ASSERT_TRUE(call.status.ok()) << call.status.error_message();
@@ -160,7 +156,7 @@ TEST_F(ServerTest, SegmentStreamsPointsThenObjectsThenTheSummary) {
   }
   const std::string text = Scrape();
   auto added = [&](const std::string& name) {
-    return count(text, name) - count(before, name);
+    return MetricIncrease(before, text, name, {"grpc_method=\"Segment\""});
   };
   EXPECT_EQ(added("fovea_objects_per_request_count"), 1);
   EXPECT_EQ(added("fovea_time_to_first_object_seconds_count"),

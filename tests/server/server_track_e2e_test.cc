@@ -25,6 +25,7 @@ namespace fovea::server {
 namespace {
 
 using ::fovea::server::testing::kCallTimeout;
+using ::fovea::server::testing::MetricIncrease;
 using ::fovea::server::testing::MetricValue;
 using ::fovea::server::testing::ServerTest;
 using ::fovea::server::testing::WaitFor;
@@ -270,13 +271,6 @@ TEST_F(ServerTest, TrackStreamsAreLimitedPerPeerAndClosedWhenIdle) {
   config.max_track_streams_per_peer = 1;
   config.track_idle_timeout_s = 0.5;
   StartServer(config);
-  // The metrics are the process's: other tests of this binary may have
-  // shed streams before this one.
-  auto shed = [](const std::string& text, const std::string& reason) {
-    return MetricValue(text, "fovea_calls_shed_total",
-                       {"reason=\"" + reason + "\""})
-        .value_or(0);
-  };
   const std::string before = Scrape();
   auto first_context = Context();
   std::unique_ptr<Stream> first = stub_->Track(first_context.get());
@@ -306,8 +300,12 @@ TEST_F(ServerTest, TrackStreamsAreLimitedPerPeerAndClosedWhenIdle) {
   EXPECT_THAT(idle.error_message(), HasSubstr("sent nothing"));
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
   const std::string metrics = Scrape();
-  EXPECT_EQ(shed(metrics, "idle_stream") - shed(before, "idle_stream"), 1);
-  EXPECT_EQ(shed(metrics, "stream_limit") - shed(before, "stream_limit"), 1);
+  EXPECT_EQ(MetricIncrease(before, metrics, "fovea_calls_shed_total",
+                           {"reason=\"idle_stream\""}),
+            1);
+  EXPECT_EQ(MetricIncrease(before, metrics, "fovea_calls_shed_total",
+                           {"reason=\"stream_limit\""}),
+            1);
   // The stream is closed once the server's side of the call is done too.
   EXPECT_TRUE(WaitFor(
       [&] {

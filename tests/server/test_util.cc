@@ -116,6 +116,13 @@ std::optional<double> MetricValue(const std::string& text,
   return std::nullopt;
 }
 
+double MetricIncrease(const std::string& before, const std::string& after,
+                      const std::string& name,
+                      const std::vector<std::string>& labels) {
+  return MetricValue(after, name, labels).value_or(0) -
+         MetricValue(before, name, labels).value_or(0);
+}
+
 std::string HealthStatus(const std::shared_ptr<grpc::Channel>& channel,
                          const std::string& service) {
   auto stub = grpc::health::v1::Health::NewStub(channel);

@@ -39,6 +39,13 @@ std::optional<double> MetricValue(const std::string& text,
                                   const std::string& name,
                                   const std::vector<std::string>& labels);
 
+// How much that sample grew from Prometheus text `before` to `after`, an
+// absent sample counting as 0. The metrics are the process's: the tests of
+// one binary, run in one process, see each other's calls.
+double MetricIncrease(const std::string& before, const std::string& after,
+                      const std::string& name,
+                      const std::vector<std::string>& labels);
+
 // grpc.health.v1 Check for `service` on `channel`: "SERVING",
 // "NOT_SERVING", ... or the gRPC error code's number as text when the
 // call fails.
