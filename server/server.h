@@ -70,8 +70,8 @@ struct ServerConfig {
   // 3600].
   double stream_stall_timeout_s = 5.0;
   // Track streams: open at once in all and from one peer address, [1,
-  // 100000]; one whose client sent nothing for track_idle_timeout_s is
-  // closed, (0, 3600].
+  // 100000]; one whose client sent nothing for track_idle_timeout_s, with
+  // none of its frames waiting or running, is closed, (0, 3600].
   int max_track_streams = 64;
   int max_track_streams_per_peer = 8;
   double track_idle_timeout_s = 10.0;

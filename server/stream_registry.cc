@@ -28,6 +28,11 @@ std::string PeerAddress(const std::string& peer) {
 
 void StreamRegistry::Handle::Touch() { last_touch_ns_.store(NowNs()); }
 
+void StreamRegistry::Handle::SetBusy(bool busy) {
+  if (!busy) Touch();  // before busy_ reads false: idle from now
+  busy_.store(busy);
+}
+
 StreamRegistry::StreamRegistry(StreamLimits limits) : limits_(limits) {
   reaper_ = std::thread([this] { Reap(); });
 }
@@ -93,7 +98,9 @@ void StreamRegistry::Reap() {
     const int64_t now = NowNs();
     std::vector<std::shared_ptr<Handle>> idle;
     for (const auto& [key, handle] : open_) {
-      if (now - handle->last_touch_ns_.load() > idle_ns) idle.push_back(handle);
+      if (!handle->busy_.load() && now - handle->last_touch_ns_.load() > idle_ns) {
+        idle.push_back(handle);
+      }
     }
     lock.unlock();
     for (const std::shared_ptr<Handle>& handle : idle) {

@@ -22,7 +22,8 @@ namespace fovea::server {
 struct StreamLimits {
   int max_streams = 64;          // open at once, all peers
   int max_streams_per_peer = 8;  // open at once from one peer address
-  // A stream whose client sent nothing for this long is cancelled.
+  // A stream whose client sent nothing for this long, while the server
+  // owed it nothing, is cancelled.
   std::chrono::milliseconds idle_timeout{10000};
   // fovea_calls_shed_total's reason for a stream cancelled so.
   std::string_view shed_reason = "idle_stream";
@@ -45,6 +46,10 @@ class StreamRegistry {
    public:
     // The client sent something: the stream is not idle.
     void Touch();
+    // The server is working for the stream (a frame queued or being
+    // processed): not idle, however long its client waits for the answer.
+    // Once set back to false, the idle time counts from then.
+    void SetBusy(bool busy);
 
    private:
     friend class StreamRegistry;
@@ -52,6 +57,7 @@ class StreamRegistry {
     std::function<void()> cancel_;  // guarded by mutex_; empty once closed
     std::string peer_;
     std::atomic<int64_t> last_touch_ns_{0};
+    std::atomic<bool> busy_{false};
     bool cancelled_ = false;  // guarded by mutex_
   };
 

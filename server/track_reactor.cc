@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "absl/time/time.h"
 #include "core/base/guarded.h"
 #include "core/base/status_macros.h"
 #include "core/base/tsan.h"
@@ -157,10 +158,12 @@ class TrackReactor final
 
   // The registry's idle timer fired: nothing came from the client.
   void OnIdle() {
-    FinishWith(absl::CancelledError(
-        absl::StrCat("Track: the client sent nothing for ",
-                     config_.streams->limits().idle_timeout.count(),
-                     " ms (--track_idle_timeout_ms); stream closed")));
+    FinishWith(absl::CancelledError(absl::StrCat(
+        "Track: the client sent nothing for ",
+        absl::FormatDuration(
+            absl::FromChrono(config_.streams->limits().idle_timeout)),
+        " while none of its frames waited or ran (--track_idle_timeout_s); "
+        "stream closed")));
   }
 
   // A message read: the options first, then frames.
@@ -202,7 +205,10 @@ class TrackReactor final
       if (broken_ || final_status_) return absl::OkStatus();
       if (pending_) SkipPendingLocked();  // the freshest frame wins
       pending_ = Pending{std::move(request), Clock::now()};
-      if (!job_active_) submit = job_active_ = true;
+      if (!job_active_) {
+        submit = job_active_ = true;
+        handle_->SetBusy(true);  // not idle while its frame waits or runs
+      }
     }
     if (submit) Submit();
     return absl::OkStatus();
@@ -226,6 +232,7 @@ class TrackReactor final
       std::lock_guard<std::mutex> lock(mutex_);
       if (pending_) SkipPendingLocked();
       job_active_ = false;
+      handle_->SetBusy(false);
       finish = ReadyToFinishLocked();
     }
     Conclude(finish);
@@ -252,6 +259,7 @@ class TrackReactor final
         again = true;  // back of the queue: others take their turn
       } else {
         job_active_ = false;
+        handle_->SetBusy(false);
         finish = ReadyToFinishLocked();
       }
     }

@@ -21,12 +21,13 @@ namespace fovea::server {
 // the response's frames_skipped and in fovea_track_frames_total). Each
 // processed frame is decoded, tracked (core/track) on a worker of the
 // shared queue, and answered with one TrackResponse; the worker is given
-// back between frames, so streams and unary calls take turns. A frame that
-// arrives when the queue is full is skipped. The stream ends OK when the
+// back between frames, so streams and unary calls take turns. An admitted
+// stream's frame waits its turn even in a full queue. The stream ends OK when the
 // client half-closes and its last frame was answered; INVALID_ARGUMENT
 // naming the field for a bad message or frame; RESOURCE_EXHAUSTED when the
 // open-stream limits refuse it; CANCELLED when the client sent nothing for
-// the idle timeout or stopped reading for the stall timeout.
+// the idle timeout while none of its frames waited or ran, or stopped
+// reading for the stall timeout.
 grpc::ServerBidiReactor<grpc::ByteBuffer, v1::TrackResponse>* NewTrackReactor(
     const ServiceConfig& config, WorkQueue& work,
     grpc::CallbackServerContext* context);

@@ -558,6 +558,8 @@ TEST_F(ServerTest, ShutdownDrainsThenRefusesAndEndsWatchStreams) {
   ASSERT_TRUE(watch->Read(&update));
   EXPECT_EQ(update.status(), grpc::health::v1::HealthCheckResponse::SERVING);
 
+  // Made first: under a sanitizer, making it took longer than the delay.
+  const v1::DetectRequest request = MakeSyntheticRequest(1, false).request;
   const auto start = std::chrono::steady_clock::now();
   std::thread shutdown([this] { server_->Shutdown(absl::Seconds(30)); });
   ASSERT_TRUE(watch->Read(&update));
@@ -565,7 +567,7 @@ TEST_F(ServerTest, ShutdownDrainsThenRefusesAndEndsWatchStreams) {
             grpc::health::v1::HealthCheckResponse::NOT_SERVING);
   // Still served during the drain delay (UNAVAILABLE after it).
   v1::DetectResponse response;
-  EXPECT_TRUE(Detect(MakeSyntheticRequest(1, false).request, &response).ok());
+  EXPECT_TRUE(Detect(request, &response).ok());
   while (watch->Read(&update)) {
   }
   watch->Finish();

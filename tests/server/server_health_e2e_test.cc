@@ -135,7 +135,9 @@ TEST_F(ServerTest, SlowMetricsClientsDoNotBlockScrapes) {
 }
 
 TEST_F(ServerTest, HealthServingAfterWarmUpThenNotServingOnDrain) {
-  StartServer();
+  ServerConfig config = DefaultConfig();
+  config.warm_up = true;
+  StartServer(config);
   EXPECT_TRUE(server_->warmed_up());
   EXPECT_EQ(HealthStatus(channel_, ""), "SERVING");
   EXPECT_EQ(HealthStatus(channel_, "fovea.v1.Perception"), "SERVING");

@@ -38,6 +38,7 @@ class StartupTest : public ServerTest {
 
 TEST_F(StartupTest, HealthIsNotServingUntilTheWarmUpCompletes) {
   ServerConfig config = DefaultConfig();
+  config.warm_up = true;
   config.before_warm_up = [this] { release_warm_up_.WaitForNotification(); };
   StartServer(config, /*wait_serving=*/false);
 

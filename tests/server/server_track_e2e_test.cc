@@ -266,6 +266,34 @@ TEST_F(ServerTest, TrackNamesWhatIsWrongWithAMessage) {
 // A stream is a way to hold a server: one peer opens at most
 // max_track_streams_per_peer, and a stream that sends nothing is closed
 // after the idle timeout.
+// A client waiting for its answer is not idle: a frame held at a stage
+// boundary for six idle timeouts is answered, and the stream ends OK. (It
+// was closed as idle when a slow machine took longer than the timeout.)
+TEST_F(ServerTest, TrackIsNotIdleWhileItsFrameWaitsOrRuns) {
+  ServerConfig config = DefaultConfig();
+  config.track_idle_timeout_s = 0.5;
+  StartServer(config);
+  const synth::Sequence sequence =
+      synth::GenerateSequence(synth::SequenceKind::kStatic, 3, 2);
+  v1::TrackRequest frame = FrameMessage(sequence.frames[0], 1);
+  auto context = Context();
+  std::unique_ptr<Stream> stream = stub_->Track(context.get());
+  ASSERT_TRUE(stream->Write(Options("slow-answer")));
+  stage_gate_.Close();
+  ASSERT_TRUE(stream->Write(frame));
+  ASSERT_TRUE(WaitFor([&] { return stage_gate_.entered() >= 1; },
+                      std::chrono::seconds(30)));
+  stream->WritesDone();  // nothing more will come from the client
+  std::this_thread::sleep_for(std::chrono::seconds(3));
+  stage_gate_.Open();
+  v1::TrackResponse response;
+  ASSERT_TRUE(stream->Read(&response));
+  EXPECT_EQ(response.sequence(), 1u);
+  EXPECT_FALSE(stream->Read(&response));
+  const grpc::Status status = stream->Finish();
+  EXPECT_TRUE(status.ok()) << status.error_message();
+}
+
 TEST_F(ServerTest, TrackStreamsAreLimitedPerPeerAndClosedWhenIdle) {
   ServerConfig config = DefaultConfig();
   config.max_track_streams_per_peer = 1;
