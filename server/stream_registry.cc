@@ -98,7 +98,8 @@ void StreamRegistry::Reap() {
     const int64_t now = NowNs();
     std::vector<std::shared_ptr<Handle>> idle;
     for (const auto& [key, handle] : open_) {
-      if (!handle->busy_.load() && now - handle->last_touch_ns_.load() > idle_ns) {
+      if (!handle->busy_.load() &&
+          now - handle->last_touch_ns_.load() > idle_ns) {
         idle.push_back(handle);
       }
     }

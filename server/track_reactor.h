@@ -22,8 +22,8 @@ namespace fovea::server {
 // processed frame is decoded, tracked (core/track) on a worker of the
 // shared queue, and answered with one TrackResponse; the worker is given
 // back between frames, so streams and unary calls take turns. An admitted
-// stream's frame waits its turn even in a full queue. The stream ends OK when the
-// client half-closes and its last frame was answered; INVALID_ARGUMENT
+// stream's frame waits its turn even in a full queue. The stream ends OK when
+// the client half-closes and its last frame was answered; INVALID_ARGUMENT
 // naming the field for a bad message or frame; RESOURCE_EXHAUSTED when the
 // open-stream limits refuse it; CANCELLED when the client sent nothing for
 // the idle timeout while none of its frames waited or ran, or stopped
