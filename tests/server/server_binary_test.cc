@@ -222,9 +222,9 @@ TEST(ServerBinaryTest, FloodOfSilentConnectionsLeavesTheListenerAlive) {
   // is served even with the flood's sockets still open on this side. (Each
   // try may take 15 s: a TSan build on a loaded machine took 2.5 s for this
   // Detect, and later 4-5.4 s, when 5 s tries all failed.)
-  EXPECT_TRUE(WaitFor(
-      [&] { return DetectOk(server.target, std::chrono::seconds(15)); },
-      std::chrono::seconds(60)));
+  EXPECT_TRUE(
+      WaitFor([&] { return DetectOk(server.target, std::chrono::seconds(15)); },
+              std::chrono::seconds(60)));
   for (const int fd : flood) close(fd);
   EXPECT_TRUE(DetectOk(server.target, std::chrono::seconds(15)));
   ExpectCleanExitOnSigterm(server.pid);
