@@ -263,9 +263,6 @@ TEST_F(ServerTest, TrackNamesWhatIsWrongWithAMessage) {
   EXPECT_TRUE(capabilities.track());
 }
 
-// A stream is a way to hold a server: one peer opens at most
-// max_track_streams_per_peer, and a stream that sends nothing is closed
-// after the idle timeout.
 // A client waiting for its answer is not idle: a frame held at a stage
 // boundary for six idle timeouts is answered, and the stream ends OK. (It
 // was closed as idle when a slow machine took longer than the timeout.)
@@ -294,6 +291,9 @@ TEST_F(ServerTest, TrackIsNotIdleWhileItsFrameWaitsOrRuns) {
   EXPECT_TRUE(status.ok()) << status.error_message();
 }
 
+// A stream is a way to hold a server: one peer opens at most
+// max_track_streams_per_peer, and a stream that sends nothing is closed
+// after the idle timeout.
 TEST_F(ServerTest, TrackStreamsAreLimitedPerPeerAndClosedWhenIdle) {
   ServerConfig config = DefaultConfig();
   config.max_track_streams_per_peer = 1;
