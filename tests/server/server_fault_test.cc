@@ -322,7 +322,12 @@ class StalledReaderTest
 // the call ends.
 TEST_P(StalledReaderTest, JobBlocksPartwayAndIsReleasedWhenTheCallEnds) {
   const auto [method, ending] = GetParam();
-  Start();
+  // The test ends the stalled call itself (cancel or deadline): the
+  // server's stall timeout must not end it first, however slow the build
+  // (its default 5 s did, under TSan beside a build, 2026-12-06).
+  ServerConfig config = DefaultConfig();
+  config.stream_stall_timeout_s = 600.0;
+  StartServer(config);
   const Requests requests = BigMessageRequests();
   const std::unique_ptr<v1::Perception::Stub> stub =
       SmallWindowStub(server_->port());
