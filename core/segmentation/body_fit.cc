@@ -10,9 +10,10 @@
 namespace fovea {
 namespace {
 
-// OnOneBody refines a cylinder into a cone only when the cylinder misses by
-// at most this many times the allowed rms.
-constexpr float kConeSearchRms = 4.0f;
+// OnOneBody refines a cylinder into a cone, and a body into one with a
+// wall, only when the body misses by at most this many times the allowed
+// rms.
+constexpr float kRefineRms = 4.0f;
 
 // At most `limit` of `points`, evenly strided, appended to `out`.
 void Sample(const std::vector<Eigen::Vector3f>& points, int limit,
@@ -30,6 +31,37 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> AxesAcross(
                                      : Eigen::Vector3d::UnitY();
   const Eigen::Vector3d u = n.cross(helper).normalized();
   return {u, n.cross(u)};
+}
+
+// Gauss-Newton on `n` residuals from `x`: residual(i, x) is the i-th
+// residual and its gradient in x. At most 8 steps, ending at a step under
+// 1e-7; the sum of squared residuals at the solution, nullopt where a step
+// is not finite.
+template <int P, typename Residual>
+std::optional<double> GaussNewton(Eigen::Matrix<double, P, 1>& x, size_t n,
+                                  const Residual& residual) {
+  using Vector = Eigen::Matrix<double, P, 1>;
+  using Matrix = Eigen::Matrix<double, P, P>;
+  for (int iteration = 0; iteration < 8; ++iteration) {
+    Matrix jtj = Matrix::Zero();
+    Vector jte = Vector::Zero();
+    for (size_t i = 0; i < n; ++i) {
+      const auto [e, j] = residual(i, x);
+      jtj += j * j.transpose();
+      jte += j * e;
+    }
+    const Vector step = jtj.ldlt().solve(-jte);
+    if (!step.allFinite()) return std::nullopt;
+    x += step;
+    if (step.norm() < 1e-7) break;
+  }
+  double sum = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    const double e = residual(i, x).first;
+    sum += e * e;
+  }
+  if (!std::isfinite(sum)) return std::nullopt;
+  return sum;
 }
 
 // The least-squares solution of |q|^2 + g . q + f = 0 over `q` (rows of
@@ -92,6 +124,9 @@ absl::Status Validate(const BodyFitOptions& o) {
   if (!(o.max_taper >= 0.0f)) {
     return absl::InvalidArgumentError("body_join.max_taper must be >= 0");
   }
+  if (!(o.max_wall_m >= 0.0f)) {
+    return absl::InvalidArgumentError("body_join.max_wall_m must be >= 0");
+  }
   return absl::OkStatus();
 }
 
@@ -121,13 +156,19 @@ std::optional<BodyFit> FitUprightCylinder(
 
 namespace {
 
-// FitUprightCone from `cylinder`, the points' FitUprightCylinder.
+// The cone of axis `up` through `points` from `cylinder`, their
+// FitUprightCylinder. With `wall` (P = 5), the points from index `wall_from`
+// on lie on a second cone of the same axis and taper, its radius the fit's
+// `wall` off the first's (a vessel's inside and outside).
+template <int P>
 std::optional<BodyFit> ConeFromCylinder(
     const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& up,
-    const BodyFit& cylinder) {
-  if (points.size() < 5) return std::nullopt;
+    const BodyFit& cylinder, size_t wall_from = 0, float* wall = nullptr) {
+  static_assert(P == 4 || P == 5);
+  if (points.size() < P + 1) return std::nullopt;
   const Eigen::Vector3d n = up.cast<double>().normalized();
   const Eigen::Vector3d center = cylinder.center.cast<double>();
+  const auto [u, v] = AxesAcross(n);
   // Each point: its offset from the cylinder's axis across `up` and its
   // height along it, centred.
   std::vector<Eigen::Vector3d> across;
@@ -144,45 +185,63 @@ std::optional<BodyFit> ConeFromCylinder(
   mean_h /= static_cast<double>(points.size());
   for (double& h : height) h -= mean_h;
   // Gauss-Newton on the distance to the cone: the axis' offset (two
-  // coordinates across `up`), the radius at the mean height and the taper,
-  // from the cylinder.
-  const auto [u, v] = AxesAcross(n);
-  Eigen::Vector4d x(0.0, 0.0, cylinder.radius, 0.0);
-  // The normal equations J^T J step = -J^T e of the residuals at `at`;
-  // returns the sum of squared residuals.
-  const auto accumulate = [&](const Eigen::Vector4d& at, Eigen::Matrix4d* jtj,
-                              Eigen::Vector4d* jte) {
-    double sum = 0.0;
-    for (size_t i = 0; i < across.size(); ++i) {
-      const Eigen::Vector3d d = across[i] - u * at(0) - v * at(1);
-      const double r = std::max(d.norm(), 1e-9);
-      const double e = r - (at(2) + at(3) * height[i]);
-      sum += e * e;
-      if (jtj == nullptr) continue;
-      const Eigen::Vector4d j(-u.dot(d) / r, -v.dot(d) / r, -1.0, -height[i]);
-      *jtj += j * j.transpose();
-      *jte += j * e;
-    }
-    return sum;
-  };
-  for (int iteration = 0; iteration < 8; ++iteration) {
-    Eigen::Matrix4d jtj = Eigen::Matrix4d::Zero();
-    Eigen::Vector4d jte = Eigen::Vector4d::Zero();
-    accumulate(x, &jtj, &jte);
-    const Eigen::Vector4d step = jtj.ldlt().solve(-jte);
-    if (!step.allFinite()) return std::nullopt;
-    x += step;
-    if (step.norm() < 1e-7) break;
-  }
-  const double sum = accumulate(x, nullptr, nullptr);
-  if (!std::isfinite(sum) || !(x(2) > 0.0)) return std::nullopt;
+  // coordinates across `up`), the radius at the mean height, the taper and
+  // the wall, from the cylinder.
+  using Vector = Eigen::Matrix<double, P, 1>;
+  Vector x = Vector::Zero();
+  x(2) = cylinder.radius;
+  const std::optional<double> sum =
+      GaussNewton<P>(x, across.size(), [&](size_t i, const Vector& at) {
+        const Eigen::Vector3d d = across[i] - u * at(0) - v * at(1);
+        const double r = std::max(d.norm(), 1e-9);
+        Vector j;
+        j.template head<4>() << -u.dot(d) / r, -v.dot(d) / r, -1.0, -height[i];
+        double e = r - (at(2) + at(3) * height[i]);
+        if constexpr (P == 5) {
+          const double in_wall = i >= wall_from ? 1.0 : 0.0;
+          e -= at(4) * in_wall;
+          j(4) = -in_wall;
+        }
+        return std::pair{e, j};
+      });
+  if (!sum.has_value() || !(x(2) > 0.0)) return std::nullopt;
+  if constexpr (P == 5) *wall = static_cast<float>(x(4));
   BodyFit cone;
-  cone.center = (center + u * x(0) + v * x(1) + n * mean_h).cast<float>();
+  cone.center =
+      (center + u * x(0) + v * x(1) + n * mean_h).template cast<float>();
   cone.radius = static_cast<float>(x(2));
   cone.taper = static_cast<float>(x(3));
   cone.rms =
-      static_cast<float>(std::sqrt(sum / static_cast<double>(across.size())));
+      static_cast<float>(std::sqrt(*sum / static_cast<double>(across.size())));
   return cone;
+}
+
+// The sphere through `points` from `sphere`, their FitSphere, the points
+// from index `wall_from` on on a second sphere of the same centre, its
+// radius `wall` off the first's (a bowl's inside and outside).
+std::optional<BodyFit> WalledSphere(const std::vector<Eigen::Vector3f>& points,
+                                    const BodyFit& sphere, size_t wall_from,
+                                    float* wall) {
+  if (points.size() < 6) return std::nullopt;
+  Eigen::Matrix<double, 5, 1> x;
+  x << sphere.center.cast<double>(), sphere.radius, 0.0;
+  const std::optional<double> sum = GaussNewton<5>(
+      x, points.size(), [&](size_t i, const Eigen::Matrix<double, 5, 1>& at) {
+        const Eigen::Vector3d d = points[i].cast<double>() - at.head<3>();
+        const double r = std::max(d.norm(), 1e-9);
+        const double in_wall = i >= wall_from ? 1.0 : 0.0;
+        Eigen::Matrix<double, 5, 1> j;
+        j << -d / r, -1.0, -in_wall;
+        return std::pair{r - at(3) - at(4) * in_wall, j};
+      });
+  if (!sum.has_value() || !(x(3) > 0.0)) return std::nullopt;
+  *wall = static_cast<float>(x(4));
+  BodyFit fit;
+  fit.center = x.head<3>().cast<float>();
+  fit.radius = static_cast<float>(x(3));
+  fit.rms =
+      static_cast<float>(std::sqrt(*sum / static_cast<double>(points.size())));
+  return fit;
 }
 
 }  // namespace
@@ -191,7 +250,7 @@ std::optional<BodyFit> FitUprightCone(
     const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& up) {
   const std::optional<BodyFit> cylinder = FitUprightCylinder(points, up);
   if (!cylinder.has_value()) return std::nullopt;
-  return ConeFromCylinder(points, up, *cylinder);
+  return ConeFromCylinder<4>(points, up, *cylinder);
 }
 
 bool OnOneBody(const std::vector<Eigen::Vector3f>& a,
@@ -204,6 +263,7 @@ bool OnOneBody(const std::vector<Eigen::Vector3f>& a,
   std::vector<Eigen::Vector3f> both;
   both.reserve(2 * options.max_fit_points);
   Sample(a, options.max_fit_points, both);
+  const size_t b_from = both.size();
   Sample(b, options.max_fit_points, both);
   float z = 0.0f;
   for (const Eigen::Vector3f& p : both) z += p.z();
@@ -214,17 +274,39 @@ bool OnOneBody(const std::vector<Eigen::Vector3f>& a,
     return fit.has_value() && fit->radius >= options.min_radius_m &&
            fit->radius <= options.max_radius_m && fit->rms <= max_rms;
   };
-  if (fits(FitSphere(both))) return true;
+  // Fits farther off than this are not refined.
+  const auto near = [&](const std::optional<BodyFit>& fit) {
+    return fit.has_value() && fit->rms <= kRefineRms * max_rms;
+  };
+  const std::optional<BodyFit> sphere = FitSphere(both);
+  if (fits(sphere)) return true;
   const std::optional<BodyFit> cylinder = FitUprightCylinder(both, up);
   if (fits(cylinder)) return true;
   // A cone within max_taper is near a cylinder: a 10 cm mug of taper 0.15
-  // misses its cylinder by 4 mm rms. Pairs farther off are not refined.
-  if (!(options.max_taper > 0.0f) || !cylinder.has_value() ||
-      cylinder->rms > kConeSearchRms * max_rms) {
-    return false;
+  // misses its cylinder by 4 mm rms.
+  const bool cones = options.max_taper > 0.0f && near(cylinder);
+  if (cones) {
+    const std::optional<BodyFit> cone =
+        ConeFromCylinder<4>(both, up, *cylinder);
+    if (fits(cone) && std::abs(cone->taper) <= options.max_taper) return true;
   }
-  const std::optional<BodyFit> cone = ConeFromCylinder(both, up, *cylinder);
-  return fits(cone) && std::abs(cone->taper) <= options.max_taper;
+  // One body's inside and outside, a wall apart.
+  if (!(options.max_wall_m > 0.0f)) return false;
+  float wall = 0.0f;
+  if (near(sphere)) {
+    const std::optional<BodyFit> walled =
+        WalledSphere(both, *sphere, b_from, &wall);
+    if (fits(walled) && std::abs(wall) <= options.max_wall_m) return true;
+  }
+  if (cones) {
+    const std::optional<BodyFit> walled =
+        ConeFromCylinder<5>(both, up, *cylinder, b_from, &wall);
+    if (fits(walled) && std::abs(walled->taper) <= options.max_taper &&
+        std::abs(wall) <= options.max_wall_m) {
+      return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace fovea

@@ -39,6 +39,11 @@ struct BodyFitOptions {
   // its radius changes by at most this much per metre of height (0.3: 17
   // degrees off vertical); 0: cylinders only.
   float max_taper = 0.3f;
+  // A vessel's inside and outside are one body too, their radii at most
+  // this far apart (a mug's or a bowl's wall): the second surface's radius
+  // is fitted on its own, its axis or centre and its taper shared. The
+  // cones need max_taper > 0. 0: no walls.
+  float max_wall_m = 0.008f;
 };
 
 absl::Status Validate(const BodyFitOptions& options);

@@ -1,7 +1,8 @@
 // One curved body on hand-made point sets whose answer is geometry: a
 // bowl's inside and outside lie on one sphere, a mug's inside and side on
-// one upright cylinder, a tapered mug's on one upright cone; a cup in a
-// bowl, two cans side by side and two planes do not.
+// one upright cylinder, a tapered mug's on one upright cone, a thick-walled
+// vessel's through its wall; a cup in a bowl or a mug, two cans side by side
+// and two planes do not.
 
 #include "core/segmentation/body_fit.h"
 
@@ -185,6 +186,37 @@ TEST(BodyFitTest, ATaperedMugsInsideAndSideAreOneConeTwoCupsAreNot) {
                          kUp, BodyFitOptions{}));
   BodyFitOptions negative;
   negative.max_taper = -0.1f;
+  EXPECT_FALSE(Validate(negative).ok());
+}
+
+TEST(BodyFitTest, ThickWalledVesselsAreOneBodyThroughTheirWall) {
+  // A stoneware bowl and mug, walls 7 mm, seen from above: the inside's
+  // far side and flanks, the outside's front and flanks. Where the two
+  // overlap in azimuth no one sphere or cylinder fits both within the
+  // 2.5 mm the noise and half a thin wall allow; a second radius a wall off
+  // the first fits both to the noise.
+  const Eigen::Vector3f c = kAway;
+  const std::vector<Eigen::Vector3f> bowl_outside =
+      SpherePatch(c, 0.08f, 1.7f, 2.6f, 0.5f, 2.6f, 0.001f, 19);
+  const std::vector<Eigen::Vector3f> bowl_inside =
+      SpherePatch(c, 0.073f, 1.7f, 2.6f, 1.8f, 6.0f, 0.001f, 20);
+  const Eigen::Vector3f m = kAway + Eigen::Vector3f(0.3f, 0.1f, 0.0f);
+  const std::vector<Eigen::Vector3f> mug_side =
+      CylinderPatch(m, 0.04f, 0.0f, 0.1f, 0.3f, 2.8f, 0.001f, 21);
+  const std::vector<Eigen::Vector3f> mug_inside =
+      CylinderPatch(m, 0.033f, 0.01f, 0.1f, 1.2f, 6.0f, 0.001f, 22);
+  EXPECT_TRUE(OnOneBody(bowl_outside, bowl_inside, kUp, BodyFitOptions{}));
+  EXPECT_TRUE(OnOneBody(mug_side, mug_inside, kUp, BodyFitOptions{}));
+  BodyFitOptions no_walls;
+  no_walls.max_wall_m = 0.0f;
+  EXPECT_FALSE(OnOneBody(bowl_outside, bowl_inside, kUp, no_walls));
+  EXPECT_FALSE(OnOneBody(mug_side, mug_inside, kUp, no_walls));
+  // A cup 12 mm narrower than the mug, standing in it, is no wall.
+  const std::vector<Eigen::Vector3f> cup_in_mug =
+      CylinderPatch(m, 0.028f, 0.01f, 0.1f, 1.2f, 6.0f, 0.001f, 23);
+  EXPECT_FALSE(OnOneBody(mug_side, cup_in_mug, kUp, BodyFitOptions{}));
+  BodyFitOptions negative;
+  negative.max_wall_m = -0.001f;
   EXPECT_FALSE(Validate(negative).ok());
 }
 
