@@ -1,10 +1,12 @@
 #include "core/segmentation/rbf_svm.h"
 
+#include <dlfcn.h>
 #include <gtest/gtest.h>
 
 #include <cstdlib>
 #include <random>
 
+#include "core/baseline/scene_segmenters.h"
 #include "core/segmentation/svm_training.h"
 
 namespace fovea {
@@ -43,6 +45,25 @@ TEST(RbfSvmTest, SeparatesADiscWithCalibratedProbabilities) {
       CrossValidateRbfSvm(Disc(300, 3), 5, RbfSvmTrainingOptions{});
   ASSERT_TRUE(cv.ok()) << cv.status();
   EXPECT_GT(cv->accuracy, 0.9);
+}
+
+// PCL's pcl_ml, which pcl_segmentation loads, exports a libsvm of its own
+// (older, another svm_model). This executable lists PCL before
+// fovea_training: with the shared libsvm its calls to svm_train bound to
+// PCL's, and every probability came out as one minus itself. Training holds
+// libsvm's static library whole, and its calls bind there.
+TEST(RbfSvmTest, TrainsWithLibsvmEvenWithPclLinkedFirst) {
+  EXPECT_TRUE(Validate(EuclideanSceneOptions{}).ok());  // from PCL's user
+  Dl_info bound{};
+  ASSERT_NE(dladdr(dlsym(RTLD_DEFAULT, "svm_train"), &bound), 0);
+  Dl_info self{};
+  ASSERT_NE(dladdr(reinterpret_cast<void*>(&Disc), &self), 0);
+  EXPECT_STREQ(bound.dli_fname, self.dli_fname);
+  absl::StatusOr<RbfSvm> svm =
+      TrainRbfSvm(Disc(200, 4), {"x", "y"}, "test", RbfSvmTrainingOptions{});
+  ASSERT_TRUE(svm.ok()) << svm.status();
+  EXPECT_GT(svm->Probability({0.5, 0.5}), 0.9);
+  EXPECT_LT(svm->Probability({0.02, 0.02}), 0.1);
 }
 
 TEST(RbfSvmTest, SerializeAndParseGiveTheSameDecisions) {
