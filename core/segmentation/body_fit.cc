@@ -33,6 +33,27 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> AxesAcross(
   return {u, n.cross(u)};
 }
 
+// The rms distance of the points in [first, last) to their least-squares
+// plane: the square root of their covariance's smallest eigenvalue.
+float PlaneRms(std::vector<Eigen::Vector3f>::const_iterator first,
+               std::vector<Eigen::Vector3f>::const_iterator last) {
+  const double n = static_cast<double>(last - first);
+  if (n < 3.0) return 0.0f;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (auto p = first; p != last; ++p) mean += p->cast<double>();
+  mean /= n;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (auto p = first; p != last; ++p) {
+    const Eigen::Vector3d d = p->cast<double>() - mean;
+    covariance += d * d.transpose();
+  }
+  covariance /= n;
+  const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(
+                              covariance, Eigen::EigenvaluesOnly)
+                              .eigenvalues()(0);
+  return static_cast<float>(std::sqrt(std::max(smallest, 0.0)));
+}
+
 // Gauss-Newton on `n` residuals from `x`: residual(i, x) is the i-th
 // residual and its gradient in x. At most 8 steps, ending at a step under
 // 1e-7; the sum of squared residuals at the solution, nullopt where a step
@@ -290,8 +311,14 @@ bool OnOneBody(const std::vector<Eigen::Vector3f>& a,
         ConeFromCylinder<4>(both, up, *cylinder);
     if (fits(cone) && std::abs(cone->taper) <= options.max_taper) return true;
   }
-  // One body's inside and outside, a wall apart.
-  if (!(options.max_wall_m > 0.0f)) return false;
+  // One body's inside and outside, a wall apart; each of them curved (no
+  // plane holds it within the noise): the second radius would otherwise
+  // let a box's face beside a bowl pass for its other side.
+  if (!(options.max_wall_m > 0.0f) ||
+      PlaneRms(both.begin(), both.begin() + b_from) <= max_rms ||
+      PlaneRms(both.begin() + b_from, both.end()) <= max_rms) {
+    return false;
+  }
   float wall = 0.0f;
   if (near(sphere)) {
     const std::optional<BodyFit> walled =

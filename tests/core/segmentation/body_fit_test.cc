@@ -205,16 +205,17 @@ TEST(BodyFitTest, ThickWalledVesselsAreOneBodyThroughTheirWall) {
       CylinderPatch(m, 0.04f, 0.0f, 0.1f, 0.3f, 2.8f, 0.001f, 21);
   const std::vector<Eigen::Vector3f> mug_inside =
       CylinderPatch(m, 0.033f, 0.01f, 0.1f, 1.2f, 6.0f, 0.001f, 22);
-  EXPECT_TRUE(OnOneBody(bowl_outside, bowl_inside, kUp, BodyFitOptions{}));
-  EXPECT_TRUE(OnOneBody(mug_side, mug_inside, kUp, BodyFitOptions{}));
-  BodyFitOptions no_walls;
-  no_walls.max_wall_m = 0.0f;
+  BodyFitOptions walls;
+  walls.max_wall_m = 0.008f;
+  EXPECT_TRUE(OnOneBody(bowl_outside, bowl_inside, kUp, walls));
+  EXPECT_TRUE(OnOneBody(mug_side, mug_inside, kUp, walls));
+  const BodyFitOptions no_walls;  // the default
   EXPECT_FALSE(OnOneBody(bowl_outside, bowl_inside, kUp, no_walls));
   EXPECT_FALSE(OnOneBody(mug_side, mug_inside, kUp, no_walls));
   // A cup 12 mm narrower than the mug, standing in it, is no wall.
   const std::vector<Eigen::Vector3f> cup_in_mug =
       CylinderPatch(m, 0.028f, 0.01f, 0.1f, 1.2f, 6.0f, 0.001f, 23);
-  EXPECT_FALSE(OnOneBody(mug_side, cup_in_mug, kUp, BodyFitOptions{}));
+  EXPECT_FALSE(OnOneBody(mug_side, cup_in_mug, kUp, walls));
   BodyFitOptions negative;
   negative.max_wall_m = -0.001f;
   EXPECT_FALSE(Validate(negative).ok());
