@@ -178,13 +178,13 @@ std::optional<BodyFit> FitUprightCylinder(
 namespace {
 
 // The cone of axis `up` through `points` from `cylinder`, their
-// FitUprightCylinder. With `wall` (P = 5), the points from index `wall_from`
-// on lie on a second cone of the same axis and taper, its radius the fit's
-// `wall` off the first's (a vessel's inside and outside).
+// FitUprightCylinder. With P = 5, the points from index `wall_from` on lie
+// on a second cone of the same axis and taper, its radius the fit's `wall`
+// off the first's (a vessel's inside and outside).
 template <int P>
 std::optional<BodyFit> ConeFromCylinder(
     const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& up,
-    const BodyFit& cylinder, size_t wall_from = 0, float* wall = nullptr) {
+    const BodyFit& cylinder, size_t wall_from = 0) {
   static_assert(P == 4 || P == 5);
   if (points.size() < P + 1) return std::nullopt;
   const Eigen::Vector3d n = up.cast<double>().normalized();
@@ -226,12 +226,12 @@ std::optional<BodyFit> ConeFromCylinder(
         return std::pair{e, j};
       });
   if (!sum.has_value() || !(x(2) > 0.0)) return std::nullopt;
-  if constexpr (P == 5) *wall = static_cast<float>(x(4));
   BodyFit cone;
   cone.center =
       (center + u * x(0) + v * x(1) + n * mean_h).template cast<float>();
   cone.radius = static_cast<float>(x(2));
   cone.taper = static_cast<float>(x(3));
+  if constexpr (P == 5) cone.wall = static_cast<float>(x(4));
   cone.rms =
       static_cast<float>(std::sqrt(*sum / static_cast<double>(across.size())));
   return cone;
@@ -239,10 +239,9 @@ std::optional<BodyFit> ConeFromCylinder(
 
 // The sphere through `points` from `sphere`, their FitSphere, the points
 // from index `wall_from` on on a second sphere of the same centre, its
-// radius `wall` off the first's (a bowl's inside and outside).
+// radius the fit's `wall` off the first's (a bowl's inside and outside).
 std::optional<BodyFit> WalledSphere(const std::vector<Eigen::Vector3f>& points,
-                                    const BodyFit& sphere, size_t wall_from,
-                                    float* wall) {
+                                    const BodyFit& sphere, size_t wall_from) {
   if (points.size() < 6) return std::nullopt;
   Eigen::Matrix<double, 5, 1> x;
   x << sphere.center.cast<double>(), sphere.radius, 0.0;
@@ -256,10 +255,10 @@ std::optional<BodyFit> WalledSphere(const std::vector<Eigen::Vector3f>& points,
         return std::pair{r - at(3) - at(4) * in_wall, j};
       });
   if (!sum.has_value() || !(x(3) > 0.0)) return std::nullopt;
-  *wall = static_cast<float>(x(4));
   BodyFit fit;
   fit.center = x.head<3>().cast<float>();
   fit.radius = static_cast<float>(x(3));
+  fit.wall = static_cast<float>(x(4));
   fit.rms =
       static_cast<float>(std::sqrt(*sum / static_cast<double>(points.size())));
   return fit;
@@ -319,17 +318,16 @@ bool OnOneBody(const std::vector<Eigen::Vector3f>& a,
       PlaneRms(both.begin() + b_from, both.end()) <= max_rms) {
     return false;
   }
-  float wall = 0.0f;
-  if (near(sphere)) {
-    const std::optional<BodyFit> walled =
-        WalledSphere(both, *sphere, b_from, &wall);
-    if (fits(walled) && std::abs(wall) <= options.max_wall_m) return true;
+  const auto fits_walled = [&](const std::optional<BodyFit>& fit) {
+    return fits(fit) && std::abs(fit->wall) <= options.max_wall_m;
+  };
+  if (near(sphere) && fits_walled(WalledSphere(both, *sphere, b_from))) {
+    return true;
   }
   if (cones) {
     const std::optional<BodyFit> walled =
-        ConeFromCylinder<5>(both, up, *cylinder, b_from, &wall);
-    if (fits(walled) && std::abs(walled->taper) <= options.max_taper &&
-        std::abs(wall) <= options.max_wall_m) {
+        ConeFromCylinder<5>(both, up, *cylinder, b_from);
+    if (fits_walled(walled) && std::abs(walled->taper) <= options.max_taper) {
       return true;
     }
   }

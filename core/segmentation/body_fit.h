@@ -57,6 +57,7 @@ struct BodyFit {
   float radius = 0.0f;  // metres; a cone's at the height of `center`
   float rms = 0.0f;     // metres
   float taper = 0.0f;   // a cone's radius change per metre along `up`
+  float wall = 0.0f;    // a walled fit's second radius minus its first
 };
 
 // The least-squares sphere through `points` (algebraic fit: |p|^2 + D.p + F
