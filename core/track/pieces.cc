@@ -14,7 +14,7 @@ namespace fovea {
 void Tracker::JoinAndSplit(
     const std::optional<Eigen::Isometry3f>& camera_to_world, Association& a,
     std::vector<Track>& tracks, TrackedFrame& out) const {
-  // Pieces that moved together: join the younger into the older.
+  // Pieces that moved together: join the smaller into the larger.
   std::vector<SegmentedObject>& found = a.found;
   std::vector<Eigen::Vector3f>& world = a.world;
   const Eigen::Vector3f& shift = a.shift;
@@ -51,9 +51,15 @@ void Tracker::JoinAndSplit(
       if (!Touch(found[a].mask, found[a].box, found[b].mask, found[b].box, 3)) {
         continue;
       }
-      const bool a_older = tracks[track_of[a]].id < tracks[track_of[b]].id;
-      const size_t keep = a_older ? a : b;
-      const size_t drop = a_older ? b : a;
+      // The larger piece's identity stays (the older's at equal size): an
+      // object cut in pieces goes on as its main part, and two objects
+      // swept along as one as the one that covers the most of it.
+      const bool a_keeps =
+          found[a].area != found[b].area
+              ? found[a].area > found[b].area
+              : tracks[track_of[a]].id < tracks[track_of[b]].id;
+      const size_t keep = a_keeps ? a : b;
+      const size_t drop = a_keeps ? b : a;
       for (Piece& p : pieces[drop]) {
         p.former_id = tracks[track_of[drop]].id;
         p.former_frames_seen = tracks[track_of[drop]].frames_seen;

@@ -47,14 +47,14 @@ namespace fovea {
 //     matched nothing (TrackerOptions::reidentify_distance).
 //   - Pieces that move rigidly together become one object: two tracks whose
 //     masks touch and that moved by the same displacement (more than
-//     moved_m, within joint_motion_m of each other) join; the older
-//     identity stays. A joined object keeps its pieces: when INC cuts it
-//     again, a part that moved more than joint_motion_m apart from the
-//     rest (the two were separate objects swept along together) splits
-//     off with an identity of its own. The pieces are carried along while
-//     INC cuts the object whole; when the joined track matches no object
-//     (its parts moved apart, its centroid between them), each part that
-//     is one of its pieces takes that piece's identity.
+//     moved_m, within joint_motion_m of each other) join; the larger
+//     one's identity stays (the older's at equal size). A joined object keeps
+//     its pieces: when INC cuts it again, a part that moved more than
+//     joint_motion_m apart from the rest (the two were separate objects swept
+//     along together) splits off with an identity of its own. The pieces are
+//     carried along while INC cuts the object whole; when the joined track
+//     matches no object (its parts moved apart, its centroid between them),
+//     each part that is one of its pieces takes that piece's identity.
 
 enum class TrackState {
   kAppeared,  // first seen in this frame: a new track_id
