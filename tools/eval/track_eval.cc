@@ -329,8 +329,11 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
       if (options.with_pose) pose = frame.camera_to_world;
       // The fresh call on the same frame, timed before the tracker's on
       // every other frame and after it on the rest: whichever runs second
-      // finds the thread pool awake and the frame in cache, which on an
-      // idle machine made the second 1.7x faster.
+      // finds the thread pool awake and the frame in cache. (It ran 1.3-1.7x
+      // faster while fovea-eval handed a frame's large blocks back to the
+      // kernel and the first call paid their page faults again; main() now
+      // keeps them, as the server does, and the two orders agree within a
+      // few per cent.)
       std::vector<cv::Mat> fresh;
       const auto run_fresh = [&]() -> absl::Status {
         SegmentSinks sinks;
