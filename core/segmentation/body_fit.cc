@@ -33,27 +33,6 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> AxesAcross(
   return {u, n.cross(u)};
 }
 
-// The rms distance of the points in [first, last) to their least-squares
-// plane: the square root of their covariance's smallest eigenvalue.
-float PlaneRms(std::vector<Eigen::Vector3f>::const_iterator first,
-               std::vector<Eigen::Vector3f>::const_iterator last) {
-  const double n = static_cast<double>(last - first);
-  if (n < 3.0) return 0.0f;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (auto p = first; p != last; ++p) mean += p->cast<double>();
-  mean /= n;
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  for (auto p = first; p != last; ++p) {
-    const Eigen::Vector3d d = p->cast<double>() - mean;
-    covariance += d * d.transpose();
-  }
-  covariance /= n;
-  const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(
-                              covariance, Eigen::EigenvaluesOnly)
-                              .eigenvalues()(0);
-  return static_cast<float>(std::sqrt(std::max(smallest, 0.0)));
-}
-
 // Gauss-Newton on `n` residuals from `x`: residual(i, x) is the i-th
 // residual and its gradient in x. At most 8 steps, ending at a step under
 // 1e-7; the sum of squared residuals at the solution, nullopt where a step
@@ -149,6 +128,25 @@ absl::Status Validate(const BodyFitOptions& o) {
     return absl::InvalidArgumentError("body_join.max_wall_m must be >= 0");
   }
   return absl::OkStatus();
+}
+
+double PlaneRms(std::vector<Eigen::Vector3f>::const_iterator first,
+                std::vector<Eigen::Vector3f>::const_iterator last) {
+  const double n = static_cast<double>(last - first);
+  if (n < 3.0) return 0.0;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (auto p = first; p != last; ++p) mean += p->cast<double>();
+  mean /= n;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (auto p = first; p != last; ++p) {
+    const Eigen::Vector3d d = p->cast<double>() - mean;
+    covariance += d * d.transpose();
+  }
+  covariance /= n;
+  const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(
+                              covariance, Eigen::EigenvaluesOnly)
+                              .eigenvalues()(0);
+  return std::sqrt(std::max(smallest, 0.0));
 }
 
 std::optional<BodyFit> FitSphere(const std::vector<Eigen::Vector3f>& points) {

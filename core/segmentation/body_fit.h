@@ -60,6 +60,12 @@ struct BodyFit {
   float wall = 0.0f;    // a walled fit's second radius minus its first
 };
 
+// The rms distance of the points in [first, last) to their least-squares
+// plane: the square root of their covariance's smallest eigenvalue; 0 for
+// fewer than 3 points.
+double PlaneRms(std::vector<Eigen::Vector3f>::const_iterator first,
+                std::vector<Eigen::Vector3f>::const_iterator last);
+
 // The least-squares sphere through `points` (algebraic fit: |p|^2 + D.p + F
 // = 0 solved linearly, then the geometric rms); nullopt for fewer than 4
 // points or a degenerate fit.

@@ -1,6 +1,5 @@
 #include "core/segmentation/patch_features.h"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -10,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/parallel.h"
+#include "core/segmentation/body_fit.h"
 
 extern "C" {
 #include "libqhull_r/qhull_ra.h"
@@ -33,18 +33,7 @@ FILE* QhullErrorFile() {
 }
 
 bool IsFlat(const std::vector<Eigen::Vector3f>& points) {
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3f& p : points) mean += p.cast<double>();
-  mean /= static_cast<double>(points.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const Eigen::Vector3f& p : points) {
-    const Eigen::Vector3d d = p.cast<double>() - mean;
-    cov += d * d.transpose();
-  }
-  cov /= static_cast<double>(points.size());
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(
-      cov, Eigen::EigenvaluesOnly);
-  return solver.eigenvalues()(0) < kFlatSigma * kFlatSigma;
+  return PlaneRms(points.begin(), points.end()) < kFlatSigma;
 }
 
 // The planes (outward unit normal n, offset o: n . p + o = 0, inside < 0)
