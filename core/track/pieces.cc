@@ -73,9 +73,11 @@ void Tracker::JoinAndSplit(
   }
   // Objects j (no track) and k (joined track t's): whether j is one of
   // t's pieces that moved with k's (1: INC cut the object in two again)
-  // or apart from it and no longer touches it (0: they are two objects;
-  // `piece` gets j's), by their own pieces before this frame's joins; -1
-  // when neither (or either is not one of t's pieces). `k_piece` gets k's.
+  // or apart from it and no longer touches it (0: they are two objects),
+  // or moved otherwise than it while touching it still (2: the two parts
+  // of two objects pushed along together, whose cut between them moved),
+  // by their own pieces before this frame's joins; -1 when j or k is not
+  // one of t's pieces. `piece` gets j's piece, `k_piece` k's.
   const auto moved_with = [&](size_t j, size_t k, const Track& t, int* piece,
                               int* k_piece) {
     const Piece& now_j = pieces[j].front();
@@ -92,7 +94,7 @@ void Tracker::JoinAndSplit(
     if ((motion_j - motion_k).norm() <= options_.joint_motion_m) return 1;
     // Parts of one object cut otherwise this time touch still.
     return Touch(found[j].mask, found[j].box, found[k].mask, found[k].box, 3)
-               ? -1
+               ? 2
                : 0;
   };
   // An object without a track that is one of a joined track's pieces, or
@@ -101,6 +103,29 @@ void Tracker::JoinAndSplit(
   // (split). Per object that split off: the piece it was.
   std::vector<std::optional<Piece>>& split_from = a.split_from;
   split_from.assign(found.size(), std::nullopt);
+  // j, one of track t's pieces, splits off from k, another: j goes on as
+  // its piece, under the identity that piece had before it was joined, or
+  // under t's own, and then k under its piece's.
+  const auto split = [&](size_t j, size_t k, const Track& t, int piece,
+                         int k_piece) {
+    ++out.split;
+    if (t.pieces[piece].former_id != 0) {
+      split_from[j] = t.pieces[piece];
+      return;
+    }
+    state[j] = StateOfMotion(world[j] - shift - t.pieces[piece].world_centroid);
+    track_of[j] = track_of[k];
+    track_of[k] = -1;
+    split_from[k] = t.pieces[k_piece];
+  };
+  // Pairs of pieces that moved otherwise than each other while touching
+  // still (moved_with's 2), j outside the track's last mask: settled once
+  // the clearer cases have taken their pieces.
+  struct MovedOtherwise {
+    size_t j, k;
+    int track, piece, k_piece;
+  };
+  std::vector<MovedOtherwise> moved_otherwise;  // rarely any
   for (size_t j = 0; j < found.size(); ++j) {
     if (absorbed[j] || track_of[j] >= 0 || split_from[j]) continue;
     for (size_t k = 0; k < found.size(); ++k) {
@@ -111,26 +136,41 @@ void Tracker::JoinAndSplit(
       int k_piece = -1;
       const int with = moved_with(j, k, t, &piece, &k_piece);
       if (with == 0) {
-        ++out.split;
-        if (t.pieces[piece].former_id != 0) {
-          split_from[j] = t.pieces[piece];
-          break;
-        }
-        // j is the track's own first piece: it keeps the identity, and k
-        // splits off with its piece's.
-        state[j] =
-            StateOfMotion(world[j] - shift - t.pieces[piece].world_centroid);
-        track_of[j] = track_of[k];
-        track_of[k] = -1;
-        split_from[k] = t.pieces[k_piece];
+        split(j, k, t, piece, k_piece);
         break;
       }
-      if (with == 1 ||
-          OverlapWithHeld(found[j].mask, t.object) * 2 > found[j].area) {
+      // Mostly inside the track's last mask: one object cut in two again.
+      const bool inside =
+          OverlapWithHeld(found[j].mask, t.object) * 2 > found[j].area;
+      if (with == 1 || inside) {
         join(j, k);
         break;
       }
+      if (with == 2) {
+        moved_otherwise.push_back({j, k, track_of[k], piece, k_piece});
+      }
     }
+  }
+  // Such a pair is two objects pushed along together whose cut between
+  // them moved: each part goes on as its piece, not as a new object, when
+  // no other object took that piece (or, for the track's own piece, k's).
+  const auto taken = [&](const Piece& piece) {
+    for (const std::optional<Piece>& s : split_from) {
+      if (s && s->former_id == piece.former_id) return true;
+    }
+    return false;
+  };
+  for (const MovedOtherwise& m : moved_otherwise) {
+    if (absorbed[m.j] || track_of[m.j] >= 0 || split_from[m.j] ||
+        absorbed[m.k] || track_of[m.k] != m.track) {
+      continue;
+    }
+    const Track& t = tracks[m.track];
+    const Piece& piece = t.pieces[m.piece];
+    const Piece& k_piece = t.pieces[m.k_piece];
+    const Piece& leaving = piece.former_id != 0 ? piece : k_piece;
+    if (leaving.former_id == 0 || taken(leaving)) continue;
+    split(m.j, m.k, t, m.piece, m.k_piece);
   }
 
   // The tracks some object has now (the two rules below keep it up to date).

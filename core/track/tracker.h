@@ -51,7 +51,10 @@ namespace fovea {
 //     one's identity stays (the older's at equal size). A joined object keeps
 //     its pieces: when INC cuts it again, a part that moved more than
 //     joint_motion_m apart from the rest (the two were separate objects swept
-//     along together) splits off with an identity of its own. The pieces are
+//     along together) splits off under the identity its piece had before
+//     the join, whether it no longer touches the rest or touches it still
+//     outside the joined mask (pushed along together, the cut between the
+//     two moved), unless another part took that piece. The pieces are
 //     carried along while INC cuts the object whole; when the joined track
 //     matches no object (its parts moved apart, its centroid between them),
 //     each part that is one of its pieces takes that piece's identity.
@@ -250,7 +253,8 @@ class Tracker {
   };
   // The rules on pieces (pieces.cc): objects that moved together and touch
   // join; an object without a track that is one of a joined track's pieces
-  // joins it again, unless the two moved apart (split); a track last seen
+  // joins it again, unless the two moved apart (split, also while they
+  // touch outside its last mask); a track last seen
   // in the previous frame that matched nothing and lies mostly under one
   // object joins it. Counts in out.joined and out.split.
   void JoinAndSplit(const std::optional<Eigen::Isometry3f>& camera_to_world,

@@ -495,6 +495,45 @@ TEST(Tracker, TwoObjectsSweptAlongAsOneGoOnAsTheLargerOfThem) {
   EXPECT_GT(checked, 0);
 }
 
+TEST(Tracker, APairCutInTwoAgainWhileSweptAlongGoesOnAsItsPieces) {
+  ASSERT_NE(Models(), nullptr);
+  // Seed 7: the pair is cut in two at frame 0, joined at frame 1 (they
+  // moved together) and cut in two again at frame 3 while still pushed
+  // along, touching, the cut between them moved: their centroids moved
+  // 1.8 cm apart. Each part is one of the joined track's pieces and goes
+  // on under that piece's identity. When a touching part that moved
+  // otherwise was a new object, the pair's first object took a new
+  // identity and the second the first's (2 switches).
+  const Sequence sequence = GenerateSequence(SequenceKind::kPushApart, 7, 12);
+  const std::vector<int> pair = SweptPair(sequence);
+  ASSERT_EQ(pair.size(), 2u);
+  std::vector<TrackedFrame> frames;
+  Play(sequence, true, &frames);
+  // The identity each of the pair had at frame 0.
+  std::map<int, int> first;
+  for (const TrackedObject& o : frames[0].objects) {
+    const int truth = TruthOf(sequence.frames[0], o.object.mask);
+    if (truth == pair[0] || truth == pair[1]) first[truth] = o.track_id;
+  }
+  ASSERT_EQ(first.size(), 2u);
+  bool joined = false;
+  for (size_t t = 1; t < frames.size(); ++t) {
+    joined = joined || frames[t].joined > 0;
+    if (!joined) continue;
+    std::map<int, int> now;
+    for (const TrackedObject& o : frames[t].objects) {
+      if (o.state == TrackState::kGone) continue;
+      const int truth = TruthOf(sequence.frames[t], o.object.mask);
+      if (truth == pair[0] || truth == pair[1]) now[truth] = o.track_id;
+    }
+    if (now.size() < 2) continue;
+    // The first frame after the join with both parts apart again.
+    EXPECT_EQ(now, first) << "frame " << t;
+    return;
+  }
+  ADD_FAILURE() << "the pair was never joined and cut in two again";
+}
+
 TEST(Tracker, AFragmentBesideAMovedObjectDoesNotTakeItsIdentity) {
   ASSERT_NE(Models(), nullptr);
   // Seed 22: while the pair is swept along, INC cuts small fragments off
