@@ -68,6 +68,23 @@ int TruthOf(const synth::SequenceFrame& frame, const cv::Mat& mask) {
   return best;
 }
 
+// For each of `truths`: the track id of an object of `tracked` (not gone)
+// whose mask is mostly that truth in `frame` (TruthOf); truths without
+// one are left out.
+std::map<int, int> IdsOfTruths(const synth::SequenceFrame& frame,
+                               const TrackedFrame& tracked,
+                               const std::vector<int>& truths) {
+  std::map<int, int> ids;
+  for (const TrackedObject& o : tracked.objects) {
+    if (o.state == TrackState::kGone) continue;
+    const int truth = TruthOf(frame, o.object.mask);
+    if (std::find(truths.begin(), truths.end(), truth) != truths.end()) {
+      ids[truth] = o.track_id;
+    }
+  }
+  return ids;
+}
+
 // Plays `sequence` through a tracker; for each ground-truth object, the
 // track ids that carried its largest mask, frame after frame (a piece of an
 // object cut in two is not a second identity; a new id on its largest piece
@@ -408,17 +425,11 @@ TEST(Tracker, PartsSweptTogetherSplitWhenTheyMoveApart) {
   EXPECT_GT(split, 0);
   // Apart, they are two objects again, each with its own mask.
   EXPECT_EQ(MasksOfTwoObjects(sequence.frames.back(), frames.back()), 0);
-  int last_id[2] = {0, 0};
-  for (const TrackedObject& o : frames.back().objects) {
-    if (o.state == TrackState::kGone) continue;
-    const int truth = TruthOf(sequence.frames.back(), o.object.mask);
-    for (int i = 0; i < 2; ++i) {
-      if (truth == pair[i]) last_id[i] = o.track_id;
-    }
-  }
-  EXPECT_NE(last_id[0], 0);
-  EXPECT_NE(last_id[1], 0);
-  EXPECT_NE(last_id[0], last_id[1]);
+  std::map<int, int> last_id =
+      IdsOfTruths(sequence.frames.back(), frames.back(), pair);
+  EXPECT_NE(last_id[pair[0]], 0);
+  EXPECT_NE(last_id[pair[1]], 0);
+  EXPECT_NE(last_id[pair[0]], last_id[pair[1]]);
   // The one that stopped has the identity it had before it was joined.
   EXPECT_EQ(tracks.at(stays).size(), 1u);
 }
@@ -480,13 +491,8 @@ TEST(Tracker, TwoObjectsSweptAlongAsOneGoOnAsTheLargerOfThem) {
       }
       const int larger = pixels[pair[0]] > pixels[pair[1]] ? pair[0] : pair[1];
       // The identity the larger one had in the frame before.
-      int before = 0;
-      for (const TrackedObject& p : frames[t - 1].objects) {
-        if (p.state != TrackState::kGone &&
-            TruthOf(sequence.frames[t - 1], p.object.mask) == larger) {
-          before = p.track_id;
-        }
-      }
+      const int before =
+          IdsOfTruths(sequence.frames[t - 1], frames[t - 1], {larger})[larger];
       ASSERT_NE(before, 0) << "frame " << t;
       EXPECT_EQ(o.track_id, before) << "frame " << t;
       ++checked;
@@ -510,22 +516,15 @@ TEST(Tracker, APairCutInTwoAgainWhileSweptAlongGoesOnAsItsPieces) {
   std::vector<TrackedFrame> frames;
   Play(sequence, true, &frames);
   // The identity each of the pair had at frame 0.
-  std::map<int, int> first;
-  for (const TrackedObject& o : frames[0].objects) {
-    const int truth = TruthOf(sequence.frames[0], o.object.mask);
-    if (truth == pair[0] || truth == pair[1]) first[truth] = o.track_id;
-  }
+  const std::map<int, int> first =
+      IdsOfTruths(sequence.frames[0], frames[0], pair);
   ASSERT_EQ(first.size(), 2u);
   bool joined = false;
   for (size_t t = 1; t < frames.size(); ++t) {
     joined = joined || frames[t].joined > 0;
     if (!joined) continue;
-    std::map<int, int> now;
-    for (const TrackedObject& o : frames[t].objects) {
-      if (o.state == TrackState::kGone) continue;
-      const int truth = TruthOf(sequence.frames[t], o.object.mask);
-      if (truth == pair[0] || truth == pair[1]) now[truth] = o.track_id;
-    }
+    const std::map<int, int> now =
+        IdsOfTruths(sequence.frames[t], frames[t], pair);
     if (now.size() < 2) continue;
     // The first frame after the join with both parts apart again.
     EXPECT_EQ(now, first) << "frame " << t;
