@@ -112,6 +112,31 @@ int MatchingPiece(const Piece& now, const Eigen::Vector3f& shift,
   return best;
 }
 
+void CarryUnseenPieces(const std::vector<Piece>& before,
+                       const std::vector<std::optional<Piece>>& split_from,
+                       const SegmentedObject& was,
+                       const Eigen::Vector3f& was_world,
+                       const SegmentedObject& object,
+                       const Eigen::Vector3f& world, std::vector<Piece>& now) {
+  std::vector<Piece> unseen;
+  for (const Piece& p : before) {
+    if (p.former_id == 0) continue;
+    const auto same = [&](const Piece& q) {
+      return q.former_id == p.former_id;
+    };
+    const auto took = [&](const std::optional<Piece>& q) {
+      return q && q->former_id == p.former_id;
+    };
+    if (std::none_of(now.begin(), now.end(), same) &&
+        std::none_of(split_from.begin(), split_from.end(), took)) {
+      unseen.push_back(p);
+    }
+  }
+  if (unseen.empty()) return;
+  CarryPieces(was, was_world, object, world, unseen);
+  now.insert(now.end(), unseen.begin(), unseen.end());
+}
+
 void KeepFormerIds(const Eigen::Vector3f& shift,
                    const std::vector<Piece>& before, std::vector<Piece>& now) {
   for (Piece& p : now) {

@@ -106,6 +106,18 @@ void CarryPieces(const SegmentedObject& was, const Eigen::Vector3f& was_world,
                  const SegmentedObject& now, const Eigen::Vector3f& now_world,
                  std::vector<Piece>& pieces);
 
+// The pieces of `before` with an identity of their own (former_id) that no
+// piece of `now` has and no part of this frame took (`split_from`): each
+// was hidden, or cut into the rest, this frame. They are carried along with
+// the joined object (CarryPieces, from `was` to `object`) and added to
+// `now`, so that the part is told when it comes back.
+void CarryUnseenPieces(const std::vector<Piece>& before,
+                       const std::vector<std::optional<Piece>>& split_from,
+                       const SegmentedObject& was,
+                       const Eigen::Vector3f& was_world,
+                       const SegmentedObject& object,
+                       const Eigen::Vector3f& world, std::vector<Piece>& now);
+
 }  // namespace fovea
 
 #endif  // FOVEA_CORE_TRACK_OBJECT_OPS_H_

@@ -432,6 +432,8 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
           CarryPieces(t.object, t.world_centroid, found[j], world[j], t.pieces);
         } else if (t.composite || composite[j]) {
           KeepFormerIds(shift, t.pieces, pieces[j]);
+          CarryUnseenPieces(t.pieces, split_from, t.object, t.world_centroid,
+                            found[j], world[j], pieces[j]);
           t.pieces = std::move(pieces[j]);
         }
         t.composite = t.composite || composite[j];

@@ -55,7 +55,9 @@ namespace fovea {
 //     the join, whether it no longer touches the rest or touches it still
 //     outside the joined mask (pushed along together, the cut between the
 //     two moved), unless another part took that piece. The pieces are
-//     carried along while INC cuts the object whole; when the joined track
+//     carried along while INC cuts the object whole, and so is a piece with
+//     an identity of its own that no part of the frame is (hidden, or cut
+//     into the rest), until its part comes back; when the joined track
 //     matches no object (its parts moved apart, its centroid between them),
 //     each part that is one of its pieces takes that piece's identity.
 

@@ -137,6 +137,42 @@ TEST(ObjectOps, PiecesOfAWholeAreCarriedAlongWithIt) {
   EXPECT_EQ(MatchingPiece(right, Eigen::Vector3f::Zero(), pieces), 1);
 }
 
+TEST(ObjectOps, AnUnseenPieceWithAnIdentityIsCarriedAlong) {
+  // A joined object: its own 4x4 piece at (0,0) and one that was object 5
+  // at (4,0). This frame the object is its own part only, 5 px right
+  // (0.03 m in the world): piece 5 is no part of the frame, so it is
+  // carried along to (9,0), while the own piece is this frame's.
+  std::vector<Piece> before = {
+      PieceOf(Square(0, 0, 4, Eigen::Vector3f(0.00f, 0, 1)),
+              Eigen::Vector3f(0.00f, 0, 1)),
+      PieceOf(Square(4, 0, 4, Eigen::Vector3f(0.02f, 0, 1)),
+              Eigen::Vector3f(0.02f, 0, 1))};
+  before[1].former_id = 5;
+  const SegmentedObject was = Square(0, 0, 4, Eigen::Vector3f(0.00f, 0, 1));
+  const SegmentedObject object = Square(5, 0, 4, Eigen::Vector3f(0.03f, 0, 1));
+  const std::vector<Piece> own = {
+      PieceOf(object, Eigen::Vector3f(0.03f, 0, 1))};
+  std::vector<Piece> now = own;
+  CarryUnseenPieces(before, {std::nullopt}, was, Eigen::Vector3f(0, 0, 1),
+                    object, Eigen::Vector3f(0.03f, 0, 1), now);
+  ASSERT_EQ(now.size(), 2u);
+  EXPECT_EQ(now[0].former_id, 0);
+  EXPECT_EQ(now[1].former_id, 5);
+  EXPECT_EQ(now[1].box, cv::Rect(9, 0, 4, 4));
+  EXPECT_TRUE(now[1].world_centroid.isApprox(Eigen::Vector3f(0.05f, 0, 1)));
+  // Not when a part of the frame is piece 5 already, nor when one split
+  // off as it.
+  std::vector<Piece> seen = now;
+  CarryUnseenPieces(before, {std::nullopt}, was, Eigen::Vector3f(0, 0, 1),
+                    object, Eigen::Vector3f(0.03f, 0, 1), seen);
+  EXPECT_EQ(seen.size(), 2u);
+  std::vector<Piece> split = own;
+  CarryUnseenPieces(before, {std::nullopt, before[1]}, was,
+                    Eigen::Vector3f(0, 0, 1), object,
+                    Eigen::Vector3f(0.03f, 0, 1), split);
+  EXPECT_EQ(split.size(), 1u);
+}
+
 TEST(ObjectOps, AHeldObjectKeepsOnlyItsBoxAndOverlapsAsBefore) {
   // A 4x4 square at (6,3) in a 20x20 frame, held cropped: 16 bytes, not
   // 400, and the same pixels at the frame's size again.

@@ -533,6 +533,35 @@ TEST(Tracker, APairCutInTwoAgainWhileSweptAlongGoesOnAsItsPieces) {
   ADD_FAILURE() << "the pair was never joined and cut in two again";
 }
 
+TEST(Tracker, AHiddenPieceIsCarriedAlongUntilItsPartComesBack) {
+  ASSERT_NE(Models(), nullptr);
+  // Seed 16: a small object (truth 0, about 370 pixels), first found at
+  // frame 1, is joined into a large one's track at frame 2; at frame 3 no
+  // object of the frame is its piece (the track's mask holds the large
+  // one only), and at frame 4 it is found alone again. Its piece is
+  // carried along meanwhile, so it comes back under its identity. When the
+  // pieces were only those of the frame, it came back new.
+  const Sequence sequence = GenerateSequence(SequenceKind::kPushApart, 16, 12);
+  std::vector<TrackedFrame> frames;
+  Play(sequence, true, &frames);
+  const std::map<int, int> first =
+      IdsOfTruths(sequence.frames[1], frames[1], {0});
+  ASSERT_EQ(first.size(), 1u);
+  bool hidden = false;
+  for (size_t t = 2; t < frames.size(); ++t) {
+    const std::map<int, int> now =
+        IdsOfTruths(sequence.frames[t], frames[t], {0});
+    if (now.empty()) {
+      hidden = true;
+      continue;
+    }
+    if (!hidden) continue;
+    EXPECT_EQ(now, first) << "frame " << t;
+    return;
+  }
+  ADD_FAILURE() << "truth 0 was never hidden and found again";
+}
+
 TEST(Tracker, AFragmentBesideAMovedObjectDoesNotTakeItsIdentity) {
   ASSERT_NE(Models(), nullptr);
   // Seed 22: while the pair is swept along, INC cuts small fragments off
