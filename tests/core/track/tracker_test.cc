@@ -4,7 +4,9 @@
 // is reported gone once, a drifting camera keeps every identity, an object
 // put down elsewhere keeps its own, objects swept along together and then
 // pulled apart split and get back their identities (whether INC cut the
-// pair whole meanwhile, or the joined track matched neither part), and a
+// pair whole meanwhile, or the joined track matched neither part), a pair
+// cut in two again while still pushed along goes on as its pieces, a
+// piece hidden for a frame is carried along until its part comes back, a
 // fragment does not take a moved object's identity, and a pushed object is
 // cut again in the region around it while the rest is kept as it was.
 
