@@ -112,6 +112,14 @@ int MatchingPiece(const Piece& now, const Eigen::Vector3f& shift,
   return best;
 }
 
+bool SplitOffAs(const std::vector<std::optional<Piece>>& split_from,
+                int former_id) {
+  return std::any_of(split_from.begin(), split_from.end(),
+                     [&](const std::optional<Piece>& p) {
+                       return p && p->former_id == former_id;
+                     });
+}
+
 void CarryUnseenPieces(const std::vector<Piece>& before,
                        const std::vector<std::optional<Piece>>& split_from,
                        const SegmentedObject& was,
@@ -124,11 +132,8 @@ void CarryUnseenPieces(const std::vector<Piece>& before,
     const auto same = [&](const Piece& q) {
       return q.former_id == p.former_id;
     };
-    const auto took = [&](const std::optional<Piece>& q) {
-      return q && q->former_id == p.former_id;
-    };
     if (std::none_of(now.begin(), now.end(), same) &&
-        std::none_of(split_from.begin(), split_from.end(), took)) {
+        !SplitOffAs(split_from, p.former_id)) {
       unseen.push_back(p);
     }
   }

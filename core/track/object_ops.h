@@ -106,6 +106,11 @@ void CarryPieces(const SegmentedObject& was, const Eigen::Vector3f& was_world,
                  const SegmentedObject& now, const Eigen::Vector3f& now_world,
                  std::vector<Piece>& pieces);
 
+// Whether some object of this frame split off as a piece of identity
+// `former_id` (split_from: per object, the piece it split off as).
+bool SplitOffAs(const std::vector<std::optional<Piece>>& split_from,
+                int former_id);
+
 // The pieces of `before` with an identity of their own (former_id) that no
 // piece of `now` has and no part of this frame took (`split_from`): each
 // was hidden, or cut into the rest, this frame. They are carried along with

@@ -154,12 +154,6 @@ void Tracker::JoinAndSplit(
   // Such a pair is two objects pushed along together whose cut between
   // them moved: each part goes on as its piece, not as a new object, when
   // no other object took that piece (or, for the track's own piece, k's).
-  const auto taken = [&](const Piece& piece) {
-    for (const std::optional<Piece>& s : split_from) {
-      if (s && s->former_id == piece.former_id) return true;
-    }
-    return false;
-  };
   for (const MovedOtherwise& m : moved_otherwise) {
     if (absorbed[m.j] || track_of[m.j] >= 0 || split_from[m.j] ||
         absorbed[m.k] || track_of[m.k] != m.track) {
@@ -169,7 +163,9 @@ void Tracker::JoinAndSplit(
     const Piece& piece = t.pieces[m.piece];
     const Piece& k_piece = t.pieces[m.k_piece];
     const Piece& leaving = piece.former_id != 0 ? piece : k_piece;
-    if (leaving.former_id == 0 || taken(leaving)) continue;
+    if (leaving.former_id == 0 || SplitOffAs(split_from, leaving.former_id)) {
+      continue;
+    }
     split(m.j, m.k, t, m.piece, m.k_piece);
   }
 
