@@ -139,8 +139,10 @@ void Tracker::JoinAndSplit(
         split(j, k, t, piece, k_piece);
         break;
       }
-      // Mostly inside the track's last mask: one object cut in two again.
+      // Mostly inside the track's last mask: one object cut in two again
+      // (not counted when j joins k anyway).
       const bool inside =
+          with != 1 &&
           OverlapWithHeld(found[j].mask, t.object) * 2 > found[j].area;
       if (with == 1 || inside) {
         join(j, k);
