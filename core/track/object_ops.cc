@@ -112,6 +112,42 @@ int MatchingPiece(const Piece& now, const Eigen::Vector3f& shift,
   return best;
 }
 
+namespace {
+
+// The centroid of `mask` (CV_8UC1) placed at `box` in the frame, in pixels;
+// nullopt when it has no pixel.
+std::optional<cv::Point2d> MaskCentroid(const cv::Mat& mask,
+                                        const cv::Rect& box) {
+  if (mask.empty()) return std::nullopt;
+  const cv::Moments m = cv::moments(mask, true);
+  if (m.m00 <= 0.0) return std::nullopt;
+  return cv::Point2d(box.x + m.m10 / m.m00, box.y + m.m01 / m.m00);
+}
+
+// The whole pixels from `from` to `to` (none when either is missing).
+cv::Point PixelShift(const std::optional<cv::Point2d>& from,
+                     const std::optional<cv::Point2d>& to) {
+  if (!from || !to) return {0, 0};
+  return {static_cast<int>(std::lround(to->x - from->x)),
+          static_cast<int>(std::lround(to->y - from->y))};
+}
+
+}  // namespace
+
+std::vector<Piece> MovedAs(const std::vector<Piece>& pieces, const Piece& from,
+                           const Piece& to, const Eigen::Vector3f& shift) {
+  const Eigen::Vector3f motion =
+      to.world_centroid - shift - from.world_centroid;
+  const cv::Point pixels = PixelShift(MaskCentroid(from.mask, from.box),
+                                      MaskCentroid(to.mask, to.box));
+  std::vector<Piece> moved = pieces;
+  for (Piece& p : moved) {
+    p.world_centroid += motion;
+    p.box += pixels;
+  }
+  return moved;
+}
+
 bool SplitOffAs(const std::vector<std::optional<Piece>>& split_from,
                 int former_id) {
   return std::any_of(split_from.begin(), split_from.end(),
@@ -163,10 +199,7 @@ std::optional<cv::Point2d> PixelCentroid(const SegmentedObject& object) {
       cropped ? object.box
               : object.box & cv::Rect(0, 0, object.mask.cols, object.mask.rows);
   if (box.empty()) return std::nullopt;
-  const cv::Moments m =
-      cv::moments(cropped ? object.mask : object.mask(box), true);
-  if (m.m00 <= 0.0) return std::nullopt;
-  return cv::Point2d(box.x + m.m10 / m.m00, box.y + m.m01 / m.m00);
+  return MaskCentroid(cropped ? object.mask : object.mask(box), box);
 }
 
 }  // namespace
@@ -215,12 +248,7 @@ bool IsWhole(int area, const std::vector<Piece>& pieces) {
 void CarryPieces(const SegmentedObject& was, const Eigen::Vector3f& was_world,
                  const SegmentedObject& now, const Eigen::Vector3f& now_world,
                  std::vector<Piece>& pieces) {
-  const std::optional<cv::Point2d> from = PixelCentroid(was);
-  const std::optional<cv::Point2d> to = PixelCentroid(now);
-  const cv::Point shift =
-      from && to ? cv::Point(static_cast<int>(std::lround(to->x - from->x)),
-                             static_cast<int>(std::lround(to->y - from->y)))
-                 : cv::Point(0, 0);
+  const cv::Point shift = PixelShift(PixelCentroid(was), PixelCentroid(now));
   const double scale =
       was.area > 0 ? static_cast<double>(now.area) / was.area : 1.0;
   for (Piece& p : pieces) {

@@ -69,6 +69,15 @@ Piece PieceOf(const SegmentedObject& object,
 int MatchingPiece(const Piece& now, const Eigen::Vector3f& shift,
                   const std::vector<Piece>& before);
 
+// `pieces` moved as their piece `from` moved to `to` (one part of this
+// frame): in the world by its motion less `shift` (the camera's own), in
+// the image by the motion of its mask's centroid. Parts pushed along
+// together move alike, and a small one moves by more than its own size
+// from one frame to the next: it overlaps its piece only once the piece is
+// moved.
+std::vector<Piece> MovedAs(const std::vector<Piece>& pieces, const Piece& from,
+                           const Piece& to, const Eigen::Vector3f& shift);
+
 // The pieces keep the identities they had before being joined: each piece
 // of `now` without one takes that of its MatchingPiece in `before`.
 void KeepFormerIds(const Eigen::Vector3f& shift,

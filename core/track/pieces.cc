@@ -82,9 +82,16 @@ void Tracker::JoinAndSplit(
                               int* k_piece) {
     const Piece& now_j = pieces[j].front();
     const Piece& now_k = pieces[k].front();
-    const int pj = MatchingPiece(now_j, shift, t.pieces);
     const int pk = MatchingPiece(now_k, shift, t.pieces);
-    if (pj < 0 || pk < 0 || pj == pk) return -1;
+    if (pk < 0) return -1;
+    int pj = MatchingPiece(now_j, shift, t.pieces);
+    if (pj < 0 || pj == pk) {
+      // j may have moved by more than its size: look for it among the
+      // pieces moved as k's moved.
+      pj = MatchingPiece(now_j, shift,
+                         MovedAs(t.pieces, t.pieces[pk], now_k, shift));
+    }
+    if (pj < 0 || pj == pk) return -1;
     *piece = pj;
     *k_piece = pk;
     const Eigen::Vector3f motion_j =

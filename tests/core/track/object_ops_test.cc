@@ -137,6 +137,36 @@ TEST(ObjectOps, PiecesOfAWholeAreCarriedAlongWithIt) {
   EXPECT_EQ(MatchingPiece(right, Eigen::Vector3f::Zero(), pieces), 1);
 }
 
+TEST(ObjectOps, PiecesMovedAsOneOfThemMovedFindASmallPartThatMovedFar) {
+  // A 6x6 piece at (0,0) and a 2x2 one beside it at (6,0), pushed along
+  // together 4 px right and 3 cm in the world: the small part, now at
+  // (10,0), no longer overlaps its piece, which lay where it was.
+  const std::vector<Piece> before = {
+      PieceOf(Square(0, 0, 6, Eigen::Vector3f(0.00f, 0, 1)),
+              Eigen::Vector3f(0.00f, 0, 1)),
+      PieceOf(Square(6, 0, 2, Eigen::Vector3f(0.02f, 0, 1)),
+              Eigen::Vector3f(0.02f, 0, 1))};
+  const Piece large = PieceOf(Square(4, 0, 6, Eigen::Vector3f(0.03f, 0, 1)),
+                              Eigen::Vector3f(0.03f, 0, 1));
+  const Piece small = PieceOf(Square(10, 0, 2, Eigen::Vector3f(0.05f, 0, 1)),
+                              Eigen::Vector3f(0.05f, 0, 1));
+  EXPECT_EQ(MatchingPiece(small, Eigen::Vector3f::Zero(), before), -1);
+  // Moved as the large one moved (its mask's centroid 4 px right, 3 cm),
+  // the small piece is at (10,0) and 5 cm again.
+  const std::vector<Piece> moved =
+      MovedAs(before, before[0], large, Eigen::Vector3f::Zero());
+  EXPECT_EQ(moved[1].box, cv::Rect(10, 0, 2, 2));
+  EXPECT_TRUE(moved[1].world_centroid.isApprox(Eigen::Vector3f(0.05f, 0, 1)));
+  EXPECT_EQ(moved[1].area, 4);
+  EXPECT_EQ(MatchingPiece(small, Eigen::Vector3f::Zero(), moved), 1);
+  // The camera's own motion is not the pieces': with the camera moved by
+  // 3 cm, the large one did not move in the world.
+  const std::vector<Piece> still =
+      MovedAs(before, before[0], large, Eigen::Vector3f(0.03f, 0, 0));
+  EXPECT_TRUE(still[1].world_centroid.isApprox(Eigen::Vector3f(0.02f, 0, 1)));
+  EXPECT_EQ(still[1].box, cv::Rect(10, 0, 2, 2));  // the image moved
+}
+
 TEST(ObjectOps, AnUnseenPieceWithAnIdentityIsCarriedAlong) {
   // A joined object: its own 4x4 piece at (0,0) and one that was object 5
   // at (4,0). This frame the object is its own part only, 5 px right

@@ -564,6 +564,20 @@ TEST(Tracker, AHiddenPieceIsCarriedAlongUntilItsPartComesBack) {
   ADD_FAILURE() << "truth 0 was never hidden and found again";
 }
 
+TEST(Tracker, ASmallPartPushedAlongIsToldByItsPieceMovedWithTheRest) {
+  ASSERT_NE(Models(), nullptr);
+  // Seed 41: a small object (truth 2, 200-380 pixels) is pushed along
+  // with a large one, about 3 cm a frame, and joined into its track. When
+  // INC cut it off again it had moved by more than its own size since its
+  // piece was seen, overlapped it no longer, and came back as a new object
+  // (identities 3, 4, 5, 3: three switches). Found among the pieces moved
+  // as the large one moved, it joins again, and keeps one identity.
+  const Sequence sequence = GenerateSequence(SequenceKind::kPushApart, 41, 12);
+  const std::map<int, std::set<int>> tracks = Play(sequence, true);
+  ASSERT_TRUE(tracks.count(2));
+  EXPECT_EQ(tracks.at(2).size(), 1u);
+}
+
 TEST(Tracker, AFragmentBesideAMovedObjectDoesNotTakeItsIdentity) {
   ASSERT_NE(Models(), nullptr);
   // Seed 22: while the pair is swept along, INC cuts small fragments off
