@@ -82,17 +82,21 @@ absl::Status WriteTrackedPng(const synth::SequenceFrame& frame,
   return absl::OkStatus();
 }
 
-// One line per sequence on stderr (IDTP, IDFP, IDFN, switches), and for a
+// One line per sequence on stderr (IDTP, IDFP, IDFN, switches, the mean
+// overlap F of its frames), and for a
 // sequence with switches the (truth -> track) pairs of every frame and the
 // tracks joined and split in it (`events`, per frame).
 void PrintSequence(const std::string& name,
                    const std::vector<FrameIdentities>& identities,
-                   const std::vector<std::pair<int, int>>& events) {
+                   const std::vector<std::pair<int, int>>& events,
+                   double overlap_f) {
   const IdentityCounts c = CountIdentities(identities);
-  std::fprintf(stderr, "%s: idtp %lld idfp %lld idfn %lld switches %lld\n",
+  std::fprintf(stderr,
+               "%s: idtp %lld idfp %lld idfn %lld switches %lld overlap F "
+               "%.4f\n",
                name.c_str(), static_cast<long long>(c.idtp),
                static_cast<long long>(c.idfp), static_cast<long long>(c.idfn),
-               static_cast<long long>(c.switches));
+               static_cast<long long>(c.switches), overlap_f);
   if (!identities.empty()) {
     for (const std::string& mask : identities.front().unmatched) {
       std::fprintf(stderr, "  frame 0, unmatched: %s\n", mask.c_str());
@@ -323,6 +327,7 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
     Tracker tracker(options.tracker, models.inc ? &*models.inc : nullptr);
     std::vector<FrameIdentities> identities;
     std::vector<std::pair<int, int>> events;  // joined, split per frame
+    const double f_sum_before = f_sum;
     const synth::SequenceFrame* previous = nullptr;
     for (const synth::SequenceFrame& frame : sequence.frames) {
       std::optional<Eigen::Isometry3f> pose;
@@ -403,7 +408,12 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
       previous = &frame;
       ++figures.frames;
     }
-    if (options.verbose) PrintSequence(sequence.name, identities, events);
+    if (options.verbose) {
+      PrintSequence(
+          sequence.name, identities, events,
+          (f_sum - f_sum_before) /
+              static_cast<double>(std::max<size_t>(1, identities.size())));
+    }
     figures.identities += CountIdentities(identities);
     ++figures.sequences;
   }
