@@ -178,6 +178,36 @@ void Tracker::JoinAndSplit(
     split(m.j, m.k, t, m.piece, m.k_piece);
   }
 
+  // With a still camera (and not a refined cut, which replaces the last
+  // one), an object without a track whose pixels mostly did not change, lying
+  // mostly inside the last mask of a track that an object it touches kept, is a
+  // piece of that object: INC cut an unchanged object in two this time. It
+  // joins it rather than appearing.
+  if (!a.changed.empty()) {
+    for (size_t j = 0; j < found.size(); ++j) {
+      if (absorbed[j] || track_of[j] >= 0 || split_from[j]) continue;
+      const cv::Rect box =
+          found[j].box & cv::Rect(0, 0, a.changed.cols, a.changed.rows);
+      cv::Mat moved;
+      cv::bitwise_and(a.changed(box), found[j].mask(box), moved);
+      if (2 * cv::countNonZero(moved) >= found[j].area) continue;
+      for (size_t k = 0; k < found.size(); ++k) {
+        if (k == j || absorbed[k] || track_of[k] < 0 ||
+            state[k] != TrackState::kKept) {
+          continue;
+        }
+        const Track& t = tracks[track_of[k]];
+        if (2 * OverlapWithHeld(found[j].mask, t.object) <= found[j].area ||
+            !Touch(found[j].mask, found[j].box, found[k].mask, found[k].box,
+                   3)) {
+          continue;
+        }
+        join(j, k);
+        break;
+      }
+    }
+  }
+
   // The tracks some object has now (the two rules below keep it up to date).
   std::vector<bool> matched_track(tracks.size(), false);
   for (size_t j = 0; j < found.size(); ++j) {

@@ -406,6 +406,8 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
       if (track_of[j] < 0) continue;
       state[j] = StateOfMotion(displacement[j]);
     }
+    // A refined cut replaces the last one: its parts are not joined by it.
+    if (!out.refined) a.changed = changed;
     JoinAndSplit(camera_to_world, a, tracks, out);
     const std::vector<bool>& absorbed = a.absorbed;
     const std::vector<bool>& composite = a.composite;

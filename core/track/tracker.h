@@ -252,6 +252,7 @@ class Tracker {
     std::vector<bool> composite;
     std::vector<std::vector<Piece>> pieces;
     std::vector<std::optional<Piece>> split_from;
+    cv::Mat changed;  // with a still camera: the pixels that changed
   };
   // The rules on pieces (pieces.cc): objects that moved together and touch
   // join; an object without a track that is one of a joined track's pieces

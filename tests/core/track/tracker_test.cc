@@ -578,6 +578,20 @@ TEST(Tracker, ASmallPartPushedAlongIsToldByItsPieceMovedWithTheRest) {
   EXPECT_EQ(tracks.at(2).size(), 1u);
 }
 
+TEST(Tracker, AnUnchangedObjectCutInTwoIsOnePieceAndKeepsItsIdentity) {
+  ASSERT_NE(Models(), nullptr);
+  // Seed 47: at frame 8 INC cut a still object (truth 4, about 1,900
+  // pixels) in two halves; the one nearer its track's centroid kept its
+  // identity and the other, larger, appeared as a new object, which took
+  // the whole at frame 9 (the object joined under the larger piece). Its
+  // pixels did not change, and it lies inside the track's last mask: it is
+  // a piece of the half that kept the track, and joins it.
+  const Sequence sequence = GenerateSequence(SequenceKind::kPushApart, 47, 12);
+  const std::map<int, std::set<int>> tracks = Play(sequence, true);
+  ASSERT_TRUE(tracks.count(4));
+  EXPECT_EQ(tracks.at(4).size(), 1u);
+}
+
 TEST(Tracker, AFragmentBesideAMovedObjectDoesNotTakeItsIdentity) {
   ASSERT_NE(Models(), nullptr);
   // Seed 22: while the pair is swept along, INC cuts small fragments off
