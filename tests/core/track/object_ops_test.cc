@@ -22,6 +22,11 @@ SegmentedObject Square(int x, int y, int side,
   return o;
 }
 
+// Square(...) as a piece, its centroid in the world `centroid`.
+Piece SquarePiece(int x, int y, int side, const Eigen::Vector3f& centroid) {
+  return PieceOf(Square(x, y, side, centroid), centroid);
+}
+
 TEST(ObjectOps, SquaresTwoPixelsApartTouchWhenOneGrowsByThree) {
   // Columns 2-4 and 7-9: a gap of columns 5 and 6, which a grown by 2
   // fills; by 3 it reaches column 7.
@@ -70,35 +75,28 @@ TEST(ObjectOps, APieceIsTheOverlappingOneOfItsSizeNearest) {
   // Last frame's pieces: a 4x4 square at (0,0) and a 4x4 at (4,0) beside
   // it, and a 9x9 one covering both.
   const std::vector<Piece> before = {
-      PieceOf(Square(0, 0, 4, Eigen::Vector3f(0.00f, 0, 1)),
-              Eigen::Vector3f(0.00f, 0, 1)),
-      PieceOf(Square(4, 0, 4, Eigen::Vector3f(0.05f, 0, 1)),
-              Eigen::Vector3f(0.05f, 0, 1)),
-      PieceOf(Square(0, 0, 9, Eigen::Vector3f(0.02f, 0, 1)),
-              Eigen::Vector3f(0.02f, 0, 1))};
+      SquarePiece(0, 0, 4, Eigen::Vector3f(0.00f, 0, 1)),
+      SquarePiece(4, 0, 4, Eigen::Vector3f(0.05f, 0, 1)),
+      SquarePiece(0, 0, 9, Eigen::Vector3f(0.02f, 0, 1))};
   ASSERT_EQ(before[0].box, cv::Rect(0, 0, 4, 4));
   EXPECT_EQ(before[0].mask.size(), cv::Size(4, 4));
   EXPECT_EQ(before[0].area, 16);
   // A 4x4 square 1 px right of the first overlaps all three: the big one
   // is more than 1.5x its size, and the first is nearer than the second.
-  const Piece moved = PieceOf(Square(1, 0, 4, Eigen::Vector3f(0.01f, 0, 1)),
-                              Eigen::Vector3f(0.01f, 0, 1));
+  const Piece moved = SquarePiece(1, 0, 4, Eigen::Vector3f(0.01f, 0, 1));
   EXPECT_EQ(MatchingPiece(moved, Eigen::Vector3f::Zero(), before), 0);
   // Of two the same size it overlaps, the nearer after the camera's own
   // motion (`shift`) is taken out.
-  const Piece between = PieceOf(Square(3, 0, 6, Eigen::Vector3f(0.05f, 0, 1)),
-                                Eigen::Vector3f(0.05f, 0, 1));
+  const Piece between = SquarePiece(3, 0, 6, Eigen::Vector3f(0.05f, 0, 1));
   EXPECT_EQ(
       MatchingPiece(between, Eigen::Vector3f::Zero(), {before[0], before[1]}),
       -1);  // 36 px against 16: none is its size
-  const Piece small = PieceOf(Square(2, 0, 4, Eigen::Vector3f(0.05f, 0, 1)),
-                              Eigen::Vector3f(0.05f, 0, 1));
+  const Piece small = SquarePiece(2, 0, 4, Eigen::Vector3f(0.05f, 0, 1));
   const std::vector<Piece> pair = {before[0], before[1]};
   EXPECT_EQ(MatchingPiece(small, Eigen::Vector3f::Zero(), pair), 1);
   EXPECT_EQ(MatchingPiece(small, Eigen::Vector3f(0.05f, 0, 0), pair), 0);
   // Nothing overlaps: none.
-  const Piece away = PieceOf(Square(14, 14, 4, Eigen::Vector3f(0, 0, 1)),
-                             Eigen::Vector3f(0, 0, 1));
+  const Piece away = SquarePiece(14, 14, 4, Eigen::Vector3f(0, 0, 1));
   EXPECT_EQ(MatchingPiece(away, Eigen::Vector3f::Zero(), before), -1);
 }
 
@@ -107,10 +105,8 @@ TEST(ObjectOps, PiecesOfAWholeAreCarriedAlongWithIt) {
   // whole next frame, 5 px right and 5 px down, 3 cm along x in the world,
   // and 1.5 times its area (the camera came closer).
   const std::vector<Piece> was = {
-      PieceOf(Square(0, 0, 4, Eigen::Vector3f(0.00f, 0, 1)),
-              Eigen::Vector3f(0.00f, 0, 1)),
-      PieceOf(Square(4, 0, 4, Eigen::Vector3f(0.02f, 0, 1)),
-              Eigen::Vector3f(0.02f, 0, 1))};
+      SquarePiece(0, 0, 4, Eigen::Vector3f(0.00f, 0, 1)),
+      SquarePiece(4, 0, 4, Eigen::Vector3f(0.02f, 0, 1))};
   SegmentedObject whole = Square(0, 0, 4, Eigen::Vector3f(0.01f, 0, 1));
   Join(Square(4, 0, 4, Eigen::Vector3f(0.02f, 0, 1)), whole);
   SegmentedObject now;
@@ -129,10 +125,8 @@ TEST(ObjectOps, PiecesOfAWholeAreCarriedAlongWithIt) {
   EXPECT_EQ(pieces[0].area, 24);  // 16 x 48 / 32
   EXPECT_EQ(pieces[1].mask.size(), cv::Size(4, 4));
   // Each part of the whole, where the whole went, is still its own piece.
-  const Piece left = PieceOf(Square(5, 5, 5, Eigen::Vector3f(0.03f, 0, 1)),
-                             Eigen::Vector3f(0.03f, 0, 1));
-  const Piece right = PieceOf(Square(9, 5, 5, Eigen::Vector3f(0.05f, 0, 1)),
-                              Eigen::Vector3f(0.05f, 0, 1));
+  const Piece left = SquarePiece(5, 5, 5, Eigen::Vector3f(0.03f, 0, 1));
+  const Piece right = SquarePiece(9, 5, 5, Eigen::Vector3f(0.05f, 0, 1));
   EXPECT_EQ(MatchingPiece(left, Eigen::Vector3f::Zero(), pieces), 0);
   EXPECT_EQ(MatchingPiece(right, Eigen::Vector3f::Zero(), pieces), 1);
 }
@@ -142,14 +136,10 @@ TEST(ObjectOps, PiecesMovedAsOneOfThemMovedFindASmallPartThatMovedFar) {
   // together 4 px right and 3 cm in the world: the small part, now at
   // (10,0), no longer overlaps its piece, which lay where it was.
   const std::vector<Piece> before = {
-      PieceOf(Square(0, 0, 6, Eigen::Vector3f(0.00f, 0, 1)),
-              Eigen::Vector3f(0.00f, 0, 1)),
-      PieceOf(Square(6, 0, 2, Eigen::Vector3f(0.02f, 0, 1)),
-              Eigen::Vector3f(0.02f, 0, 1))};
-  const Piece large = PieceOf(Square(4, 0, 6, Eigen::Vector3f(0.03f, 0, 1)),
-                              Eigen::Vector3f(0.03f, 0, 1));
-  const Piece small = PieceOf(Square(10, 0, 2, Eigen::Vector3f(0.05f, 0, 1)),
-                              Eigen::Vector3f(0.05f, 0, 1));
+      SquarePiece(0, 0, 6, Eigen::Vector3f(0.00f, 0, 1)),
+      SquarePiece(6, 0, 2, Eigen::Vector3f(0.02f, 0, 1))};
+  const Piece large = SquarePiece(4, 0, 6, Eigen::Vector3f(0.03f, 0, 1));
+  const Piece small = SquarePiece(10, 0, 2, Eigen::Vector3f(0.05f, 0, 1));
   EXPECT_EQ(MatchingPiece(small, Eigen::Vector3f::Zero(), before), -1);
   // Moved as the large one moved (its mask's centroid 4 px right, 3 cm),
   // the small piece is at (10,0) and 5 cm again.
@@ -173,10 +163,8 @@ TEST(ObjectOps, AnUnseenPieceWithAnIdentityIsCarriedAlong) {
   // (0.03 m in the world): piece 5 is no part of the frame, so it is
   // carried along to (9,0), while the own piece is this frame's.
   std::vector<Piece> before = {
-      PieceOf(Square(0, 0, 4, Eigen::Vector3f(0.00f, 0, 1)),
-              Eigen::Vector3f(0.00f, 0, 1)),
-      PieceOf(Square(4, 0, 4, Eigen::Vector3f(0.02f, 0, 1)),
-              Eigen::Vector3f(0.02f, 0, 1))};
+      SquarePiece(0, 0, 4, Eigen::Vector3f(0.00f, 0, 1)),
+      SquarePiece(4, 0, 4, Eigen::Vector3f(0.02f, 0, 1))};
   before[1].former_id = 5;
   const SegmentedObject was = Square(0, 0, 4, Eigen::Vector3f(0.00f, 0, 1));
   const SegmentedObject object = Square(5, 0, 4, Eigen::Vector3f(0.03f, 0, 1));
