@@ -408,6 +408,17 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
     }
     // A refined cut replaces the last one: its parts are not joined by it.
     if (!out.refined) a.changed = changed;
+    // With a camera that moved by a known pose, what changed is told in the
+    // world, and only when some object has no track.
+    if (!still && same_size && camera_to_world && reference_pose_) {
+      cv::Rect area;  // where the objects without a track are
+      for (size_t j = 0; j < found.size(); ++j) {
+        if (track_of[j] < 0) area |= found[j].box;
+      }
+      if (!area.empty()) {
+        a.changed = ChangedSeenFrom(input, *camera_to_world, area);
+      }
+    }
     JoinAndSplit(camera_to_world, a, tracks, out);
     const std::vector<bool>& absorbed = a.absorbed;
     const std::vector<bool>& composite = a.composite;

@@ -273,6 +273,12 @@ class Tracker {
   // The fraction of pixels that changed from the reference frame;
   // `changed` gets them (CV_8UC1, 255 where changed).
   double ChangedFraction(const RgbdFrame& frame, cv::Mat& changed) const;
+  // With a camera that moved by a known pose (`pose`, the last frame
+  // segmented's known): the pixels of `frame` within `area` whose point,
+  // moved into the last frame's view, falls where that frame saw no depth or
+  // a different one (CV_8UC1 of the frame's size, zero outside `area`).
+  cv::Mat ChangedSeenFrom(const RgbdFrame& frame, const Eigen::Isometry3f& pose,
+                          const cv::Rect& area) const;
   bool CameraStill(const std::optional<Eigen::Isometry3f>& pose) const;
   // Segments `frame` with INC (`segment` its options) on the last support
   // when TrackerOptions::reuse_support allows; the objects go to `found`,

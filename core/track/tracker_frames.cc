@@ -75,6 +75,57 @@ double Tracker::ChangedFraction(const RgbdFrame& frame,
                     : static_cast<double>(cv::countNonZero(changed)) / valid;
 }
 
+cv::Mat Tracker::ChangedSeenFrom(const RgbdFrame& frame,
+                                 const Eigen::Isometry3f& pose,
+                                 const cv::Rect& area) const {
+  // Each pixel with depth within `area` (grown by the opening's reach, so
+  // that the opening gives within `area` what it would on the whole frame)
+  // is moved into the last view: it changed when no depth was seen there,
+  // or a different one. A pixel without depth now tells nothing.
+  cv::Mat changed(frame.depth.size(), CV_8UC1, cv::Scalar(0));
+  const cv::Rect grown =
+      Grown(area, 4) & cv::Rect(0, 0, frame.depth.cols, frame.depth.rows);
+  if (grown.empty()) return changed;
+  const Eigen::Isometry3f to_last = reference_pose_->inverse() * pose;
+  const Intrinsics& now = frame.intrinsics;
+  const Intrinsics& last = reference_.intrinsics;
+  for (int v = grown.y; v < grown.y + grown.height; ++v) {
+    const float* z = frame.depth.ptr<float>(v);
+    uint8_t* out = changed.ptr<uint8_t>(v);
+    for (int u = grown.x; u < grown.x + grown.width; ++u) {
+      if (!(z[u] > 0.0f && std::isfinite(z[u]))) continue;
+      const Eigen::Vector3f p =
+          to_last * Eigen::Vector3f(
+                        static_cast<float>((u - now.cx) / now.fx) * z[u],
+                        static_cast<float>((v - now.cy) / now.fy) * z[u], z[u]);
+      bool moved = true;
+      if (p.z() > 0.0f) {
+        const long x = std::lround(last.fx * p.x() / p.z() + last.cx);
+        const long y = std::lround(last.fy * p.y() / p.z() + last.cy);
+        if (x >= 0 && y >= 0 && x < reference_.depth.cols &&
+            y < reference_.depth.rows) {
+          const float z0 = reference_.depth.at<float>(static_cast<int>(y),
+                                                      static_cast<int>(x));
+          if (z0 > 0.0f) {
+            const float limit =
+                std::max(options_.change_min_m,
+                         options_.change_sigmas * sensor_.DepthSigma(z0));
+            moved = std::abs(p.z() - z0) > limit;
+          }
+        }
+      }
+      out[u] = moved ? 255 : 0;
+    }
+  }
+  cv::Mat opened;
+  cv::morphologyEx(changed(grown), opened, cv::MORPH_OPEN,
+                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5)));
+  changed.setTo(0);
+  const cv::Rect inside = area & grown;
+  opened(inside - grown.tl()).copyTo(changed(inside));
+  return changed;
+}
+
 bool Tracker::CameraStill(const std::optional<Eigen::Isometry3f>& pose) const {
   if (pose.has_value() != reference_pose_.has_value()) return false;
   if (!pose) return true;  // the pixels decide
