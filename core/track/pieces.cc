@@ -178,11 +178,12 @@ void Tracker::JoinAndSplit(
     split(m.j, m.k, t, m.piece, m.k_piece);
   }
 
-  // With a still camera (and not a refined cut, which replaces the last
-  // one), an object without a track whose pixels mostly did not change, lying
-  // mostly inside the last mask of a track that an object it touches kept, is a
-  // piece of that object: INC cut an unchanged object in two this time. It
-  // joins it rather than appearing.
+  // Where what changed is known (a still camera, or one moved by a known
+  // pose; not a refined cut, which replaces the last one), an object
+  // without a track whose pixels mostly did not change, lying mostly inside
+  // the last mask of a track that an object it touches kept, is a piece of
+  // that object: INC cut an unchanged object in two this time. It joins it
+  // rather than appearing.
   if (!a.changed.empty()) {
     for (size_t j = 0; j < found.size(); ++j) {
       if (absorbed[j] || track_of[j] >= 0 || split_from[j]) continue;

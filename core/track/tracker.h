@@ -252,7 +252,10 @@ class Tracker {
     std::vector<bool> composite;
     std::vector<std::vector<Piece>> pieces;
     std::vector<std::optional<Piece>> split_from;
-    cv::Mat changed;  // with a still camera: the pixels that changed
+    // The pixels that changed since the last frame segmented: with a still
+    // camera, all; with one moved by a known pose, those of the objects
+    // without a track (ChangedSeenFrom); empty when not known.
+    cv::Mat changed;
   };
   // The rules on pieces (pieces.cc): objects that moved together and touch
   // join; an object without a track that is one of a joined track's pieces
