@@ -276,6 +276,9 @@ class Tracker {
   // The fraction of pixels that changed from the reference frame;
   // `changed` gets them (CV_8UC1, 255 where changed).
   double ChangedFraction(const RgbdFrame& frame, cv::Mat& changed) const;
+  // Whether depth `z` moved from `z0` (both > 0) by more than
+  // max(change_min_m, change_sigmas sigma(z0)).
+  bool DepthChanged(float z, float z0) const;
   // With a camera that moved by a known pose (`pose`, the last frame
   // segmented's known): the pixels of `frame` within `area` whose point,
   // moved into the last frame's view, falls where that frame saw no depth or

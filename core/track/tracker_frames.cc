@@ -30,6 +30,23 @@ void Tracker::AverageInto(const cv::Mat& depth, cv::Mat& mean, cv::Mat& count) {
   }
 }
 
+namespace {
+
+// Noise changes single pixels and the rims of depth edges (dropouts come
+// and go there); a real change is a region: what survives an opening.
+void KeepChangedRegions(const cv::Mat& changed, cv::Mat& regions) {
+  cv::morphologyEx(changed, regions, cv::MORPH_OPEN,
+                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5)));
+}
+
+}  // namespace
+
+bool Tracker::DepthChanged(float z, float z0) const {
+  return std::abs(z - z0) >
+         std::max(options_.change_min_m,
+                  options_.change_sigmas * sensor_.DepthSigma(z0));
+}
+
 double Tracker::ChangedFraction(const RgbdFrame& frame,
                                 cv::Mat& changed) const {
   const bool colors = !frame.color.empty() && !reference_.color.empty() &&
@@ -51,13 +68,7 @@ double Tracker::ChangedFraction(const RgbdFrame& frame,
       ++valid;
       // Depth that came or went counts as a change: an object placed on a
       // dark table, or taken away, may show as exactly that.
-      bool moved = has != had;
-      if (!moved) {
-        const float limit =
-            std::max(options_.change_min_m,
-                     options_.change_sigmas * sensor_.DepthSigma(z0[u]));
-        moved = std::abs(z[u] - z0[u]) > limit;
-      }
+      bool moved = has != had || DepthChanged(z[u], z0[u]);
       if (!moved && colors) {
         for (int k = 0; k < 3; ++k) {
           moved |= std::abs(static_cast<int>(c[u][k]) - c0[u][k]) >
@@ -67,10 +78,7 @@ double Tracker::ChangedFraction(const RgbdFrame& frame,
       out[u] = moved ? 255 : 0;
     }
   }
-  // Noise changes single pixels and the rims of depth edges (dropouts come
-  // and go there); a real change is a region: what survives an opening.
-  cv::morphologyEx(changed, changed, cv::MORPH_OPEN,
-                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5)));
+  KeepChangedRegions(changed, changed);
   return valid == 0 ? 1.0
                     : static_cast<double>(cv::countNonZero(changed)) / valid;
 }
@@ -86,12 +94,13 @@ cv::Mat Tracker::ChangedSeenFrom(const RgbdFrame& frame,
   const cv::Rect grown =
       Grown(area, 4) & cv::Rect(0, 0, frame.depth.cols, frame.depth.rows);
   if (grown.empty()) return changed;
+  cv::Mat local(grown.size(), CV_8UC1, cv::Scalar(0));  // `grown`'s pixels
   const Eigen::Isometry3f to_last = reference_pose_->inverse() * pose;
   const Intrinsics& now = frame.intrinsics;
   const Intrinsics& last = reference_.intrinsics;
   for (int v = grown.y; v < grown.y + grown.height; ++v) {
     const float* z = frame.depth.ptr<float>(v);
-    uint8_t* out = changed.ptr<uint8_t>(v);
+    uint8_t* out = local.ptr<uint8_t>(v - grown.y);
     for (int u = grown.x; u < grown.x + grown.width; ++u) {
       if (!(z[u] > 0.0f && std::isfinite(z[u]))) continue;
       const Eigen::Vector3f p =
@@ -106,23 +115,15 @@ cv::Mat Tracker::ChangedSeenFrom(const RgbdFrame& frame,
             y < reference_.depth.rows) {
           const float z0 = reference_.depth.at<float>(static_cast<int>(y),
                                                       static_cast<int>(x));
-          if (z0 > 0.0f) {
-            const float limit =
-                std::max(options_.change_min_m,
-                         options_.change_sigmas * sensor_.DepthSigma(z0));
-            moved = std::abs(p.z() - z0) > limit;
-          }
+          if (z0 > 0.0f) moved = DepthChanged(p.z(), z0);
         }
       }
-      out[u] = moved ? 255 : 0;
+      out[u - grown.x] = moved ? 255 : 0;
     }
   }
-  cv::Mat opened;
-  cv::morphologyEx(changed(grown), opened, cv::MORPH_OPEN,
-                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5)));
-  changed.setTo(0);
+  KeepChangedRegions(local, local);
   const cv::Rect inside = area & grown;
-  opened(inside - grown.tl()).copyTo(changed(inside));
+  local(inside - grown.tl()).copyTo(changed(inside));
   return changed;
 }
 
