@@ -442,12 +442,18 @@ SynthScene RenderScene(const SceneSpec& spec, const NoiseOptions& noise,
           shade *= TextureFactor(texture[hit], world);
         }
         rgb = (albedo[hit] * shade).cwiseMin(1.0f);
+        // A dark surface's dropped pixels keep their label, as a labeller
+        // marks a black mug whole; an edge dropout's, like a shadow's, do
+        // not (OSD labels points, and there is no point there).
+        bool labelled = true;
         if (noisy) {
+          const bool edge = edge_dropout.at<uint8_t>(v, u) != 0;
           const bool dropped =
-              edge_dropout.at<uint8_t>(v, u) != 0 ||
+              edge ||
               (dark[hit] && rng.Bernoulli(noise.dark_dropout_probability));
           if (dropped) {
             depth_row[u] = nan;
+            labelled = !edge;
           } else {
             const float normal = depth_noise.empty()
                                      ? static_cast<float>(rng.Normal())
@@ -455,7 +461,7 @@ SynthScene RenderScene(const SceneSpec& spec, const NoiseOptions& noise,
             depth_row[u] = NoisyDepth(depth_row[u], focal, noise, normal);
           }
         }
-        if (!std::isnan(depth_row[u])) {
+        if (labelled) {
           label_row[u] = label[hit];
           if (object_of_hit[hit] >= 0) ++visible[object_of_hit[hit]];
         }

@@ -176,8 +176,8 @@ struct ObjectTruth {
   int label = 0;        // OSD-style label 10 * (index + 2), object id index + 2
   Primitive primitive;  // spec.objects[index]; its parts are not repeated
   // Pixels carrying `label` in the rendered frame, over all the object's
-  // parts: seen by the camera and with depth (pixels whose depth the noise
-  // model dropped have label 0).
+  // parts: seen by the camera, with depth or dropped for being dark (an
+  // edge dropout's pixels have label 0).
   int visible_pixels = 0;
 };
 
@@ -197,7 +197,10 @@ struct SynthScene {
 //   frame.frame.color: albedo times (ambient + Lambertian term of a fixed
 //                      world-frame light), RGB; pixels seeing nothing show a
 //                      flat grey background;
-//   frame.labels:      0 where depth is NaN, 1 table, 10 * (k + 2) for
+//   frame.labels:      0 where the ray hits nothing or an edge dropout
+//                      removed the depth (a dark surface's dropped pixels
+//                      keep their label: its object is there), 1 table,
+//                      10 * (k + 2) for
 //                      spec.objects[k] and the object_parts of object k,
 //                      each background part's label;
 //   frame.name:        "synth-<seed>"; frame.frame.intrinsics =
