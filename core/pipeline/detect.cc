@@ -101,6 +101,7 @@ absl::Status Validate(const DetectOptions& options) {
                      "], got ", options.sym3d_level));
   }
   FOVEA_RETURN_IF_ERROR(Validate(options.hole_filling));
+  FOVEA_RETURN_IF_ERROR(Validate(options.dropout_fill));
   FOVEA_RETURN_IF_ERROR(Validate(options.normals));
   FOVEA_RETURN_IF_ERROR(Validate(options.support_plane));
   FOVEA_RETURN_IF_ERROR(Validate(options.table_scene));
@@ -132,8 +133,9 @@ absl::StatusOr<std::vector<AttentionPoint>> ExtractAttentionPoints(
 }
 
 std::vector<std::string> DetectStageNames() {
-  std::vector<std::string> names = {"reduce",  "fill_holes",    "cloud",
-                                    "normals", "support_plane", "fusion"};
+  std::vector<std::string> names = {"reduce", "fill_holes", "fill_dropout",
+                                    "cloud",  "normals",    "support_plane",
+                                    "fusion"};
   for (const SaliencyOperator& row : SaliencyOperators()) {
     names.push_back(absl::StrCat("saliency.", AbslView(row.name)));
   }
@@ -176,6 +178,11 @@ absl::StatusOr<DetectResult> RunDetect(const RgbdFrame& frame,
   return result;
 }
 
+DetectOptions MeasuredDepthOnly(DetectOptions options) {
+  options.fill_speckled_dropout = false;
+  return options;
+}
+
 absl::StatusOr<PreparedScene> PrepareScene(const RgbdFrame& frame,
                                            const DetectOptions& options,
                                            const InterruptCheck& interrupt) {
@@ -198,6 +205,17 @@ absl::StatusOr<PreparedScene> PrepareScene(const RgbdFrame& frame,
     filled_frame.intrinsics = reduced.frame.intrinsics;
     input = &filled_frame;
     clock.Lap("fill_holes");
+  }
+  if (options.fill_speckled_dropout) {
+    cv::Mat depth = input->depth.clone();
+    if (FillSpeckledDropout(options.dropout_fill, scene.sensor, input->color,
+                            depth) > 0) {
+      filled_frame.color = input->color;  // shares the pixels
+      filled_frame.intrinsics = input->intrinsics;
+      filled_frame.depth = std::move(depth);
+      input = &filled_frame;
+    }
+    clock.Lap("fill_dropout");
   }
   scene.cloud = BackProject(*input);
   ApplyWorkspace(options.scene.workspace, scene.sensor, scene.cloud);

@@ -17,6 +17,7 @@
 #include "core/base/interrupt.h"
 #include "core/base/name_table.h"
 #include "core/base/stage_clock.h"
+#include "core/frame/dropout_fill.h"
 #include "core/frame/frame_scale.h"
 #include "core/frame/hole_filling.h"
 #include "core/frame/organized_cloud.h"
@@ -172,6 +173,10 @@ struct DetectOptions {
   // Fill small depth holes by colour-guided diffusion before anything else
   // (thesis section 2.2).
   bool fill_holes = false;
+  // Fill speckled dropout (a dark surface whose depth the sensor returns
+  // at scattered pixels only) from the plane through each missing pixel's
+  // measured neighbours (core/frame/dropout_fill.h).
+  bool fill_speckled_dropout = true;
   // Pyramid level SYM3D runs on without a pyramid: its k x k kernel must
   // span an object (level 2 of a 640x480 frame is 160x120).
   int sym3d_level = 2;
@@ -189,6 +194,7 @@ struct DetectOptions {
   // sensor model (core/pipeline/sensor_adaptation.h) when the scene is
   // prepared.
   HoleFillingOptions hole_filling;
+  DropoutFillOptions dropout_fill;
   NormalOptions normals;
   SupportPlaneOptions support_plane;
   TableSceneOptions table_scene;
@@ -265,6 +271,12 @@ struct PreparedScene {
 // ("cloud", "normals", "support_plane", "saliency.<op>", "fusion",
 // "extract.<kind>"), for metrics that must exist before the first call.
 std::vector<std::string> DetectStageNames();
+
+// `options` without the speckled-dropout fill: the training examples of
+// the relation SVMs are taken from the surfaces the sensor measured. With
+// the filled planes among them (synthetic dark objects), the relations
+// learnt moved and OSD's leave-one-kind-out stacked F fell 0.922 -> 0.891.
+DetectOptions MeasuredDepthOnly(DetectOptions options);
 
 // The whole Detect path on a decoded frame: optional hole filling,
 // organized cloud and normals,

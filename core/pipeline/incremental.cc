@@ -260,7 +260,7 @@ absl::StatusOr<std::vector<SvmSample>> CollectIncSamples(
     const LabelledFrame& frame, int group, const DetectOptions& detect,
     const IncOptions& inc) {
   FOVEA_ASSIGN_OR_RETURN(PreparedScene scene,
-                         PrepareScene(frame.frame, detect));
+                         PrepareScene(frame.frame, MeasuredDepthOnly(detect)));
   const cv::Mat flat(frame.frame.depth.size(), CV_32FC1, cv::Scalar(0));
   FOVEA_ASSIGN_OR_RETURN(
       IncScene inc_scene,

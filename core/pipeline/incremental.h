@@ -78,7 +78,7 @@ absl::StatusOr<SegmentSummary> RunSegmentIncremental(
         std::chrono::steady_clock::now());
 
 // Relation SVM training examples of one labelled frame (IncTrainingSamples
-// on the scene `detect` prepares).
+// on the scene `detect` prepares from measured depth: MeasuredDepthOnly).
 absl::StatusOr<std::vector<SvmSample>> CollectIncSamples(
     const LabelledFrame& frame, int group, const DetectOptions& detect,
     const IncOptions& inc);

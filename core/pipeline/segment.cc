@@ -565,7 +565,7 @@ absl::StatusOr<std::vector<SvmSample>> CollectCosSamples(
     const LabelledFrame& frame, int group, const DetectOptions& detect,
     const CosOptions& cos) {
   FOVEA_ASSIGN_OR_RETURN(PreparedScene scene,
-                         PrepareScene(frame.frame, detect));
+                         PrepareScene(frame.frame, MeasuredDepthOnly(detect)));
   FOVEA_ASSIGN_OR_RETURN(
       CosScene cos_scene,
       BuildCosScene(scene.cloud, scene.plane, cos, scene.table.region));

@@ -256,7 +256,8 @@ absl::StatusOr<SegmentSummary> RunSegment(
         std::chrono::steady_clock::now());
 
 // COS training examples of one labelled frame (CosTrainingSamples on the
-// scene `detect` prepares), tagged with `group`.
+// scene `detect` prepares from measured depth: MeasuredDepthOnly), tagged
+// with `group`.
 absl::StatusOr<std::vector<SvmSample>> CollectCosSamples(
     const LabelledFrame& frame, int group, const DetectOptions& detect,
     const CosOptions& cos);

@@ -11,6 +11,7 @@
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/baseline/scene_segmenters.h"
+#include "core/frame/dropout_fill.h"
 #include "core/frame/frame_decode.h"
 #include "core/frame/organized_cloud.h"
 #include "core/frame/surface_edges.h"
@@ -38,6 +39,7 @@ namespace {
 constexpr double kDecodeRawMs = 2.0;
 constexpr double kDecodePngMs = 12.0;
 constexpr double kBackProjectMs = 1.0;
+constexpr double kDropoutFillMs = 2.0;
 constexpr double kNormalsMs = 8.0;
 constexpr double kSupportPlaneMs = 5.0;
 constexpr double kFramePrepMs = 15.0;
@@ -106,6 +108,16 @@ void RegisterFramePrepCases(const SceneList* scenes, const std::string& set,
            [](const BenchScene& scene) {
              OrganizedCloud cloud = BackProject(scene.frame);
              benchmark::DoNotOptimize(cloud.xyz.data);
+             return absl::OkStatus();
+           });
+  Register("BM_DropoutFill" + suffix, scenes, set, sweep, kDropoutFillMs,
+           [options = defaults.dropout_fill](const BenchScene& scene) {
+             // As PrepareScene runs it: on a copy of the decoded depth.
+             cv::Mat depth = scene.frame.depth.clone();
+             benchmark::DoNotOptimize(FillSpeckledDropout(
+                 options,
+                 SensorModelFor(SensorKind::kGeneric, scene.frame.intrinsics),
+                 scene.frame.color, depth));
              return absl::OkStatus();
            });
   Register("BM_Normals" + suffix, scenes, set, sweep, kNormalsMs,
