@@ -11,6 +11,7 @@
 #include "core/pipeline/incremental.h"
 #include "core/synth/synth_scene.h"
 #include "tests/core/testing/models.h"
+#include "tests/core/testing/sinks.h"
 
 namespace fovea {
 namespace {
@@ -51,14 +52,9 @@ OnObject Score(const std::vector<cv::Mat>& masks, const cv::Mat& object) {
 std::vector<cv::Mat> Masks(const RgbdFrame& frame,
                            const IncrementalOptions& options) {
   std::vector<cv::Mat> masks;
-  SegmentSinks sinks;
-  sinks.object = [&masks](SegmentedObject object) {
-    masks.push_back(object.mask);
-    return absl::OkStatus();
-  };
   const absl::Status status =
       RunSegmentIncremental(frame, options, &*testing::ShippedModels()->inc,
-                            sinks)
+                            testing::CollectMasks(masks))
           .status();
   EXPECT_TRUE(status.ok()) << status;
   return masks;

@@ -18,6 +18,7 @@
 #include "core/pipeline/segment.h"
 #include "core/synth/synth_scene.h"
 #include "tests/core/testing/models.h"
+#include "tests/core/testing/sinks.h"
 
 namespace fovea {
 namespace {
@@ -45,11 +46,7 @@ Results RunAll(const RgbdFrame& frame, const LoadedModels& models) {
   if (detect.ok()) run.detect = *std::move(detect);
   for (const bool incremental : {false, true}) {
     std::vector<cv::Mat>& masks = incremental ? run.inc_masks : run.cos_masks;
-    SegmentSinks sinks;
-    sinks.object = [&masks](SegmentedObject object) {
-      masks.push_back(object.mask);
-      return absl::OkStatus();
-    };
+    const SegmentSinks sinks = testing::CollectMasks(masks);
     const absl::Status status =
         incremental ? RunSegmentIncremental(frame, IncrementalOptions{},
                                             &*models.inc, sinks)

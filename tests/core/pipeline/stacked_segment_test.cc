@@ -14,6 +14,7 @@
 #include "core/pipeline/models.h"
 #include "core/synth/stacked_scene.h"
 #include "tests/core/testing/models.h"
+#include "tests/core/testing/sinks.h"
 
 namespace fovea {
 namespace {
@@ -39,14 +40,9 @@ TEST(StackedSegmentTest, ObjectsRestingOnOtherObjectsGetMasksOfTheirOwn) {
     for (uint64_t seed = 1; seed <= 3; ++seed) {
       const synth::StackedPile pile = synth::GenerateStackedPile(seed, sensor);
       std::vector<cv::Mat> masks;
-      SegmentSinks sinks;
-      sinks.object = [&masks](SegmentedObject object) {
-        masks.push_back(object.mask);
-        return absl::OkStatus();
-      };
       const absl::Status status =
           RunSegmentIncremental(pile.scene.frame.frame, IncrementalOptions{},
-                                &*Models()->inc, sinks)
+                                &*Models()->inc, testing::CollectMasks(masks))
               .status();
       ASSERT_TRUE(status.ok()) << pile.scene.frame.name << ": " << status;
       for (size_t k = 0; k < pile.rests_on.size(); ++k) {
