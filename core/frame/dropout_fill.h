@@ -8,13 +8,14 @@
 
 namespace fovea {
 
-// Speckled dropout: a dark or low-texture surface whose depth the sensor
-// returns at scattered pixels only (a structured-light or stereo camera
-// on a black mug). Left as it is, no normal and no patch survives there:
-// the gradients need both ends of their baseline and the patches grow over
-// 4-neighbours, which do not connect once fewer than about 60 % of the
-// pixels have depth. A shadow beside an edge or a hole on a surface that
-// is otherwise whole is not speckle and is left alone.
+// Speckled dropout: a dark surface whose depth the sensor returns at
+// scattered pixels only (a structured-light camera on a black mug). Left as
+// it is, no normal and no patch survives there: the gradients need both
+// ends of their baseline and the patches grow over 4-neighbours, which do
+// not connect once fewer than about 60 % of the pixels have depth. A
+// shadow beside an edge or a hole on a surface that is otherwise whole is
+// not speckle and is left alone. Cost: about 1 ms on a 640 x 480 frame,
+// 130-145 ms on one dark and speckled all over.
 struct DropoutFillOptions {
   // Half-size of the window around a missing pixel, pixels.
   int half_window = 3;
