@@ -146,24 +146,43 @@ float PlaneDepth(const DropoutFillOptions& options, const SensorModel& sensor,
 
 }  // namespace
 
-int FillSpeckledDropout(const DropoutFillOptions& options,
-                        const SensorModel& sensor, const cv::Mat& color,
-                        cv::Mat& depth, cv::Mat* filled) {
+FilledDepth FillSpeckledDropout(const DropoutFillOptions& options,
+                                const SensorModel& sensor, const cv::Mat& color,
+                                const cv::Mat& depth) {
   CV_Assert(depth.type() == CV_32FC1);
   CV_Assert(color.type() == CV_8UC3 && color.size() == depth.size());
-  const int r = options.half_window;
-  cv::Mat done = cv::Mat::zeros(depth.size(), CV_8UC1);
-  if (filled != nullptr) *filled = done;
-  if (depth.empty()) return 0;
-  // Pass 1, speckle: windows by integral images of the pixels with depth
-  // and of where depth starts or stops, to the right (across) and below
-  // (down). Most missing pixels (the background, shadows) are rejected by
-  // these counts alone.
+  FilledDepth out;
+  out.depth = depth;  // shared until something is filled
+  out.filled = cv::Mat::zeros(depth.size(), CV_8UC1);
+  if (depth.empty()) return out;
   cv::Mat luma;
   cv::cvtColor(color, luma, cv::COLOR_RGB2GRAY);
   const cv::Mat dark = luma <= options.max_luma;
   cv::Mat valid;
   cv::Mat sums = ValidSums(depth, valid);
+  // Most frames have no dark pixel without depth: nothing to do.
+  if (cv::countNonZero(dark & (valid == 0)) == 0) return out;
+  // The pixels a pass fills, written after it, so that each pass reads the
+  // depth as it was before it.
+  std::vector<std::pair<cv::Point, float>> fills;
+  const auto apply = [&](cv::Mat& reach) {
+    if (!fills.empty() && out.depth.data == depth.data) {
+      out.depth = depth.clone();
+    }
+    reach = cv::Mat::zeros(depth.size(), CV_8UC1);
+    for (const auto& [p, z] : fills) {
+      out.depth.at<float>(p) = z;
+      reach.at<uint8_t>(p) = 255;
+    }
+    out.filled |= reach;
+    out.filled_pixels += static_cast<int>(fills.size());
+    fills.clear();
+  };
+  // Pass 1, speckle: windows by integral images of the pixels with depth
+  // and of where depth starts or stops, to the right (across) and below
+  // (down). Most missing pixels (the background, shadows) are rejected by
+  // these counts alone.
+  const int r = options.half_window;
   cv::Mat across = cv::Mat::zeros(depth.size(), CV_8UC1);
   cv::Mat down = cv::Mat::zeros(depth.size(), CV_8UC1);
   for (int v = 0; v < depth.rows; ++v) {
@@ -179,9 +198,7 @@ int FillSpeckledDropout(const DropoutFillOptions& options,
   cv::Mat across_sums, down_sums;
   cv::integral(across, across_sums, CV_32S);
   cv::integral(down, down_sums, CV_32S);
-  cv::Mat source = depth.clone();  // measured depth only
   std::vector<cv::Vec3f> points;
-  int n_filled = 0;
   for (int v = 0; v < depth.rows; ++v) {
     const uint8_t* has = valid.ptr<uint8_t>(v);
     const uint8_t* is_dark = dark.ptr<uint8_t>(v);
@@ -199,43 +216,35 @@ int FillSpeckledDropout(const DropoutFillOptions& options,
       const int transitions = BoxSum(across_sums, u0, v0, u1 - 1, v1) +
                               BoxSum(down_sums, u0, v0, u1, v1 - 1);
       if (transitions < options.min_transition_fraction * pairs) continue;
-      const float z = PlaneDepth(options, sensor, source, sums, u, v, points);
-      if (std::isnan(z)) continue;
-      depth.at<float>(v, u) = z;
-      done.at<uint8_t>(v, u) = 255;
-      ++n_filled;
+      const float z = PlaneDepth(options, sensor, depth, sums, u, v, points);
+      if (!std::isnan(z)) fills.emplace_back(cv::Point(u, v), z);
     }
   }
-  // Later passes: the pixels left missing within the window of a filled
-  // one, from the measured and filled depth, the same plane test without
-  // the speckle test (they are what the first pass left between its
-  // pixels, at the speckle's edge and in its larger gaps).
-  cv::Mat reach = done.clone();
+  cv::Mat reach;
+  apply(reach);
+  // Later passes: the pixels left missing within the window of one the
+  // pass before filled, from the measured and filled depth, the same plane
+  // test without the speckle test (they are what the first pass left
+  // between its pixels, at the speckle's edge and in its larger gaps).
   const cv::Mat box = cv::Mat::ones(2 * r + 1, 2 * r + 1, CV_8UC1);
   for (int pass = 1; pass < options.passes && cv::countNonZero(reach) > 0;
        ++pass) {
     cv::dilate(reach, reach, box);
     reach &= dark;
-    source = depth.clone();
-    sums = ValidSums(source, valid);
-    cv::Mat now = cv::Mat::zeros(depth.size(), CV_8UC1);
+    sums = ValidSums(out.depth, valid);
     for (int v = 0; v < depth.rows; ++v) {
       const uint8_t* has = valid.ptr<uint8_t>(v);
       const uint8_t* near = reach.ptr<uint8_t>(v);
       for (int u = 0; u < depth.cols; ++u) {
         if (has[u] || !near[u]) continue;
-        const float z = PlaneDepth(options, sensor, source, sums, u, v, points);
-        if (std::isnan(z)) continue;
-        depth.at<float>(v, u) = z;
-        now.at<uint8_t>(v, u) = 255;
-        ++n_filled;
+        const float z =
+            PlaneDepth(options, sensor, out.depth, sums, u, v, points);
+        if (!std::isnan(z)) fills.emplace_back(cv::Point(u, v), z);
       }
     }
-    done |= now;
-    reach = now;
+    apply(reach);
   }
-  if (filled != nullptr) *filled = done;
-  return n_filled;
+  return out;
 }
 
 }  // namespace fovea

@@ -4,6 +4,7 @@
 #include <opencv2/core.hpp>
 
 #include "absl/status/status.h"
+#include "core/frame/hole_filling.h"
 #include "core/frame/sensor_model.h"
 
 namespace fovea {
@@ -54,12 +55,12 @@ absl::Status Validate(const DropoutFillOptions& options);
 
 // Fills each missing pixel (NaN) of `depth` (CV_32FC1 metres) in speckled
 // dropout with the depth at it of the plane through the window's measured
-// pixels, then (options.passes) the gaps beside those. Returns the pixels
-// filled; `filled` (CV_8UC1, 255 where filled) when not null.
-// `color`: CV_8UC3 RGB of the depth's size.
-int FillSpeckledDropout(const DropoutFillOptions& options,
-                        const SensorModel& sensor, const cv::Mat& color,
-                        cv::Mat& depth, cv::Mat* filled = nullptr);
+// pixels, then (options.passes) the gaps beside those. `color`: CV_8UC3 RGB
+// of the depth's size. The result's depth shares `depth`'s pixels when
+// nothing was filled, and is a copy otherwise.
+FilledDepth FillSpeckledDropout(const DropoutFillOptions& options,
+                                const SensorModel& sensor, const cv::Mat& color,
+                                const cv::Mat& depth);
 
 }  // namespace fovea
 

@@ -207,12 +207,12 @@ absl::StatusOr<PreparedScene> PrepareScene(const RgbdFrame& frame,
     clock.Lap("fill_holes");
   }
   if (options.fill_speckled_dropout) {
-    cv::Mat depth = input->depth.clone();
-    if (FillSpeckledDropout(options.dropout_fill, scene.sensor, input->color,
-                            depth) > 0) {
+    FilledDepth filled = FillSpeckledDropout(options.dropout_fill, scene.sensor,
+                                             input->color, input->depth);
+    if (filled.filled_pixels > 0) {
       filled_frame.color = input->color;  // shares the pixels
       filled_frame.intrinsics = input->intrinsics;
-      filled_frame.depth = std::move(depth);
+      filled_frame.depth = std::move(filled.depth);
       input = &filled_frame;
     }
     clock.Lap("fill_dropout");

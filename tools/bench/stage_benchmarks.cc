@@ -112,12 +112,11 @@ void RegisterFramePrepCases(const SceneList* scenes, const std::string& set,
            });
   Register("BM_DropoutFill" + suffix, scenes, set, sweep, kDropoutFillMs,
            [options = defaults.dropout_fill](const BenchScene& scene) {
-             // As PrepareScene runs it: on a copy of the decoded depth.
-             cv::Mat depth = scene.frame.depth.clone();
-             benchmark::DoNotOptimize(FillSpeckledDropout(
+             FilledDepth filled = FillSpeckledDropout(
                  options,
                  SensorModelFor(SensorKind::kGeneric, scene.frame.intrinsics),
-                 scene.frame.color, depth));
+                 scene.frame.color, scene.frame.depth);
+             benchmark::DoNotOptimize(filled.depth.data);
              return absl::OkStatus();
            });
   Register("BM_Normals" + suffix, scenes, set, sweep, kNormalsMs,

@@ -35,6 +35,14 @@ Surface SpeckledPlane(int grey, double dropout, uint32_t seed) {
   return s;
 }
 
+// Fills `s`'s depth in place; the pixels filled, and where when `filled`.
+int Fill(Surface& s, cv::Mat* filled = nullptr) {
+  FilledDepth out = FillSpeckledDropout({}, Kinect(), s.color, s.depth);
+  s.depth = out.depth;
+  if (filled != nullptr) *filled = out.filled;
+  return out.filled_pixels;
+}
+
 int Missing(const cv::Mat& depth) {
   int n = 0;
   depth.forEach<float>([&n](float z, const int*) { n += std::isnan(z); });
@@ -46,7 +54,7 @@ TEST(DropoutFillTest, ADarkSurfaceLosingMostOfItsDepthIsFilledOnItsPlane) {
   const int missing = Missing(s.depth);
   ASSERT_GT(missing, kWidth * kHeight / 2);
   cv::Mat filled;
-  const int n = FillSpeckledDropout({}, Kinect(), s.color, s.depth, &filled);
+  const int n = Fill(s, &filled);
   EXPECT_EQ(n, cv::countNonZero(filled));
   // All but a few pixels at the image's corners.
   EXPECT_LT(Missing(s.depth), missing / 50) << n << " filled";
@@ -64,7 +72,7 @@ TEST(DropoutFillTest, ABrightSurfaceIsLeftAsTheSensorGaveIt) {
   // surface's.
   Surface s = SpeckledPlane(200, 0.6, 1);
   const cv::Mat before = s.depth.clone();
-  EXPECT_EQ(FillSpeckledDropout({}, Kinect(), s.color, s.depth), 0);
+  EXPECT_EQ(Fill(s), 0);
   EXPECT_EQ(Missing(s.depth), Missing(before));
 }
 
@@ -74,7 +82,7 @@ TEST(DropoutFillTest, AHoleOrAShadowBandWithoutSpeckleStaysEmpty) {
   s.depth(cv::Rect(30, 0, 6, kHeight)).setTo(kNaN);
   s.depth(cv::Rect(60, 20, 8, 8)).setTo(kNaN);
   const int missing = Missing(s.depth);
-  EXPECT_EQ(FillSpeckledDropout({}, Kinect(), s.color, s.depth), 0);
+  EXPECT_EQ(Fill(s), 0);
   EXPECT_EQ(Missing(s.depth), missing);
 }
 
@@ -89,7 +97,7 @@ TEST(DropoutFillTest, TwoSpeckledSurfacesAtAStepKeepTheirOwnDepths) {
     }
   }
   cv::Mat filled;
-  ASSERT_GT(FillSpeckledDropout({}, Kinect(), s.color, s.depth, &filled), 0);
+  ASSERT_GT(Fill(s, &filled), 0);
   for (int v = 0; v < kHeight; ++v) {
     for (int u = 0; u < kWidth; ++u) {
       if (filled.at<uint8_t>(v, u) == 0) continue;
