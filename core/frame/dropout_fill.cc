@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.h"
 
 namespace fovea {
 namespace {
@@ -62,6 +63,11 @@ absl::Status Validate(const DropoutFillOptions& options) {
   if (options.max_luma < 0 || options.max_luma > 255) {
     return absl::InvalidArgumentError(absl::StrCat(
         "dropout_fill.max_luma must be in [0, 255], got ", options.max_luma));
+  }
+  if (options.fits_per_interrupt_check < 1) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "dropout_fill.fits_per_interrupt_check must be at least 1, got ",
+        options.fits_per_interrupt_check));
   }
   if (options.passes < 1 || options.passes > 8) {
     return absl::InvalidArgumentError(absl::StrCat(
@@ -146,9 +152,10 @@ float PlaneDepth(const DropoutFillOptions& options, const SensorModel& sensor,
 
 }  // namespace
 
-FilledDepth FillSpeckledDropout(const DropoutFillOptions& options,
-                                const SensorModel& sensor, const cv::Mat& color,
-                                const cv::Mat& depth) {
+absl::StatusOr<FilledDepth> FillSpeckledDropout(
+    const DropoutFillOptions& options, const SensorModel& sensor,
+    const cv::Mat& color, const cv::Mat& depth,
+    const InterruptCheck& interrupt) {
   CV_Assert(depth.type() == CV_32FC1);
   CV_Assert(color.type() == CV_8UC3 && color.size() == depth.size());
   FilledDepth out;
@@ -177,6 +184,13 @@ FilledDepth FillSpeckledDropout(const DropoutFillOptions& options,
     out.filled |= reach;
     out.filled_pixels += static_cast<int>(fills.size());
     fills.clear();
+  };
+  // Counts the plane fits, asking the interrupt after every
+  // fits_per_interrupt_check of them.
+  int fits = 0;
+  const int every = std::max(1, options.fits_per_interrupt_check);
+  const auto fitted = [&]() {
+    return ++fits % every == 0 ? CheckInterrupt(interrupt) : absl::OkStatus();
   };
   // Pass 1, speckle: windows by integral images of the pixels with depth
   // and of where depth starts or stops, to the right (across) and below
@@ -216,6 +230,7 @@ FilledDepth FillSpeckledDropout(const DropoutFillOptions& options,
       const int transitions = BoxSum(across_sums, u0, v0, u1 - 1, v1) +
                               BoxSum(down_sums, u0, v0, u1, v1 - 1);
       if (transitions < options.min_transition_fraction * pairs) continue;
+      FOVEA_RETURN_IF_ERROR(fitted());
       const float z = PlaneDepth(options, sensor, depth, sums, u, v, points);
       if (!std::isnan(z)) fills.emplace_back(cv::Point(u, v), z);
     }
@@ -237,6 +252,7 @@ FilledDepth FillSpeckledDropout(const DropoutFillOptions& options,
       const uint8_t* near = reach.ptr<uint8_t>(v);
       for (int u = 0; u < depth.cols; ++u) {
         if (has[u] || !near[u]) continue;
+        FOVEA_RETURN_IF_ERROR(fitted());
         const float z =
             PlaneDepth(options, sensor, out.depth, sums, u, v, points);
         if (!std::isnan(z)) fills.emplace_back(cv::Point(u, v), z);

@@ -4,6 +4,8 @@
 #include <opencv2/core.hpp>
 
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "core/base/interrupt.h"
 #include "core/frame/hole_filling.h"
 #include "core/frame/sensor_model.h"
 
@@ -16,7 +18,8 @@ namespace fovea {
 // not connect once fewer than about 60 % of the pixels have depth. A
 // shadow beside an edge or a hole on a surface that is otherwise whole is
 // not speckle and is left alone. Cost: about 1 ms on a 640 x 480 frame,
-// 130-145 ms on one dark and speckled all over.
+// 100-145 ms on one dark and speckled all over (the call's deadline is
+// asked within it).
 struct DropoutFillOptions {
   // Half-size of the window around a missing pixel, pixels.
   int half_window = 3;
@@ -44,6 +47,11 @@ struct DropoutFillOptions {
   // missing within the window of one filled by the pass before, by the
   // plane test alone, from measured and filled depth.
   int passes = 5;
+  // The call's interrupt is asked after every this many plane fits (8192
+  // take about 5 ms): a frame with little to fill is never interrupted
+  // inside (its stages' checks suffice), one dark and speckled all over
+  // (over 100 ms) stops within a few milliseconds.
+  int fits_per_interrupt_check = 8192;
   // Only dark pixels are filled (luma, 8-bit, at most this): the surfaces
   // whose depth a structured-light camera loses for their low reflectance.
   // A shadow's speckle on a bright table is not filled (an active-stereo
@@ -57,10 +65,12 @@ absl::Status Validate(const DropoutFillOptions& options);
 // dropout with the depth at it of the plane through the window's measured
 // pixels, then (options.passes) the gaps beside those. `color`: CV_8UC3 RGB
 // of the depth's size. The result's depth shares `depth`'s pixels when
-// nothing was filled, and is a copy otherwise.
-FilledDepth FillSpeckledDropout(const DropoutFillOptions& options,
-                                const SensorModel& sensor, const cv::Mat& color,
-                                const cv::Mat& depth);
+// nothing was filled, and is a copy otherwise. `interrupt` is asked as
+// options.fits_per_interrupt_check says, and its error returned.
+absl::StatusOr<FilledDepth> FillSpeckledDropout(
+    const DropoutFillOptions& options, const SensorModel& sensor,
+    const cv::Mat& color, const cv::Mat& depth,
+    const InterruptCheck& interrupt = {});
 
 }  // namespace fovea
 

@@ -207,8 +207,10 @@ absl::StatusOr<PreparedScene> PrepareScene(const RgbdFrame& frame,
     clock.Lap("fill_holes");
   }
   if (options.fill_speckled_dropout) {
-    FilledDepth filled = FillSpeckledDropout(options.dropout_fill, scene.sensor,
-                                             input->color, input->depth);
+    FOVEA_ASSIGN_OR_RETURN(
+        FilledDepth filled,
+        FillSpeckledDropout(options.dropout_fill, scene.sensor, input->color,
+                            input->depth, interrupt));
     if (filled.filled_pixels > 0) {
       filled_frame.color = input->color;  // shares the pixels
       filled_frame.intrinsics = input->intrinsics;

@@ -112,11 +112,12 @@ void RegisterFramePrepCases(const SceneList* scenes, const std::string& set,
            });
   Register("BM_DropoutFill" + suffix, scenes, set, sweep, kDropoutFillMs,
            [options = defaults.dropout_fill](const BenchScene& scene) {
-             FilledDepth filled = FillSpeckledDropout(
+             absl::StatusOr<FilledDepth> filled = FillSpeckledDropout(
                  options,
                  SensorModelFor(SensorKind::kGeneric, scene.frame.intrinsics),
                  scene.frame.color, scene.frame.depth);
-             benchmark::DoNotOptimize(filled.depth.data);
+             if (!filled.ok()) return filled.status();
+             benchmark::DoNotOptimize(filled->depth.data);
              return absl::OkStatus();
            });
   Register("BM_Normals" + suffix, scenes, set, sweep, kNormalsMs,
