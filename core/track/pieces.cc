@@ -247,10 +247,44 @@ void Tracker::JoinAndSplit(
     }
   }
 
+  // Whether track `t`, seen last frame, and track `w` were two pieces of
+  // object `k` of this frame: an object moving before a still camera that
+  // INC cut in two last frame, one piece appearing beside the other (seen
+  // before), and that moved on from where the old piece's mask was. They
+  // touched; `k` is about their summed size (within a quarter) and larger
+  // than `w` by at least half of `t`; the two together moved by more than
+  // moved_m to where `k` is, within the association's gate. Not two
+  // objects seen apart before, swept along and cut as one; not with a
+  // moving camera (a still object seen anew beside another and cut as one
+  // with it the next frame moves in the world as far as a pushed one).
+  const auto pieces_of = [&](const Track& t, const Track& w, size_t k) {
+    if (!a.still || w.last_seen_frame != frame_index_ - 1 ||
+        w.object.mask.empty() || std::min(t.frames_seen, w.frames_seen) != 1 ||
+        std::max(t.frames_seen, w.frames_seen) == 1) {
+      return false;
+    }
+    const int sum = t.object.area + w.object.area;
+    if (4 * std::abs(found[k].area - sum) > sum ||
+        2 * (found[k].area - w.object.area) < t.object.area) {
+      return false;
+    }
+    const Eigen::Vector3f both =
+        (static_cast<float>(t.object.area) * t.world_centroid +
+         static_cast<float>(w.object.area) * w.world_centroid) /
+        static_cast<float>(sum);
+    const float gate =
+        std::max(options_.match_m,
+                 options_.match_extent_fraction * found[k].extent.maxCoeff());
+    const float moved = (world[k] - shift - both).norm();
+    return moved > options_.moved_m && moved < gate &&
+           HeldTouch(t.object, w.object, found[k].mask.size(), 3);
+  };
   // A track seen last frame and matched to nothing, whose last mask is
-  // mostly under one object's mask now, was a piece of that object: its
-  // identity joins the object's (the pieces of an object INC cut in two
-  // become one object when it comes whole).
+  // mostly under one object's mask now, or that was with the object's
+  // track the two pieces of it (pieces_of: it moved away from its last
+  // mask), was a piece of that object: its identity joins the object's
+  // (the pieces of an object INC cut in two become one object when it
+  // comes whole), or the object's joins its.
   for (size_t i = 0; i < tracks.size(); ++i) {
     Track& t = tracks[i];
     if (matched_track[i] || t.id == 0 ||
@@ -259,18 +293,23 @@ void Tracker::JoinAndSplit(
     }
     for (size_t k = 0; k < found.size(); ++k) {
       if (absorbed[k] || track_of[k] < 0) continue;
-      if (2 * OverlapWithHeld(found[k].mask, t.object) > t.object.area) {
-        // The object goes on under the identity of its larger piece.
-        Track& whole = tracks[track_of[k]];
-        if (t.object.area > whole.object.area) {
-          std::swap(t.id, whole.id);
-          whole.frames_seen = std::max(whole.frames_seen, t.frames_seen);
-        }
-        composite[k] = true;
-        t.id = 0;  // forgotten below
-        ++out.joined;
-        break;
+      Track& whole = tracks[track_of[k]];
+      const bool cut_off = pieces_of(t, whole, k);
+      if (!cut_off &&
+          2 * OverlapWithHeld(found[k].mask, t.object) <= t.object.area) {
+        continue;
       }
+      // The object goes on under the identity of its larger piece; of the
+      // piece seen before when the other was cut off it last frame.
+      if (cut_off ? t.frames_seen > whole.frames_seen
+                  : t.object.area > whole.object.area) {
+        std::swap(t.id, whole.id);
+        whole.frames_seen = std::max(whole.frames_seen, t.frames_seen);
+      }
+      composite[k] = true;
+      t.id = 0;  // forgotten below
+      ++out.joined;
+      break;
     }
   }
 }

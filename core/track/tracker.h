@@ -256,13 +256,16 @@ class Tracker {
     // camera, all; with one moved by a known pose, those of the objects
     // without a track (ChangedSeenFrom); empty when not known.
     cv::Mat changed;
+    bool still = false;  // the camera did not move (CameraStill)
   };
   // The rules on pieces (pieces.cc): objects that moved together and touch
   // join; an object without a track that is one of a joined track's pieces
   // joins it again, unless the two moved apart (split, also while they
   // touch outside its last mask); a track last seen
   // in the previous frame that matched nothing and lies mostly under one
-  // object joins it. Counts in out.joined and out.split.
+  // object joins it, and so does one that was, with the object's track,
+  // the two pieces of a moving object cut in two in the previous frame.
+  // Counts in out.joined and out.split.
   void JoinAndSplit(const std::optional<Eigen::Isometry3f>& camera_to_world,
                     Association& a, std::vector<Track>& tracks,
                     TrackedFrame& out) const;
