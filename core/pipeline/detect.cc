@@ -197,13 +197,17 @@ absl::StatusOr<PreparedScene> PrepareScene(const RgbdFrame& frame,
   if (scene.scale.reduced()) clock.Lap("reduce");
   RgbdFrame filled_frame;
   const RgbdFrame* input = &reduced.frame;
+  // The input from now on: `depth` filled, the colour shared.
+  const auto use_filled = [&](cv::Mat depth) {
+    filled_frame.color = input->color;  // shares the pixels
+    filled_frame.intrinsics = input->intrinsics;
+    filled_frame.depth = std::move(depth);
+    input = &filled_frame;
+  };
   if (options.fill_holes) {
     FOVEA_ASSIGN_OR_RETURN(FilledDepth filled,
                            FillDepthHoles(reduced.frame, options.hole_filling));
-    filled_frame.color = reduced.frame.color;  // shares the pixels
-    filled_frame.depth = std::move(filled.depth);
-    filled_frame.intrinsics = reduced.frame.intrinsics;
-    input = &filled_frame;
+    use_filled(std::move(filled.depth));
     clock.Lap("fill_holes");
   }
   if (options.fill_speckled_dropout) {
@@ -211,12 +215,7 @@ absl::StatusOr<PreparedScene> PrepareScene(const RgbdFrame& frame,
         FilledDepth filled,
         FillSpeckledDropout(options.dropout_fill, scene.sensor, input->color,
                             input->depth, interrupt));
-    if (filled.filled_pixels > 0) {
-      filled_frame.color = input->color;  // shares the pixels
-      filled_frame.intrinsics = input->intrinsics;
-      filled_frame.depth = std::move(filled.depth);
-      input = &filled_frame;
-    }
+    if (filled.filled_pixels > 0) use_filled(std::move(filled.depth));
     clock.Lap("fill_dropout");
   }
   scene.cloud = BackProject(*input);

@@ -272,11 +272,9 @@ void Tracker::JoinAndSplit(
         (static_cast<float>(t.object.area) * t.world_centroid +
          static_cast<float>(w.object.area) * w.world_centroid) /
         static_cast<float>(sum);
-    const float gate =
-        std::max(options_.match_m,
-                 options_.match_extent_fraction * found[k].extent.maxCoeff());
     const float moved = (world[k] - shift - both).norm();
-    return moved > options_.moved_m && moved < gate &&
+    return moved > options_.moved_m &&
+           moved < AssociationGate(found[k].extent.maxCoeff()) &&
            HeldTouch(t.object, w.object, found[k].mask.size(), 3);
   };
   // A track seen last frame and matched to nothing, whose last mask is

@@ -344,10 +344,8 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
             options_.match_area_ratio * static_cast<float>(smaller)) {
           continue;  // a fragment is not the whole it lies beside
         }
-        gate[i][j] = std::max(
-            options_.match_m,
-            options_.match_extent_fraction *
-                std::max(LargestExtent(t.object), LargestExtent(found[j])));
+        gate[i][j] = AssociationGate(
+            std::max(LargestExtent(t.object), LargestExtent(found[j])));
         big = std::max(big, gate[i][j]);
       }
     }

@@ -2,6 +2,7 @@
 #define FOVEA_CORE_TRACK_TRACKER_H_
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <optional>
 #include <vector>
 
@@ -289,6 +290,11 @@ class Tracker {
   cv::Mat ChangedSeenFrom(const RgbdFrame& frame, const Eigen::Isometry3f& pose,
                           const cv::Rect& area) const;
   bool CameraStill(const std::optional<Eigen::Isometry3f>& pose) const;
+  // The association's gate for an object of largest extent `extent`:
+  // max(match_m, match_extent_fraction * extent), metres.
+  float AssociationGate(float extent) const {
+    return std::max(options_.match_m, options_.match_extent_fraction * extent);
+  }
   // Segments `frame` with INC (`segment` its options) on the last support
   // when TrackerOptions::reuse_support allows; the objects go to `found`,
   // the support to support_. Whether the support was kept.

@@ -38,6 +38,12 @@ using synth::SequenceKind;
 
 const LoadedModels* Models() { return testing::ShippedModels(); }
 
+// The pixels of the k-th object present in `frame` (its label, as
+// RenderScene's: 10 * (k + 2)).
+cv::Mat PixelsOfObject(const synth::SequenceFrame& frame, size_t k) {
+  return frame.frame.labels == 10 * (static_cast<int>(k) + 2);
+}
+
 // Per ground-truth identity: its pixels under `mask`.
 std::map<int, int> PixelsPerTruth(const synth::SequenceFrame& frame,
                                   const cv::Mat& mask) {
@@ -148,7 +154,7 @@ double MeanBestF(const synth::SequenceFrame& frame,
                  const TrackedFrame& tracked) {
   double sum = 0.0;
   for (size_t k = 0; k < frame.object_ids.size(); ++k) {
-    const cv::Mat truth = frame.frame.labels == 10 * (static_cast<int>(k) + 2);
+    const cv::Mat truth = PixelsOfObject(frame, k);
     const double size = cv::countNonZero(truth);
     double best = 0.0;
     for (const TrackedObject& o : tracked.objects) {
@@ -630,7 +636,7 @@ std::set<int> WholeIdentitiesOfTruth(int seed, int truth) {
         std::find(frame.object_ids.begin(), frame.object_ids.end(), truth) -
         frame.object_ids.begin();
     if (k == static_cast<long>(frame.object_ids.size())) continue;
-    const cv::Mat pixels = frame.frame.labels == 10 * (static_cast<int>(k) + 2);
+    const cv::Mat pixels = PixelsOfObject(frame, static_cast<size_t>(k));
     for (const TrackedObject& o : frames[f].objects) {
       if (o.state == TrackState::kGone) continue;
       const int both = cv::countNonZero(pixels & (o.object.mask != 0));
@@ -689,8 +695,7 @@ int PushedObject(const Sequence& sequence) {
   const auto centroids = [](const synth::SequenceFrame& f) {
     std::map<int, cv::Point2d> at;
     for (size_t k = 0; k < f.object_ids.size(); ++k) {
-      const cv::Moments m =
-          cv::moments(f.frame.labels == 10 * (static_cast<int>(k) + 2), true);
+      const cv::Moments m = cv::moments(PixelsOfObject(f, k), true);
       if (m.m00 > 0) at[f.object_ids[k]] = {m.m10 / m.m00, m.m01 / m.m00};
     }
     return at;
