@@ -89,6 +89,33 @@ struct IncOptions {
     int gap_px = 2;
   };
   BodyJoin body_join;
+  // Pieces within an object's footprint: when an object is final, the
+  // surfaces still in the scene that no border joins to it, whose points
+  // lie, seen along the support's normal, within its footprint and that
+  // reach its top, join it: a box's top face or a tin's lid cut from its
+  // sides, a bowl's rim from its body, by a ring of pixels no surface took
+  // (otherwise each comes out later as an object of its own). An object
+  // resting on another rises above its top, one beside another stands
+  // outside its footprint and one in an open box stays below the box's
+  // rim: they are kept apart. Reads the surfaces' points, which the scene
+  // keeps when fuse_surfaces is on. Scorecard (docs/scorecard.md): masks
+  // per object on the synthetic piles 1.148 -> 1.102, stacked scenes
+  // 1.437 -> 1.344 and rooms 1.119 -> 1.084, OSD within 0.001 overlap F;
+  // tracking (30 sequences of each kind) IDF1 up on every kind.
+  struct PiecesWithin {
+    bool enabled = true;
+    // Share of a surface's points within the footprint, [0, 1].
+    double min_inside = 0.9;
+    // The footprint (the convex hull of the object's points on the
+    // support's plane) grown by this, m.
+    double margin_m = 0.01;
+    // The surface's top (the 99th percentile of its points' heights above
+    // the support) within this of the object's, and its bottom (the 1st)
+    // at most `max_below_m` below the object's, m.
+    double top_m = 0.005;
+    double max_below_m = 0.015;
+  };
+  PiecesWithin pieces_within;
   // Objects of fewer points leave the scene without being emitted (noise
   // surfaces), pixels.
   int min_object_points = 150;
@@ -166,6 +193,22 @@ class IncSegmenter {
   double coverage() const;
 
  private:
+  // Points seen along the support's normal (IncOptions::PiecesWithin): on
+  // its plane, the box around them there, and their heights' 1st and 99th
+  // percentiles (none: no points kept), of an even sample of at most about
+  // `max_points` of the surfaces' points.
+  struct Footprint {
+    std::vector<cv::Point2f> flat;
+    cv::Rect2f box;
+    float bottom = 0.0f;
+    float top = 0.0f;
+  };
+  Footprint FootprintOf(const std::vector<int>& surfaces,
+                        size_t max_points) const;
+  // Adds to `group` (sorted, and kept so) the surfaces still in the scene
+  // that no border joins to it, that lie within its footprint and reach
+  // its top (IncOptions::PiecesWithin); they leave the scene.
+  void AddPiecesWithin(std::vector<int>& group);
   // p(same object) of two neighbouring surfaces: the SVM's, raised to
   // convex_join.joined_probability or body_join.joined_probability where
   // that criterion holds; cached.
@@ -184,6 +227,8 @@ class IncSegmenter {
   const IncOptions options_;
   std::vector<bool> removed_;
   int removed_points_ = 0;
+  // Per surface, its footprint (pieces_within), when first needed.
+  std::vector<std::optional<Footprint>> footprints_;
   std::unordered_map<uint64_t, double> probability_;  // pair -> p(same)
   // Per surface: fitted yet, and its model (none: support, too few points
   // or degenerate).

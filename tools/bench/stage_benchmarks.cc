@@ -535,18 +535,26 @@ void RegisterFrameCases(
                benchmark::DoNotOptimize(result);
                return result.status();
              });
-    Register("BM_Frame/inc/" + name, scenes, name, sweep, kSegmentMs,
-             [](const BenchScene& scene) {
-               const absl::StatusOr<LoadedModels>& models = BenchModels();
-               if (!models.ok()) return models.status();
-               FOVEA_ASSIGN_OR_RETURN(
-                   RgbdFrame frame,
-                   DecodeFrame(scene.raw_wire, BenchFrameLimits()));
-               absl::StatusOr<SegmentSummary> summary = RunSegmentIncremental(
-                   frame, IncrementalOptions{}, &*models->inc, SegmentSinks{});
-               benchmark::DoNotOptimize(summary);
-               return summary.status();
-             });
+    // Whole-scene INC, and beside it without the pieces within an object's
+    // footprint joining it (IncOptions::pieces_within): what that costs.
+    for (const bool pieces : {true, false}) {
+      IncrementalOptions options;
+      options.inc.pieces_within.enabled = pieces;
+      Register(absl::StrCat("BM_Frame/inc", pieces ? "" : "_without_pieces",
+                            "/", name),
+               scenes, name, sweep, kSegmentMs,
+               [options](const BenchScene& scene) {
+                 const absl::StatusOr<LoadedModels>& models = BenchModels();
+                 if (!models.ok()) return models.status();
+                 FOVEA_ASSIGN_OR_RETURN(
+                     RgbdFrame frame,
+                     DecodeFrame(scene.raw_wire, BenchFrameLimits()));
+                 absl::StatusOr<SegmentSummary> summary = RunSegmentIncremental(
+                     frame, options, &*models->inc, SegmentSinks{});
+                 benchmark::DoNotOptimize(summary);
+                 return summary.status();
+               });
+    }
   }
 }
 
