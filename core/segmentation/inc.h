@@ -207,8 +207,9 @@ class IncSegmenter {
                         size_t max_points) const;
   // Adds to `group` (sorted, and kept so) the surfaces still in the scene
   // that no border joins to it, that lie within its footprint and reach
-  // its top (IncOptions::PiecesWithin); they leave the scene.
-  void AddPiecesWithin(std::vector<int>& group);
+  // its top (IncOptions::PiecesWithin; inc_pieces.cc); they leave the
+  // scene. Their pixels.
+  int AddPiecesWithin(std::vector<int>& group);
   // p(same object) of two neighbouring surfaces: the SVM's, raised to
   // convex_join.joined_probability or body_join.joined_probability where
   // that criterion holds; cached.
