@@ -1,11 +1,13 @@
 // INC's pieces within an object's footprint (IncOptions::PiecesWithin): when
 // an object is final, the surfaces still in the scene that no border joins
 // to it, that lie within its footprint seen along the support's normal and
-// reach its top, join it.
+// reach its top, join it. An object on one upright cylinder or cone has its
+// body's widest cross-section in its footprint too.
 
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <vector>
 
 #include "core/segmentation/inc.h"
@@ -18,15 +20,100 @@ namespace {
 // surface's (once per scene).
 constexpr size_t kObjectFootprintPoints = 2048;
 constexpr size_t kSurfaceFootprintPoints = 512;
+// An object's body is taken when the object spans at least this share of
+// its diameter on the support's plane.
+constexpr float kSeenAcross = 0.75f;
+
+// The support's plane's axes, the footprints' coordinates: (x, y) on it,
+// and up along its unit normal.
+struct PlaneAxes {
+  explicit PlaneAxes(const Eigen::Vector3f& normal)
+      : up(normal.normalized()), x(up.unitOrthogonal()), y(up.cross(x)) {}
+  cv::Point2f Flat(const Eigen::Vector3f& p) const {
+    return {x.dot(p), y.dot(p)};
+  }
+  Eigen::Vector3f up, x, y;
+};
+
+// A disc on the support's plane (PlaneAxes::Flat), metres.
+struct Disc {
+  cv::Point2f center;
+  float radius = 0.0f;
+};
+
+// The widest cross-section, on the support's plane (PlaneAxes::Flat), of
+// the upright cylinder or cone that the points of `surfaces` lie on, between
+// the heights `bottom` and `top` (IncOptions::PiecesWithin::body_footprint);
+// `hull` is their convex hull on the plane. nullopt: no body holds them.
+std::optional<Disc> BodyDisc(const IncScene& scene, const BodyFitOptions& fit,
+                             const std::vector<int>& surfaces, float bottom,
+                             float top, const std::vector<cv::Point2f>& hull) {
+  size_t total = 0;
+  for (const int s : surfaces) total += scene.points[s].size();
+  const size_t stride = std::max<size_t>(
+      1, (total + kObjectFootprintPoints - 1) / kObjectFootprintPoints);
+  std::vector<Eigen::Vector3f> sample;
+  for (const int s : surfaces) {
+    const std::vector<Eigen::Vector3f>& points = scene.points[s];
+    for (size_t i = 0; i < points.size(); i += stride) {
+      sample.push_back(points[i]);
+    }
+  }
+  if (static_cast<int>(sample.size()) < fit.min_points) return std::nullopt;
+  const PlaneAxes axes(scene.up);
+  const std::optional<BodyFit> body = fit.max_taper > 0.0f
+                                          ? FitUprightCone(sample, axes.up)
+                                          : FitUprightCylinder(sample, axes.up);
+  if (!body.has_value() || std::abs(body->taper) > fit.max_taper) {
+    return std::nullopt;
+  }
+  // The radius at a height along up (the footprints' heights).
+  const float center_height = axes.up.dot(body->center);
+  const auto radius_at = [&](float height) {
+    return body->radius + body->taper * (height - center_height);
+  };
+  // Within the sensor's noise and half a wall of the body, by the median
+  // distance: a handle or a rim's lip is off it.
+  std::vector<float> off;
+  off.reserve(sample.size());
+  float z = 0.0f;
+  for (const Eigen::Vector3f& p : sample) {
+    const Eigen::Vector3f d = p - body->center;
+    const float height = axes.up.dot(d);
+    off.push_back(std::abs((d - axes.up * height).norm() -
+                           radius_at(height + center_height)));
+    z += p.z();
+  }
+  z /= static_cast<float>(sample.size());
+  const auto median = off.begin() + static_cast<ptrdiff_t>(off.size() / 2);
+  std::nth_element(off.begin(), median, off.end());
+  const float allowed =
+      std::hypot(fit.wall_m, fit.sigma0_m + fit.sigma_per_z2 * z * z);
+  const float widest = std::max(radius_at(bottom), radius_at(top));
+  if (*median > allowed || widest < fit.min_radius_m ||
+      widest > fit.max_radius_m) {
+    return std::nullopt;
+  }
+  // A flat face is on a wide enough cylinder, a box's corner near a
+  // cone: the body must be seen across most of its width, as the front of
+  // a can or the inside of a pot is (a body fitted to a narrow strip is
+  // a guess).
+  float width = 0.0f;
+  for (size_t i = 0; i < hull.size(); ++i) {
+    for (size_t k = i + 1; k < hull.size(); ++k) {
+      const cv::Point2f d = hull[i] - hull[k];
+      width = std::max(width, d.dot(d));
+    }
+  }
+  if (std::sqrt(width) < kSeenAcross * 2.0f * widest) return std::nullopt;
+  return Disc{axes.Flat(body->center), widest};
+}
 
 }  // namespace
 
 IncSegmenter::Footprint IncSegmenter::FootprintOf(
     const std::vector<int>& surfaces, size_t max_points) const {
-  // Plane coordinates (x, y) and height along the support's normal.
-  const Eigen::Vector3f up = scene_.up.normalized();
-  const Eigen::Vector3f x_axis = up.unitOrthogonal();
-  const Eigen::Vector3f y_axis = up.cross(x_axis);
+  const PlaneAxes axes(scene_.up);
   size_t total = 0;
   for (const int s : surfaces) total += scene_.points[s].size();
   // Every stride-th point of each surface: at most about max_points.
@@ -37,8 +124,8 @@ IncSegmenter::Footprint IncSegmenter::FootprintOf(
   for (const int s : surfaces) {
     const std::vector<Eigen::Vector3f>& points = scene_.points[s];
     for (size_t i = 0; i < points.size(); i += stride) {
-      f.flat.emplace_back(x_axis.dot(points[i]), y_axis.dot(points[i]));
-      heights.push_back(up.dot(points[i]));
+      f.flat.push_back(axes.Flat(points[i]));
+      heights.push_back(axes.up.dot(points[i]));
     }
   }
   if (f.flat.empty()) return f;
@@ -71,12 +158,28 @@ int IncSegmenter::AddPiecesWithin(std::vector<int>& group) {
   std::vector<cv::Point2f> hull;
   cv::convexHull(object.flat, hull);
   const float margin = static_cast<float>(options.margin_m);
-  const cv::Rect2f grown(object.box.x - margin, object.box.y - margin,
-                         object.box.width + 2 * margin,
-                         object.box.height + 2 * margin);
-  const auto in_box = [&grown](const cv::Point2f& p) {
-    return p.x >= grown.x && p.x <= grown.x + grown.width && p.y >= grown.y &&
-           p.y <= grown.y + grown.height;
+  const std::optional<Disc> disc =
+      options.body_footprint ? BodyDisc(scene_, options_.body_join.fit, group,
+                                        object.bottom, object.top, hull)
+                             : std::nullopt;
+  cv::Rect2f grown(object.box.x - margin, object.box.y - margin,
+                   object.box.width + 2 * margin,
+                   object.box.height + 2 * margin);
+  // The disc grown by the margin, if any (reach 0: none).
+  const cv::Point2f center = disc ? disc->center : cv::Point2f(0.0f, 0.0f);
+  const float reach = disc ? disc->radius + margin : 0.0f;
+  if (reach > 0.0f) {
+    grown |=
+        cv::Rect2f(center.x - reach, center.y - reach, 2 * reach, 2 * reach);
+  }
+  const auto inside = [&](const cv::Point2f& p) {
+    if (p.x < grown.x || p.x > grown.x + grown.width || p.y < grown.y ||
+        p.y > grown.y + grown.height) {
+      return false;
+    }
+    const cv::Point2f d = p - center;
+    if (d.dot(d) <= reach * reach) return true;
+    return cv::pointPolygonTest(hull, p, true) >= -margin;
   };
   const auto borders_object = [&](size_t s) {
     return std::any_of(
@@ -102,16 +205,14 @@ int IncSegmenter::AddPiecesWithin(std::vector<int>& group) {
     }
     const int needed = static_cast<int>(
         std::ceil(options.min_inside * static_cast<double>(piece.flat.size())));
-    int inside = 0;
+    int within = 0;
     int left = static_cast<int>(piece.flat.size());
     for (const cv::Point2f& p : piece.flat) {
-      if (in_box(p) && cv::pointPolygonTest(hull, p, true) >= -margin) {
-        ++inside;
-      }
+      if (inside(p)) ++within;
       --left;
-      if (inside >= needed || inside + left < needed) break;
+      if (within >= needed || within + left < needed) break;
     }
-    if (inside >= needed) {
+    if (within >= needed) {
       joined.push_back(static_cast<int>(s));
       removed_[s] = true;
       pixels += scene_.pixels[s];

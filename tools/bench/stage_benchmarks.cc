@@ -536,14 +536,20 @@ void RegisterFrameCases(
                return result.status();
              });
     // Whole-scene INC, and beside it without the pieces within an object's
-    // footprint joining it (IncOptions::pieces_within): what that costs.
-    for (const bool pieces : {true, false}) {
+    // footprint joining it (IncOptions::pieces_within), or without a
+    // body's cross-section in the footprint: what each costs.
+    const struct {
+      const char* suffix;
+      bool pieces, body;
+    } variants[] = {{"", true, true},
+                    {"_without_pieces", false, false},
+                    {"_without_body_footprint", true, false}};
+    for (const auto& variant : variants) {
       IncrementalOptions options;
-      options.inc.pieces_within.enabled = pieces;
-      Register(absl::StrCat("BM_Frame/inc", pieces ? "" : "_without_pieces",
-                            "/", name),
-               scenes, name, sweep, kSegmentMs,
-               [options](const BenchScene& scene) {
+      options.inc.pieces_within.enabled = variant.pieces;
+      options.inc.pieces_within.body_footprint = variant.body;
+      Register(absl::StrCat("BM_Frame/inc", variant.suffix, "/", name), scenes,
+               name, sweep, kSegmentMs, [options](const BenchScene& scene) {
                  const absl::StatusOr<LoadedModels>& models = BenchModels();
                  if (!models.ok()) return models.status();
                  FOVEA_ASSIGN_OR_RETURN(

@@ -433,6 +433,79 @@ TEST(IncTest, PiecesWithinAnObjectsFootprintJoinItAndNoObjectIsLost) {
   EXPECT_GE(joined.second, apart.second);
 }
 
+// An 18 cm pot (a cup-shaped shell, its floor 5 mm above the table, which
+// the support takes), a 6 cm ball on its floor, its top below the pot's
+// rim, and a box as tall as the pot beside it. Seen from above at 45
+// degrees the pot's front wall and its inside beyond the floor share no
+// border: the pot's body (an upright cylinder through its front wall) has
+// the inside within its footprint, which the front wall's own hull (a
+// crescent) does not. The ball, below the rim, and the box, outside the
+// pot, stay apart.
+TEST(IncTest, APotsInsideJoinsItsFrontWallAcrossItsFloor) {
+  synth::SceneSpec spec;
+  spec.camera_pose = synth::LookAt({0.05f, -0.65f, 0.7f}, {0.0f, 0.0f, 0.04f});
+  synth::Primitive pot;
+  pot.shape = synth::Shape::kCup;
+  pot.radius = 0.09f;
+  pot.half_extents = {0.09f, 0.09f, 0.06f};
+  pot.thickness = 0.005f;
+  pot.pose.translation() = Eigen::Vector3f(0.0f, 0.0f, 0.06f);
+  pot.rgb = {0.9f, 0.8f, 0.3f};
+  synth::Primitive ball;
+  ball.shape = synth::Shape::kSphere;
+  ball.radius = 0.03f;
+  ball.pose.translation() = Eigen::Vector3f(-0.02f, 0.045f, 0.036f);
+  ball.rgb = {0.2f, 0.3f, 0.8f};
+  synth::Primitive box;
+  box.shape = synth::Shape::kBox;
+  box.half_extents = {0.04f, 0.03f, 0.06f};
+  box.pose.translation() = Eigen::Vector3f(0.17f, 0.02f, 0.06f);
+  box.rgb = {0.8f, 0.3f, 0.3f};
+  spec.objects = {pot, ball, box};
+  const Scene scene =
+      Prepare(synth::RenderScene(spec, synth::NoiseOptions{}, 3));
+  const cv::Mat& labels = scene.synth.frame.labels;
+  const cv::Mat flat(labels.size(), CV_32FC1, cv::Scalar(0));
+  // Per object label (20, 30, 40): masks mostly on it, and its best IoU.
+  const auto masks = [&](const IncOptions& options) {
+    std::map<int, std::pair<int, double>> on;
+    absl::StatusOr<IncScene> inc =
+        BuildIncScene(scene.prepared.cloud, scene.prepared.plane, flat, options,
+                      scene.prepared.table.region);
+    EXPECT_TRUE(inc.ok()) << inc.status();
+    if (!inc.ok()) return on;
+    IncSegmenter segmenter(*inc, TrainedSvm(), options);
+    while (true) {
+      absl::StatusOr<std::optional<IncObject>> next = segmenter.Next();
+      EXPECT_TRUE(next.ok()) << next.status();
+      if (!next.ok() || !next->has_value()) break;
+      const cv::Mat& mask = (*next)->mask;
+      for (const int label : {20, 30, 40}) {
+        const cv::Mat truth = labels == label;
+        std::pair<int, double>& o = on[label];
+        if (2 * cv::countNonZero(mask & truth) > cv::countNonZero(mask)) {
+          ++o.first;
+        }
+        o.second = std::max(o.second, Iou(mask, truth));
+      }
+    }
+    return on;
+  };
+  IncOptions with;
+  IncOptions without = with;
+  without.pieces_within.body_footprint = false;
+  std::map<int, std::pair<int, double>> joined = masks(with);
+  std::map<int, std::pair<int, double>> apart = masks(without);
+  // With the body's footprint: the pot in one mask, the ball and the box
+  // each in their own; without it the pot is two.
+  for (const int label : {20, 30, 40}) {
+    EXPECT_EQ(joined[label].first, 1) << "label " << label;
+    EXPECT_GT(joined[label].second, 0.9) << "label " << label;
+  }
+  EXPECT_GT(apart[20].first, 1);
+  EXPECT_LT(apart[20].second, 0.8);
+}
+
 TEST(IncOptionsTest, ValidateNamesTheField) {
   IncOptions options;
   options.k = 0.0;
