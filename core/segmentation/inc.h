@@ -114,14 +114,16 @@ struct IncOptions {
     // at most `max_below_m` below the object's, m.
     double top_m = 0.005;
     double max_below_m = 0.015;
-    // An object whose points lie on one upright cylinder or cone (within
-    // body_join.fit's radii, taper and noise, by their median distance to
-    // it), seen across at least 3/4 of its diameter, has the body's
-    // cross-section in its footprint too, at its widest between its bottom
-    // and top: a pot's front wall seen from outside stands for the whole
-    // pot, its inside wall beyond the floor (which the support takes)
-    // within it, though the front wall's own hull is a thin crescent.
-    // Scorecard: OSD cylindric overlap F 0.912 -> 0.929, nothing lower
+    // An object whose points lie on one upright cylinder or cone, or else
+    // on one sphere (within body_join.fit's radii, taper and noise, by
+    // their median distance to it), seen across at least 3/4 of its
+    // diameter, has the body's cross-section in its footprint too, at its
+    // widest between its bottom and top: a pot's front wall seen from
+    // outside stands for the whole pot, its inside wall beyond the floor
+    // (which the support takes) within it, though the front wall's own
+    // hull is a thin crescent. A surface bordering such a body and nothing
+    // else still in the scene (a sliver of a bowl's rim) joins it too.
+    // Scorecard: OSD cylindric overlap F 0.912 -> 0.933, nothing lower
     // (docs/scorecard.md).
     bool body_footprint = true;
   };

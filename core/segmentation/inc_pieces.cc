@@ -1,8 +1,9 @@
 // INC's pieces within an object's footprint (IncOptions::PiecesWithin): when
 // an object is final, the surfaces still in the scene that no border joins
 // to it, that lie within its footprint seen along the support's normal and
-// reach its top, join it. An object on one upright cylinder or cone has its
-// body's widest cross-section in its footprint too.
+// reach its top, join it. An object on one upright cylinder or cone, or on
+// one sphere, has its body's widest cross-section in its footprint too, and
+// a surface bordering such a body and nothing else joins it.
 
 #include <algorithm>
 #include <cmath>
@@ -41,10 +42,23 @@ struct Disc {
   float radius = 0.0f;
 };
 
+// The median of `off` over `points`.
+template <typename Off>
+float MedianOff(const std::vector<Eigen::Vector3f>& points, const Off& off) {
+  std::vector<float> distances;
+  distances.reserve(points.size());
+  for (const Eigen::Vector3f& p : points) distances.push_back(off(p));
+  const auto median =
+      distances.begin() + static_cast<ptrdiff_t>(distances.size() / 2);
+  std::nth_element(distances.begin(), median, distances.end());
+  return *median;
+}
+
 // The widest cross-section, on the support's plane (PlaneAxes::Flat), of
-// the upright cylinder or cone that the points of `surfaces` lie on, between
-// the heights `bottom` and `top` (IncOptions::PiecesWithin::body_footprint);
-// `hull` is their convex hull on the plane. nullopt: no body holds them.
+// the upright cylinder or cone, or else the sphere (a bowl, a ball), that
+// the points of `surfaces` lie on, between the heights `bottom` and `top`
+// (IncOptions::PiecesWithin::body_footprint); `hull` is their convex hull
+// on the plane. nullopt: no body holds them.
 std::optional<Disc> BodyDisc(const IncScene& scene, const BodyFitOptions& fit,
                              const std::vector<int>& surfaces, float bottom,
                              float top, const std::vector<cv::Point2f>& hull) {
@@ -53,51 +67,24 @@ std::optional<Disc> BodyDisc(const IncScene& scene, const BodyFitOptions& fit,
   const size_t stride = std::max<size_t>(
       1, (total + kObjectFootprintPoints - 1) / kObjectFootprintPoints);
   std::vector<Eigen::Vector3f> sample;
+  float z = 0.0f;
   for (const int s : surfaces) {
     const std::vector<Eigen::Vector3f>& points = scene.points[s];
     for (size_t i = 0; i < points.size(); i += stride) {
       sample.push_back(points[i]);
+      z += points[i].z();
     }
   }
   if (static_cast<int>(sample.size()) < fit.min_points) return std::nullopt;
-  const PlaneAxes axes(scene.up);
-  const std::optional<BodyFit> body = fit.max_taper > 0.0f
-                                          ? FitUprightCone(sample, axes.up)
-                                          : FitUprightCylinder(sample, axes.up);
-  if (!body.has_value() || std::abs(body->taper) > fit.max_taper) {
-    return std::nullopt;
-  }
-  // The radius at a height along up (the footprints' heights).
-  const float center_height = axes.up.dot(body->center);
-  const auto radius_at = [&](float height) {
-    return body->radius + body->taper * (height - center_height);
-  };
-  // Within the sensor's noise and half a wall of the body, by the median
-  // distance: a handle or a rim's lip is off it.
-  std::vector<float> off;
-  off.reserve(sample.size());
-  float z = 0.0f;
-  for (const Eigen::Vector3f& p : sample) {
-    const Eigen::Vector3f d = p - body->center;
-    const float height = axes.up.dot(d);
-    off.push_back(std::abs((d - axes.up * height).norm() -
-                           radius_at(height + center_height)));
-    z += p.z();
-  }
   z /= static_cast<float>(sample.size());
-  const auto median = off.begin() + static_cast<ptrdiff_t>(off.size() / 2);
-  std::nth_element(off.begin(), median, off.end());
+  // Within the sensor's noise and half a wall of the body, by the median
+  // distance (a handle or a rim's lip is off it), of the radii allowed,
+  // and seen across most of its width, as the front of a can or the inside
+  // of a pot or a bowl is: a flat face is on a wide enough cylinder, a
+  // box's corner near a cone, and a body fitted to a narrow strip is a
+  // guess.
   const float allowed =
       std::hypot(fit.wall_m, fit.sigma0_m + fit.sigma_per_z2 * z * z);
-  const float widest = std::max(radius_at(bottom), radius_at(top));
-  if (*median > allowed || widest < fit.min_radius_m ||
-      widest > fit.max_radius_m) {
-    return std::nullopt;
-  }
-  // A flat face is on a wide enough cylinder, a box's corner near a
-  // cone: the body must be seen across most of its width, as the front of
-  // a can or the inside of a pot is (a body fitted to a narrow strip is
-  // a guess).
   float width = 0.0f;
   for (size_t i = 0; i < hull.size(); ++i) {
     for (size_t k = i + 1; k < hull.size(); ++k) {
@@ -105,8 +92,48 @@ std::optional<Disc> BodyDisc(const IncScene& scene, const BodyFitOptions& fit,
       width = std::max(width, d.dot(d));
     }
   }
-  if (std::sqrt(width) < kSeenAcross * 2.0f * widest) return std::nullopt;
-  return Disc{axes.Flat(body->center), widest};
+  width = std::sqrt(width);
+  const auto holds = [&](float median, float widest) {
+    return median <= allowed && widest >= fit.min_radius_m &&
+           widest <= fit.max_radius_m && width >= kSeenAcross * 2.0f * widest;
+  };
+  const PlaneAxes axes(scene.up);
+  const std::optional<BodyFit> upright =
+      fit.max_taper > 0.0f ? FitUprightCone(sample, axes.up)
+                           : FitUprightCylinder(sample, axes.up);
+  if (upright.has_value() && std::abs(upright->taper) <= fit.max_taper) {
+    const BodyFit& body = *upright;
+    // The radius at a height along up above the body's centre.
+    const auto radius_at = [&body](float height) {
+      return body.radius + body.taper * height;
+    };
+    const float median = MedianOff(sample, [&](const Eigen::Vector3f& p) {
+      const Eigen::Vector3f d = p - body.center;
+      const float height = axes.up.dot(d);
+      return std::abs((d - axes.up * height).norm() - radius_at(height));
+    });
+    const float center = axes.up.dot(body.center);
+    const float widest =
+        std::max(radius_at(bottom - center), radius_at(top - center));
+    if (holds(median, widest)) return Disc{axes.Flat(body.center), widest};
+  }
+  const std::optional<BodyFit> sphere = FitSphere(sample);
+  if (sphere.has_value()) {
+    const BodyFit& body = *sphere;
+    const float median = MedianOff(sample, [&](const Eigen::Vector3f& p) {
+      return std::abs((p - body.center).norm() - body.radius);
+    });
+    // Its widest cross-section between bottom and top: the equator's,
+    // or the one at the end nearer it.
+    const float center = axes.up.dot(body.center);
+    const float off_equator = center < bottom
+                                  ? bottom - center
+                                  : (center > top ? center - top : 0.0f);
+    const float widest = std::sqrt(
+        std::max(0.0f, body.radius * body.radius - off_equator * off_equator));
+    if (holds(median, widest)) return Disc{axes.Flat(body.center), widest};
+  }
+  return std::nullopt;
 }
 
 }  // namespace
@@ -187,12 +214,18 @@ int IncSegmenter::AddPiecesWithin(std::vector<int>& group) {
           return std::binary_search(group.begin(), group.end(), t);
         });
   };
+  const auto borders_others = [&](size_t s) {
+    return std::any_of(scene_.neighbours[s].begin(), scene_.neighbours[s].end(),
+                       [&](int t) { return !removed_[t]; });
+  };
   std::vector<int> joined;
   int pixels = 0;
   for (size_t s = 0; s < removed_.size(); ++s) {
     if (removed_[s] || scene_.points[s].empty()) continue;
-    // Where a border joins them the grouping has decided already.
-    if (borders_object(s)) continue;
+    // Where a border joins them the grouping has decided already; but a
+    // surface that borders a body and nothing else still in the scene (a
+    // sliver of a bowl's rim) would be an object of its own.
+    if (borders_object(s) && (reach <= 0.0f || borders_others(s))) continue;
     if (!footprints_[s]) {
       footprints_[s] =
           FootprintOf({static_cast<int>(s)}, kSurfaceFootprintPoints);
