@@ -185,27 +185,41 @@ int IncSegmenter::AddPiecesWithin(std::vector<int>& group) {
   std::vector<cv::Point2f> hull;
   cv::convexHull(object.flat, hull);
   const float margin = static_cast<float>(options.margin_m);
-  const std::optional<Disc> disc =
-      options.body_footprint ? BodyDisc(scene_, options_.body_join.fit, group,
-                                        object.bottom, object.top, hull)
-                             : std::nullopt;
-  cv::Rect2f grown(object.box.x - margin, object.box.y - margin,
-                   object.box.width + 2 * margin,
-                   object.box.height + 2 * margin);
-  // The disc grown by the margin, if any (reach 0: none).
-  const cv::Point2f center = disc ? disc->center : cv::Point2f(0.0f, 0.0f);
-  const float reach = disc ? disc->radius + margin : 0.0f;
-  if (reach > 0.0f) {
-    grown |=
-        cv::Rect2f(center.x - reach, center.y - reach, 2 * reach, 2 * reach);
-  }
-  const auto inside = [&](const cv::Point2f& p) {
-    if (p.x < grown.x || p.x > grown.x + grown.width || p.y < grown.y ||
-        p.y > grown.y + grown.height) {
+  // The footprint's box and the body's disc grown by the margin (reach 0:
+  // no body), fitted only once a surface needs them: most objects have no
+  // piece of the right height.
+  struct Extent {
+    cv::Rect2f grown;
+    cv::Point2f center;
+    float reach = 0.0f;
+  };
+  std::optional<Extent> extent;
+  const auto extent_of_object = [&]() -> const Extent& {
+    if (extent) return *extent;
+    extent.emplace();
+    extent->grown = cv::Rect2f(object.box.x - margin, object.box.y - margin,
+                               object.box.width + 2 * margin,
+                               object.box.height + 2 * margin);
+    const std::optional<Disc> disc =
+        options.body_footprint ? BodyDisc(scene_, options_.body_join.fit, group,
+                                          object.bottom, object.top, hull)
+                               : std::nullopt;
+    if (disc) {
+      extent->center = disc->center;
+      extent->reach = disc->radius + margin;
+      const float r = extent->reach;
+      extent->grown |=
+          cv::Rect2f(disc->center.x - r, disc->center.y - r, 2 * r, 2 * r);
+    }
+    return *extent;
+  };
+  const auto inside = [&](const Extent& e, const cv::Point2f& p) {
+    if (p.x < e.grown.x || p.x > e.grown.x + e.grown.width || p.y < e.grown.y ||
+        p.y > e.grown.y + e.grown.height) {
       return false;
     }
-    const cv::Point2f d = p - center;
-    if (d.dot(d) <= reach * reach) return true;
+    const cv::Point2f d = p - e.center;
+    if (d.dot(d) <= e.reach * e.reach) return true;
     return cv::pointPolygonTest(hull, p, true) >= -margin;
   };
   const auto borders_object = [&](size_t s) {
@@ -225,15 +239,20 @@ int IncSegmenter::AddPiecesWithin(std::vector<int>& group) {
     // Where a border joins them the grouping has decided already; but a
     // surface that borders a body and nothing else still in the scene (a
     // sliver of a bowl's rim) would be an object of its own.
-    if (borders_object(s) && (reach <= 0.0f || borders_others(s))) continue;
+    const bool bordering = borders_object(s);
+    if (bordering && borders_others(s)) continue;
     if (!footprints_[s]) {
       footprints_[s] =
           FootprintOf({static_cast<int>(s)}, kSurfaceFootprintPoints);
     }
     const Footprint& piece = *footprints_[s];
     if (std::abs(piece.top - object.top) > options.top_m ||
-        piece.bottom < object.bottom - options.max_below_m ||
-        (grown & piece.box).area() <= 0.0f) {
+        piece.bottom < object.bottom - options.max_below_m) {
+      continue;
+    }
+    const Extent& e = extent_of_object();
+    if ((bordering && e.reach <= 0.0f) ||
+        (e.grown & piece.box).area() <= 0.0f) {
       continue;
     }
     const int needed = static_cast<int>(
@@ -241,7 +260,7 @@ int IncSegmenter::AddPiecesWithin(std::vector<int>& group) {
     int within = 0;
     int left = static_cast<int>(piece.flat.size());
     for (const cv::Point2f& p : piece.flat) {
-      if (inside(p)) ++within;
+      if (inside(e, p)) ++within;
       --left;
       if (within >= needed || within + left < needed) break;
     }
