@@ -22,37 +22,36 @@
 
 namespace fovea::testing {
 
-// A relation SVM trained on random synthetic scenes and piles (not the
-// test scenes).
+// The relation samples of random synthetic scenes and piles (not the test
+// scenes), labelled by their objects.
+inline std::vector<SvmSample> SyntheticRelationSamples() {
+  std::vector<SvmSample> samples;
+  for (uint64_t seed = 21; seed < 33; ++seed) {
+    const synth::SynthScene scene =
+        seed % 2 == 0 ? synth::GenerateScene(seed) : synth::GeneratePile(seed);
+    absl::StatusOr<std::vector<SvmSample>> s = CollectIncSamples(
+        scene.frame, static_cast<int>(seed), DetectOptions{}, IncOptions{});
+    if (s.ok()) samples.insert(samples.end(), s->begin(), s->end());
+  }
+  return samples;
+}
+
+// A relation SVM trained on SyntheticRelationSamples.
 inline const RbfSvm& TrainedSvm() {
   static const RbfSvm* svm = [] {
-    std::vector<SvmSample> samples;
-    for (uint64_t seed = 21; seed < 33; ++seed) {
-      const synth::SynthScene scene = seed % 2 == 0 ? synth::GenerateScene(seed)
-                                                    : synth::GeneratePile(seed);
-      absl::StatusOr<std::vector<SvmSample>> s = CollectIncSamples(
-          scene.frame, static_cast<int>(seed), DetectOptions{}, IncOptions{});
-      if (s.ok()) samples.insert(samples.end(), s->begin(), s->end());
-    }
-    absl::StatusOr<RbfSvm> trained = TrainRbfSvm(
-        samples, RelationFeatureNames(), "inc", RbfSvmTrainingOptions{});
+    absl::StatusOr<RbfSvm> trained =
+        TrainRbfSvm(SyntheticRelationSamples(), RelationFeatureNames(), "inc",
+                    RbfSvmTrainingOptions{});
     return new RbfSvm(*std::move(trained));
   }();
   return *svm;
 }
 
-// An SVM that has learnt the opposite: trained on TrainedSvm's scenes with
+// An SVM that has learnt the opposite: trained on the same samples with
 // every label flipped, it calls the faces of one box different objects.
 inline const RbfSvm& ContrarySvm() {
   static const RbfSvm* svm = [] {
-    std::vector<SvmSample> samples;
-    for (uint64_t seed = 21; seed < 33; ++seed) {
-      const synth::SynthScene scene = seed % 2 == 0 ? synth::GenerateScene(seed)
-                                                    : synth::GeneratePile(seed);
-      absl::StatusOr<std::vector<SvmSample>> s = CollectIncSamples(
-          scene.frame, static_cast<int>(seed), DetectOptions{}, IncOptions{});
-      if (s.ok()) samples.insert(samples.end(), s->begin(), s->end());
-    }
+    std::vector<SvmSample> samples = SyntheticRelationSamples();
     for (SvmSample& sample : samples) sample.label = -sample.label;
     absl::StatusOr<RbfSvm> trained = TrainRbfSvm(
         samples, RelationFeatureNames(), "inc", RbfSvmTrainingOptions{});
