@@ -219,7 +219,7 @@ int IncSegmenter::AddPiecesWithin(std::vector<int>& group) {
       return false;
     }
     const cv::Point2f d = p - e.center;
-    if (d.dot(d) <= e.reach * e.reach) return true;
+    if (e.reach > 0.0f && d.dot(d) <= e.reach * e.reach) return true;
     return cv::pointPolygonTest(hull, p, true) >= -margin;
   };
   const auto borders_object = [&](size_t s) {
