@@ -123,7 +123,7 @@ struct IncOptions {
     // (which the support takes) within it, though the front wall's own
     // hull is a thin crescent. A surface bordering such a body and nothing
     // else still in the scene (a sliver of a bowl's rim) joins it too.
-    // Scorecard: OSD cylindric overlap F 0.912 -> 0.933, nothing lower
+    // Scorecard: OSD cylindric overlap F 0.912 -> 0.929, nothing lower
     // (docs/scorecard.md).
     bool body_footprint = true;
   };

@@ -36,6 +36,26 @@ struct PlaneAxes {
   Eigen::Vector3f up, x, y;
 };
 
+// Every stride-th point of each of `surfaces`, the stride such that at most
+// about `max_points` are kept: an even sample.
+std::vector<Eigen::Vector3f> EvenSample(const IncScene& scene,
+                                        const std::vector<int>& surfaces,
+                                        size_t max_points) {
+  size_t total = 0;
+  for (const int s : surfaces) total += scene.points[s].size();
+  const size_t stride =
+      std::max<size_t>(1, (total + max_points - 1) / max_points);
+  std::vector<Eigen::Vector3f> sample;
+  sample.reserve(total / stride + surfaces.size());
+  for (const int s : surfaces) {
+    const std::vector<Eigen::Vector3f>& points = scene.points[s];
+    for (size_t i = 0; i < points.size(); i += stride) {
+      sample.push_back(points[i]);
+    }
+  }
+  return sample;
+}
+
 // A disc on the support's plane (PlaneAxes::Flat), metres.
 struct Disc {
   cv::Point2f center;
@@ -62,20 +82,11 @@ float MedianOff(const std::vector<Eigen::Vector3f>& points, const Off& off) {
 std::optional<Disc> BodyDisc(const IncScene& scene, const BodyFitOptions& fit,
                              const std::vector<int>& surfaces, float bottom,
                              float top, const std::vector<cv::Point2f>& hull) {
-  size_t total = 0;
-  for (const int s : surfaces) total += scene.points[s].size();
-  const size_t stride = std::max<size_t>(
-      1, (total + kObjectFootprintPoints - 1) / kObjectFootprintPoints);
-  std::vector<Eigen::Vector3f> sample;
-  float z = 0.0f;
-  for (const int s : surfaces) {
-    const std::vector<Eigen::Vector3f>& points = scene.points[s];
-    for (size_t i = 0; i < points.size(); i += stride) {
-      sample.push_back(points[i]);
-      z += points[i].z();
-    }
-  }
+  const std::vector<Eigen::Vector3f> sample =
+      EvenSample(scene, surfaces, kObjectFootprintPoints);
   if (static_cast<int>(sample.size()) < fit.min_points) return std::nullopt;
+  float z = 0.0f;
+  for (const Eigen::Vector3f& p : sample) z += p.z();
   z /= static_cast<float>(sample.size());
   // Within the sensor's noise and half a wall of the body, by the median
   // distance (a handle or a rim's lip is off it), of the radii allowed,
@@ -141,19 +152,11 @@ std::optional<Disc> BodyDisc(const IncScene& scene, const BodyFitOptions& fit,
 IncSegmenter::Footprint IncSegmenter::FootprintOf(
     const std::vector<int>& surfaces, size_t max_points) const {
   const PlaneAxes axes(scene_.up);
-  size_t total = 0;
-  for (const int s : surfaces) total += scene_.points[s].size();
-  // Every stride-th point of each surface: at most about max_points.
-  const size_t stride =
-      std::max<size_t>(1, (total + max_points - 1) / max_points);
   Footprint f;
   std::vector<float> heights;
-  for (const int s : surfaces) {
-    const std::vector<Eigen::Vector3f>& points = scene_.points[s];
-    for (size_t i = 0; i < points.size(); i += stride) {
-      f.flat.push_back(axes.Flat(points[i]));
-      heights.push_back(axes.up.dot(points[i]));
-    }
+  for (const Eigen::Vector3f& p : EvenSample(scene_, surfaces, max_points)) {
+    f.flat.push_back(axes.Flat(p));
+    heights.push_back(axes.up.dot(p));
   }
   if (f.flat.empty()) return f;
   const auto at = [&heights](double q) {

@@ -227,7 +227,7 @@ TEST(IncTest, OneSphereKeepsABowlTogetherWhereTheSvmWouldSplitIt) {
   // puts them together (5 masks on the bowl, best IoU 0.37, become 3 with
   // IoU 0.78 when this was written).
   // (The body's footprint, IncOptions::pieces_within, joins them too; off
-  // here, and tested on its own below.)
+  // here, and tested on its own in inc_pieces_test.cc.)
   const Scene scene = Prepare(BowlOnTable(0.008f));
   IncOptions with;
   with.pieces_within.body_footprint = false;
