@@ -183,27 +183,63 @@ void Tracker::JoinAndSplit(
   // without a track whose pixels mostly did not change, lying mostly inside
   // the last mask of a track that an object it touches kept, is a piece of
   // that object: INC cut an unchanged object in two this time. It joins it
-  // rather than appearing.
+  // rather than appearing; so does one that is the part of the last mask
+  // the kept object lacks and reaches beyond it where no other track was
+  // (an object cut short before, whole now that its region is cut again).
+  // An object that "moved" only by being a piece (its centroid is not the
+  // whole's; inside the last mask, unchanged) counts as kept, and its state
+  // is told again once the pieces are one.
+  // Whether a track other than `except` seen last frame held more than half
+  // of `beyond` pixels of `mask` in its last mask.
+  const auto held_by_another = [&](const cv::Mat& mask, int beyond,
+                                   int except) {
+    for (size_t u = 0; u < tracks.size(); ++u) {
+      const Track& other = tracks[u];
+      if (static_cast<int>(u) == except || other.id == 0 ||
+          other.last_seen_frame != frame_index_ - 1) {
+        continue;
+      }
+      if (2 * OverlapWithHeld(mask, other.object) > beyond) return true;
+    }
+    return false;
+  };
   if (!a.changed.empty()) {
-    for (size_t j = 0; j < found.size(); ++j) {
-      if (absorbed[j] || track_of[j] >= 0 || split_from[j]) continue;
+    const auto unchanged = [&](size_t j) {
       const cv::Rect box =
           found[j].box & cv::Rect(0, 0, a.changed.cols, a.changed.rows);
       cv::Mat moved;
       cv::bitwise_and(a.changed(box), found[j].mask(box), moved);
-      if (2 * cv::countNonZero(moved) >= found[j].area) continue;
+      return 2 * cv::countNonZero(moved) < found[j].area;
+    };
+    for (size_t j = 0; j < found.size(); ++j) {
+      if (absorbed[j] || track_of[j] >= 0 || split_from[j] || !unchanged(j)) {
+        continue;
+      }
       for (size_t k = 0; k < found.size(); ++k) {
-        if (k == j || absorbed[k] || track_of[k] < 0 ||
-            state[k] != TrackState::kKept) {
-          continue;
-        }
+        if (k == j || absorbed[k] || track_of[k] < 0) continue;
         const Track& t = tracks[track_of[k]];
-        if (2 * OverlapWithHeld(found[j].mask, t.object) <= found[j].area ||
-            !Touch(found[j].mask, found[j].box, found[k].mask, found[k].box,
+        if (!Touch(found[j].mask, found[j].box, found[k].mask, found[k].box,
                    3)) {
           continue;
         }
+        const int k_in = OverlapWithHeld(found[k].mask, t.object);
+        const bool moved_piece = state[k] == TrackState::kMoved &&
+                                 2 * k_in > found[k].area && unchanged(k);
+        if (state[k] != TrackState::kKept && !moved_piece) continue;
+        // k covers less than 3/4 of the last mask, j and k together at
+        // least, and a quarter of j is inside it.
+        const int j_in = OverlapWithHeld(found[j].mask, t.object);
+        const bool inside = 2 * j_in > found[j].area;
+        const bool completes =
+            !inside && 4 * k_in < 3 * t.object.area &&
+            4 * (j_in + k_in) >= 3 * t.object.area &&
+            4 * j_in >= found[j].area &&
+            !held_by_another(found[j].mask, found[j].area - j_in, track_of[k]);
+        if (!inside && !completes) continue;
         join(j, k);
+        if (moved_piece) {
+          state[k] = StateOfMotion(world[k] - shift - t.world_centroid);
+        }
         break;
       }
     }
