@@ -227,6 +227,55 @@ int OverlapWithHeld(const cv::Mat& mask, const SegmentedObject& held) {
   return cv::countNonZero(both);
 }
 
+bool HeldAsOne(const std::vector<SegmentedObject>& cut,
+               const SegmentedObject& a, const SegmentedObject& b) {
+  return std::any_of(cut.begin(), cut.end(), [&](const SegmentedObject& o) {
+    return 2 * OverlapWithHeld(a.mask, o) > a.area &&
+           2 * OverlapWithHeld(b.mask, o) > b.area;
+  });
+}
+
+int JoinWhereMostHoldAsOne(
+    const std::vector<std::vector<SegmentedObject>>& cuts,
+    std::vector<SegmentedObject>& found) {
+  // Groups by union-find; each group's root its largest object.
+  std::vector<size_t> root(found.size());
+  for (size_t i = 0; i < root.size(); ++i) root[i] = i;
+  const auto find = [&root](size_t i) {
+    while (root[i] != i) i = root[i] = root[root[i]];
+    return i;
+  };
+  for (size_t a = 0; a < found.size(); ++a) {
+    for (size_t b = a + 1; b < found.size(); ++b) {
+      const size_t ra = find(a);
+      const size_t rb = find(b);
+      if (ra == rb) continue;
+      const auto as_one = std::count_if(
+          cuts.begin(), cuts.end(), [&](const std::vector<SegmentedObject>& c) {
+            return HeldAsOne(c, found[a], found[b]);
+          });
+      if (2 * static_cast<size_t>(as_one) <= cuts.size()) continue;
+      if (found[ra].area >= found[rb].area) {
+        root[rb] = ra;
+      } else {
+        root[ra] = rb;
+      }
+    }
+  }
+  int joined = 0;
+  for (size_t i = 0; i < found.size(); ++i) {
+    if (find(i) == i) continue;
+    Join(found[i], found[find(i)]);
+    ++joined;
+  }
+  std::vector<SegmentedObject> kept;
+  for (size_t i = 0; i < found.size(); ++i) {
+    if (find(i) == i) kept.push_back(std::move(found[i]));
+  }
+  found = std::move(kept);
+  return joined;
+}
+
 bool HeldTouch(const SegmentedObject& a, const SegmentedObject& b,
                cv::Size size, int radius) {
   // Masks at the frame's size only for boxes that come near.

@@ -95,6 +95,20 @@ cv::Mat MaskAtSize(const SegmentedObject& held, cv::Size size);
 // mask.
 int OverlapWithHeld(const cv::Mat& mask, const SegmentedObject& held);
 
+// Whether `cut` (objects held, CropMaskToBox) holds `a` and `b` (masks at
+// the frame's size) as one: one of its objects covers more than half of
+// each.
+bool HeldAsOne(const std::vector<SegmentedObject>& cut,
+               const SegmentedObject& a, const SegmentedObject& b);
+
+// Joins the objects of `found` (masks at the frame's size) that more than
+// half of `cuts` (other cuts of the same view, objects held) hold as one
+// (HeldAsOne), each group into its largest. How many objects were joined
+// into others.
+int JoinWhereMostHoldAsOne(
+    const std::vector<std::vector<SegmentedObject>>& cuts,
+    std::vector<SegmentedObject>& found);
+
 // Whether two held objects (CropMaskToBox) of a frame of `size` touch, as
 // Touch's.
 bool HeldTouch(const SegmentedObject& a, const SegmentedObject& b,

@@ -103,6 +103,10 @@ absl::Status Validate(const TrackerOptions& options) {
   if (options.region_whole_every < 1) {
     return absl::InvalidArgumentError("track.region_whole_every: must be >= 1");
   }
+  if (options.refine_votes < 0 || options.refine_votes > 31) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "track.refine_votes: ", options.refine_votes, " is not in [0, 31]"));
+  }
   if (options.refine_frames < 0 || options.refine_frames == 1 ||
       options.refine_frames > 64) {
     return absl::InvalidArgumentError(
@@ -228,6 +232,8 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
     if (still_frames_ + 1 < options_.refine_frames) {
       AverageInto(frame.depth, reference_.depth, still_count_);
       ++still_frames_;
+      out.voted =
+          options_.refine_frames - still_frames_ <= options_.refine_votes;
     } else {
       mean.intrinsics = frame.intrinsics;
       mean.color = reference_.color;
@@ -255,6 +261,19 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
       kept.world_centroid = t.world_centroid;
       kept.frames_seen = t.frames_seen;
       out.objects.push_back(std::move(kept));
+    }
+    if (out.voted) {
+      // A cut that fails is no vote; the frame is answered all the same.
+      std::vector<SegmentedObject> cut;
+      if (Segment(frame, options_.segment, camera_to_world,
+                  out.changed_fraction, cut, interrupt)
+              .ok()) {
+        for (SegmentedObject& o : cut) CropMaskToBox(o);
+        votes_.push_back(std::move(cut));
+      } else {
+        out.voted = false;
+      }
+      clock.Lap("vote");
     }
   } else {
     Association a;
@@ -317,6 +336,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
                                      out.changed_fraction, found, interrupt));
     }
     clock.Lap("segment");
+    if (out.refined && !votes_.empty()) JoinAsVoted(tracks, found);
 
     // Candidates: tracks seen within remember_frames.
     std::vector<int> candidates;
@@ -508,6 +528,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
     // A changed scene starts a still period; a refined one has ended its.
     still_frames_ = 0;
     still_count_.release();
+    votes_.clear();
     refined_ = out.refined;
     reference_pose_ = camera_to_world;
     ++segmentations_;

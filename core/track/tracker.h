@@ -142,6 +142,20 @@ struct TrackerOptions {
   // segmented (which the change test compares with), plus a count per
   // pixel. 0: never; else 2 to 64.
   int refine_frames = 6;
+  // The refined cut is voted on: the last refine_votes frames of the still
+  // period before it are cut too, unseen (each is answered as reused), and
+  // two objects of the refined cut join when most of those cuts and the
+  // period's first hold them as one (an object covering more than half of
+  // each). The cut of the mean is the better cut where the noise that
+  // differs frame to frame misleads INC; single frames' cuts err apart
+  // where INC is unsure whatever the noise (an object in two pieces in one
+  // frame, whole in the next), and most of them hold it whole when the
+  // mean's does not. Only joins: an object the single frames miss, or cut
+  // in pieces alike, is as the mean's cut has it. The last frames, so that
+  // a period that ends before its refined cut seldom paid for votes. 0: the
+  // cut of the mean alone; at most refine_frames - 2 are cut, whatever this
+  // asks.
+  int refine_votes = 2;
   // A gone track may come back (same identity) within this many frames.
   int remember_frames = 30;
   // Re-identification: an object that matched no track (outside the gate:
@@ -175,8 +189,11 @@ struct TrackedFrame {
   // The scene did not change: the last segmentation was reused.
   bool reused = false;
   // The scene did not change for TrackerOptions::refine_frames frames, and
-  // their mean was segmented.
+  // their mean was segmented (and voted on: TrackerOptions::refine_votes).
   bool refined = false;
+  // The scene did not change and the last segmentation was reused, but
+  // this frame was cut too, for the refined cut's vote.
+  bool voted = false;
   // See TrackerOptions::static_fraction; 1 when the pose says the camera
   // moved (the pixels are then not compared).
   double changed_fraction = 0.0;
@@ -189,7 +206,8 @@ struct TrackedFrame {
   // Only this part of the frame was segmented, the objects outside it kept
   // (TrackerOptions::reuse_regions); empty: the whole frame (or none).
   cv::Rect region;
-  std::vector<StageTiming> timings;  // "change", INC's stages, "associate"
+  // "change", INC's stages, "associate"; "vote" on a frame voted.
+  std::vector<StageTiming> timings;
   double seconds = 0.0;
 };
 
@@ -318,6 +336,13 @@ class Tracker {
       const std::optional<Eigen::Isometry3f>& pose, const cv::Rect& region,
       const cv::Mat& changed, const std::vector<Track>& tracks,
       std::vector<SegmentedObject>& found, const InterruptCheck& interrupt);
+  // The refined cut's vote (TrackerOptions::refine_votes): objects of
+  // `found` (the cut of the mean, masks at the frame's size) that most of
+  // the still period's first cut (the objects of `tracks` seen last frame)
+  // and votes_ hold as one (HeldAsOne) are joined, each group into its
+  // largest. votes_ are used up.
+  void JoinAsVoted(const std::vector<Track>& tracks,
+                   std::vector<SegmentedObject>& found);
   // The support plane (support_) in the camera at `pose`.
   Eigen::Vector4f SupportInCamera(
       const std::optional<Eigen::Isometry3f>& pose) const;
@@ -347,6 +372,9 @@ class Tracker {
   int still_frames_ = 0;
   cv::Mat still_count_;
   bool refined_ = false;
+  // TrackerOptions::refine_votes: the still period's frames cut so far for
+  // the vote (their objects held, CropMaskToBox).
+  std::vector<std::vector<SegmentedObject>> votes_;
   // Averages `depth` into `mean` (CV_32FC1) where it has depth; `count`
   // (CV_8UC1) counts the frames averaged at each pixel. `depth` may be
   // `mean` itself (with `count` 0: counts its pixels with depth).

@@ -202,6 +202,19 @@ Eigen::Vector4f Tracker::SupportInCamera(
   return plane;
 }
 
+void Tracker::JoinAsVoted(const std::vector<Track>& tracks,
+                          std::vector<SegmentedObject>& found) {
+  std::vector<std::vector<SegmentedObject>> cuts(1);
+  for (const Track& t : tracks) {
+    if (t.last_seen_frame == frame_index_ - 1) cuts[0].push_back(t.object);
+  }
+  for (std::vector<SegmentedObject>& vote : votes_) {
+    cuts.push_back(std::move(vote));
+  }
+  votes_.clear();
+  JoinWhereMostHoldAsOne(cuts, found);
+}
+
 absl::StatusOr<bool> Tracker::SegmentRegion(
     const RgbdFrame& frame, IncrementalOptions segment,
     const std::optional<Eigen::Isometry3f>& pose, const cv::Rect& region,

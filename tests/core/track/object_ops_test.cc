@@ -225,5 +225,72 @@ TEST(ObjectOps, AHeldObjectKeepsOnlyItsBoxAndOverlapsAsBefore) {
   EXPECT_EQ(from_held[0].box, from_full[0].box);
 }
 
+// A square at (x, y), its centroid the origin.
+SegmentedObject Sq(int x, int y, int side) {
+  return Square(x, y, side, Eigen::Vector3f::Zero());
+}
+
+// A 4 x 8 rectangle at (x, y) of a 20 x 20 frame.
+SegmentedObject Wide(int x, int y) {
+  SegmentedObject o = Sq(x, y, 4);
+  o.box = cv::Rect(x, y, 8, 4);
+  o.mask(o.box).setTo(255);
+  o.area = 32;
+  return o;
+}
+
+// `o` held, as a cut kept for a vote holds it.
+SegmentedObject Held(SegmentedObject o) {
+  CropMaskToBox(o);
+  return o;
+}
+
+TEST(ObjectOps, TwoObjectsAreHeldAsOneWhenOneObjectCoversMostOfEach) {
+  // The halves of a 4 x 8 rectangle at (2,2): the whole covers both; a
+  // square on the left half covers it but not the right; two squares one
+  // each, neither both.
+  const SegmentedObject left = Sq(2, 2, 4);
+  const SegmentedObject right = Sq(6, 2, 4);
+  EXPECT_TRUE(HeldAsOne({Held(Wide(2, 2))}, left, right));
+  EXPECT_FALSE(HeldAsOne({Held(Sq(2, 2, 4))}, left, right));
+  EXPECT_FALSE(HeldAsOne({Held(Sq(2, 2, 4)), Held(Sq(6, 2, 4))}, left, right));
+  // Covering 3 of the right half's 4 columns is more than half of it.
+  EXPECT_TRUE(HeldAsOne({Held(Wide(1, 2))}, left, right));
+  // 2 of its 4 columns are not.
+  EXPECT_FALSE(HeldAsOne({Held(Wide(0, 2))}, left, right));
+}
+
+TEST(ObjectOps, ObjectsMostOtherCutsHoldAsOneAreJoinedIntoTheLargest) {
+  // The cut to mend: a rectangle's halves (the right one larger), and a
+  // square apart. Of three other cuts, two hold the rectangle whole and
+  // one in halves: the halves join, under the larger's place in the
+  // list; the square stays.
+  const auto mend = [] {
+    SegmentedObject right = Sq(6, 2, 4);
+    right.mask(cv::Rect(6, 6, 4, 1)).setTo(255);
+    right.box = cv::Rect(6, 2, 4, 5);
+    right.area = 20;
+    return std::vector<SegmentedObject>{Sq(2, 2, 4), right, Sq(14, 14, 4)};
+  };
+  const std::vector<SegmentedObject> whole = {Held(Wide(2, 2)),
+                                              Held(Sq(14, 14, 4))};
+  const std::vector<SegmentedObject> halves = {
+      Held(Sq(2, 2, 4)), Held(Sq(6, 2, 4)), Held(Sq(14, 14, 4))};
+  std::vector<SegmentedObject> found = mend();
+  EXPECT_EQ(JoinWhereMostHoldAsOne({whole, halves, whole}, found), 1);
+  ASSERT_EQ(found.size(), 2u);
+  EXPECT_EQ(found[0].area, 36);
+  EXPECT_EQ(found[0].box, cv::Rect(2, 2, 8, 5));
+  EXPECT_EQ(found[1].box, cv::Rect(14, 14, 4, 4));
+  // One of three, or two of four, is no majority.
+  found = mend();
+  EXPECT_EQ(JoinWhereMostHoldAsOne({whole, halves, halves}, found), 0);
+  EXPECT_EQ(found.size(), 3u);
+  EXPECT_EQ(JoinWhereMostHoldAsOne({whole, halves, halves, whole}, found), 0);
+  EXPECT_EQ(found.size(), 3u);
+  // No other cut: nothing joins.
+  EXPECT_EQ(JoinWhereMostHoldAsOne({}, found), 0);
+}
+
 }  // namespace
 }  // namespace fovea
