@@ -15,25 +15,19 @@
 #include "core/synth/replayed_scene.h"
 #include "core/synth/sequence.h"
 #include "core/track/tracker.h"
-#include "tests/core/testing/models.h"
 #include "tests/core/testing/osd.h"
+#include "tests/core/track/tracker_testing.h"
 
 namespace fovea {
 namespace {
 
-const LoadedModels* Models() { return testing::ShippedModels(); }
+using tracker_testing::Models;
 
+// `sequence` played with its poses: each frame's result.
 std::vector<TrackedFrame> Play(const synth::Sequence& sequence,
                                const TrackerOptions& options) {
-  Tracker tracker(options, &*Models()->inc);
   std::vector<TrackedFrame> frames;
-  for (const synth::SequenceFrame& f : sequence.frames) {
-    absl::StatusOr<TrackedFrame> out =
-        tracker.Process(f.frame.frame, f.camera_to_world);
-    EXPECT_TRUE(out.ok()) << out.status();
-    if (!out.ok()) break;
-    frames.push_back(*std::move(out));
-  }
+  tracker_testing::Play(sequence, true, &frames, options);
   return frames;
 }
 
