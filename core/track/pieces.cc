@@ -178,17 +178,6 @@ void Tracker::JoinAndSplit(
     split(m.j, m.k, t, m.piece, m.k_piece);
   }
 
-  // Where what changed is known (a still camera, or one moved by a known
-  // pose; not a refined cut, which replaces the last one), an object
-  // without a track whose pixels mostly did not change, lying mostly inside
-  // the last mask of a track that an object it touches kept, is a piece of
-  // that object: INC cut an unchanged object in two this time. It joins it
-  // rather than appearing; so does one that is the part of the last mask
-  // the kept object lacks and reaches beyond it where no other track was
-  // (an object cut short before, whole now that its region is cut again).
-  // An object that "moved" only by being a piece (its centroid is not the
-  // whole's; inside the last mask, unchanged) counts as kept, and its state
-  // is told again once the pieces are one.
   // Whether a track other than `except` seen last frame held more than half
   // of `beyond` pixels of `mask` in its last mask.
   const auto held_by_another = [&](const cv::Mat& mask, int beyond,
@@ -203,6 +192,18 @@ void Tracker::JoinAndSplit(
     }
     return false;
   };
+
+  // Where what changed is known (a still camera, or one moved by a known
+  // pose; not a refined cut, which replaces the last one), an object
+  // without a track whose pixels mostly did not change, lying mostly inside
+  // the last mask of a track that an object it touches kept, is a piece of
+  // that object: INC cut an unchanged object in two this time. It joins it
+  // rather than appearing; so does one that is the part of the last mask
+  // the kept object lacks and reaches beyond it where no other track was
+  // (an object cut short before, whole now that its region is cut again).
+  // An object that "moved" only by being a piece (its centroid is not the
+  // whole's; inside the last mask, unchanged) counts as kept, and its state
+  // is told again once the pieces are one.
   if (!a.changed.empty()) {
     const auto unchanged = [&](size_t j) {
       const cv::Rect box =

@@ -24,18 +24,8 @@
 #include "core/track/tracker.h"
 #include "tests/core/track/tracker_testing.h"
 
-namespace fovea {
+namespace fovea::tracker_testing {
 namespace {
-
-using tracker_testing::GenerateSequence;
-using tracker_testing::IdsOfTruths;
-using tracker_testing::Models;
-using tracker_testing::PixelsOfObject;
-using tracker_testing::PixelsPerTruth;
-using tracker_testing::Play;
-using tracker_testing::Sequence;
-using tracker_testing::SequenceKind;
-using tracker_testing::TruthOf;
 
 // The ground-truth objects of `frame` with their pixel centroids.
 std::map<int, cv::Point2d> TruthCentroids(const synth::SequenceFrame& frame) {
@@ -266,11 +256,11 @@ TEST(Tracker, AHiddenPieceIsCarriedAlongUntilItsPartComesBack) {
   ADD_FAILURE() << "truth 0 was never hidden and found again";
 }
 
-// The identities that truth `truth` of push-apart sequence `seed` (12
+// The identities that truth `truth` of the `kind` sequence `seed` (12
 // frames, the pose sent) had (Play); none when it was never found.
-std::set<int> IdentitiesOfTruth(int seed, int truth) {
+std::set<int> IdentitiesOfTruth(SequenceKind kind, int seed, int truth) {
   const std::map<int, std::set<int>> tracks =
-      Play(GenerateSequence(SequenceKind::kPushApart, seed, 12), true);
+      Play(GenerateSequence(kind, seed, 12), true);
   const auto it = tracks.find(truth);
   return it == tracks.end() ? std::set<int>() : it->second;
 }
@@ -283,7 +273,7 @@ TEST(Tracker, ASmallPartPushedAlongIsToldByItsPieceMovedWithTheRest) {
   // piece was seen, overlapped it no longer, and came back as a new object
   // (identities 3, 4, 5, 3: three switches). Found among the pieces moved
   // as the large one moved, it joins again, and keeps one identity.
-  EXPECT_EQ(IdentitiesOfTruth(41, 2).size(), 1u);
+  EXPECT_EQ(IdentitiesOfTruth(SequenceKind::kPushApart, 41, 2).size(), 1u);
 }
 
 TEST(Tracker, AnUnchangedObjectCutInTwoIsOnePieceAndKeepsItsIdentity) {
@@ -294,7 +284,7 @@ TEST(Tracker, AnUnchangedObjectCutInTwoIsOnePieceAndKeepsItsIdentity) {
   // the whole at frame 9 (the object joined under the larger piece). Its
   // pixels did not change, and it lies inside the track's last mask: it is
   // a piece of the half that kept the track, and joins it.
-  EXPECT_EQ(IdentitiesOfTruth(47, 4).size(), 1u);
+  EXPECT_EQ(IdentitiesOfTruth(SequenceKind::kPushApart, 47, 4).size(), 1u);
 }
 
 TEST(Tracker, AnObjectCutShortBeforeComesWholeUnderItsIdentity) {
@@ -308,10 +298,7 @@ TEST(Tracker, AnObjectCutShortBeforeComesWholeUnderItsIdentity) {
   // (identities 6, 8). The wall did not change, is the part of the last
   // mask the inside lacks, and reaches beyond it where no other track
   // was: it joins the inside, and the bowl keeps one identity.
-  const std::map<int, std::set<int>> tracks =
-      Play(GenerateSequence(SequenceKind::kRemove, 115, 12), true);
-  ASSERT_TRUE(tracks.count(4));
-  EXPECT_EQ(tracks.at(4).size(), 1u);
+  EXPECT_EQ(IdentitiesOfTruth(SequenceKind::kRemove, 115, 4).size(), 1u);
 }
 
 TEST(Tracker, APieceThatMovedOnlyByBeingAPieceIsCompletedToo) {
@@ -324,10 +311,7 @@ TEST(Tracker, APieceThatMovedOnlyByBeingAPieceIsCompletedToo) {
   // its centroid is not the last mask's. Seen from the last frame's view
   // neither part changed, and the part is inside the last mask: it counts
   // as kept, and the side completes it.
-  const std::map<int, std::set<int>> tracks =
-      Play(GenerateSequence(SequenceKind::kDrift, 20, 12), true);
-  ASSERT_TRUE(tracks.count(0));
-  EXPECT_EQ(tracks.at(0).size(), 1u);
+  EXPECT_EQ(IdentitiesOfTruth(SequenceKind::kDrift, 20, 0).size(), 1u);
 }
 
 // For `truth` of the push-apart sequence `seed`, played with its poses:
@@ -400,4 +384,4 @@ TEST(Tracker, PartsThatMovedApartFromAnUnmatchedJoinedTrackTakeTheirPieces) {
 }
 
 }  // namespace
-}  // namespace fovea
+}  // namespace fovea::tracker_testing

@@ -22,18 +22,8 @@
 
 #include "tests/core/track/tracker_testing.h"
 
-namespace fovea {
+namespace fovea::tracker_testing {
 namespace {
-
-using tracker_testing::GenerateSequence;
-using tracker_testing::IdsOfTruths;
-using tracker_testing::Models;
-using tracker_testing::PixelsOfObject;
-using tracker_testing::PixelsPerTruth;
-using tracker_testing::Play;
-using tracker_testing::Sequence;
-using tracker_testing::SequenceKind;
-using tracker_testing::TruthOf;
 
 TEST(Tracker, AStillSceneIsSegmentedOnceAndKeepsItsIdentities) {
   ASSERT_NE(Models(), nullptr);
@@ -362,4 +352,4 @@ TEST(Tracker, BadOptionsAreNamed) {
 }
 
 }  // namespace
-}  // namespace fovea
+}  // namespace fovea::tracker_testing
