@@ -235,8 +235,35 @@ bool HeldAsOne(const std::vector<SegmentedObject>& cut,
   });
 }
 
+BorderJumps CountBorderJumps(const SegmentedObject& a, const SegmentedObject& b,
+                             const cv::Mat& depth,
+                             const std::function<bool(float, float)>& jump) {
+  BorderJumps out;
+  const cv::Rect frame(0, 0, depth.cols, depth.rows);
+  const cv::Rect near = Grown(a.box, 1) & Grown(b.box, 1) & frame;
+  const auto pair = [&](int u, int v, int u2, int v2) {
+    const bool ab = a.mask.at<uint8_t>(v, u) && b.mask.at<uint8_t>(v2, u2);
+    const bool ba = b.mask.at<uint8_t>(v, u) && a.mask.at<uint8_t>(v2, u2);
+    if (!ab && !ba) return;
+    const float z = depth.at<float>(v, u);
+    const float z2 = depth.at<float>(v2, u2);
+    if (!(z > 0.0f) || !(z2 > 0.0f)) return;
+    ++out.pairs;
+    if (jump(z, z2)) ++out.jumps;
+  };
+  for (int v = near.y; v < near.y + near.height; ++v) {
+    for (int u = near.x; u < near.x + near.width; ++u) {
+      if (u + 1 < frame.width) pair(u, v, u + 1, v);
+      if (v + 1 < frame.height) pair(u, v, u, v + 1);
+    }
+  }
+  return out;
+}
+
 int JoinWhereMostHoldAsOne(
     const std::vector<std::vector<SegmentedObject>>& cuts,
+    const std::function<bool(const SegmentedObject&, const SegmentedObject&)>&
+        may_join,
     std::vector<SegmentedObject>& found) {
   // Groups by union-find; each group's root its largest object.
   std::vector<size_t> root(found.size());
@@ -254,7 +281,10 @@ int JoinWhereMostHoldAsOne(
           cuts.begin(), cuts.end(), [&](const std::vector<SegmentedObject>& c) {
             return HeldAsOne(c, found[a], found[b]);
           });
-      if (2 * static_cast<size_t>(as_one) <= cuts.size()) continue;
+      if (2 * static_cast<size_t>(as_one) <= cuts.size() ||
+          !may_join(found[a], found[b])) {
+        continue;
+      }
       if (found[ra].area >= found[rb].area) {
         root[rb] = ra;
       } else {

@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <functional>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <vector>
@@ -103,11 +104,24 @@ bool HeldAsOne(const std::vector<SegmentedObject>& cut,
 
 // Joins the objects of `found` (masks at the frame's size) that more than
 // half of `cuts` (other cuts of the same view, objects held) hold as one
-// (HeldAsOne), each group into its largest. How many objects were joined
-// into others.
+// (HeldAsOne) and `may_join` allows, each group into its largest. How many
+// objects were joined into others.
 int JoinWhereMostHoldAsOne(
     const std::vector<std::vector<SegmentedObject>>& cuts,
+    const std::function<bool(const SegmentedObject&, const SegmentedObject&)>&
+        may_join,
     std::vector<SegmentedObject>& found);
+
+// Of the pairs of 4-neighbour pixels one on `a`, the other on `b` (masks at
+// the frame's size), both with depth in `depth` (CV_32FC1): how many, and
+// how many `jump` says differ.
+struct BorderJumps {
+  int pairs = 0;
+  int jumps = 0;
+};
+BorderJumps CountBorderJumps(const SegmentedObject& a, const SegmentedObject& b,
+                             const cv::Mat& depth,
+                             const std::function<bool(float, float)>& jump);
 
 // Whether two held objects (CropMaskToBox) of a frame of `size` touch, as
 // Touch's.

@@ -336,7 +336,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
                                      out.changed_fraction, found, interrupt));
     }
     clock.Lap("segment");
-    if (out.refined && !votes_.empty()) JoinAsVoted(tracks, found);
+    if (out.refined && !votes_.empty()) JoinAsVoted(tracks, input.depth, found);
 
     // Candidates: tracks seen within remember_frames.
     std::vector<int> candidates;

@@ -146,7 +146,8 @@ struct TrackerOptions {
   // period before it are cut too, unseen (each is answered as reused), and
   // two objects of the refined cut join when most of those cuts and the
   // period's first hold them as one (an object covering more than half of
-  // each). The cut of the mean is the better cut where the noise that
+  // each), unless most of the border between them is a jump in depth beyond
+  // the sensor's noise (DepthChanged, on the mean). The cut of the mean is the better cut where the noise that
   // differs frame to frame misleads INC; single frames' cuts err apart
   // where INC is unsure whatever the noise (an object in two pieces in one
   // frame, whole in the next), and most of them hold it whole when the
@@ -340,8 +341,9 @@ class Tracker {
   // `found` (the cut of the mean, masks at the frame's size) that most of
   // the still period's first cut (the objects of `tracks` seen last frame)
   // and votes_ hold as one (HeldAsOne) are joined, each group into its
-  // largest. votes_ are used up.
-  void JoinAsVoted(const std::vector<Track>& tracks,
+  // largest, unless `depth` (the mean's) jumps along most of the border
+  // between them. votes_ are used up.
+  void JoinAsVoted(const std::vector<Track>& tracks, const cv::Mat& depth,
                    std::vector<SegmentedObject>& found);
   // The support plane (support_) in the camera at `pose`.
   Eigen::Vector4f SupportInCamera(

@@ -203,6 +203,7 @@ Eigen::Vector4f Tracker::SupportInCamera(
 }
 
 void Tracker::JoinAsVoted(const std::vector<Track>& tracks,
+                          const cv::Mat& depth,
                           std::vector<SegmentedObject>& found) {
   std::vector<std::vector<SegmentedObject>> cuts(1);
   for (const Track& t : tracks) {
@@ -212,7 +213,15 @@ void Tracker::JoinAsVoted(const std::vector<Track>& tracks,
     cuts.push_back(std::move(vote));
   }
   votes_.clear();
-  JoinWhereMostHoldAsOne(cuts, found);
+  // Not two objects one occludes: most of the border between them a jump
+  // in depth beyond the sensor's noise.
+  const auto may_join = [&](const SegmentedObject& a,
+                            const SegmentedObject& b) {
+    const BorderJumps border = CountBorderJumps(
+        a, b, depth, [this](float z, float z2) { return DepthChanged(z, z2); });
+    return 2 * border.jumps <= border.pairs;
+  };
+  JoinWhereMostHoldAsOne(cuts, may_join, found);
 }
 
 absl::StatusOr<bool> Tracker::SegmentRegion(

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
@@ -260,6 +261,9 @@ TEST(ObjectOps, TwoObjectsAreHeldAsOneWhenOneObjectCoversMostOfEach) {
   EXPECT_FALSE(HeldAsOne({Held(Wide(0, 2))}, left, right));
 }
 
+// Any two objects may join.
+bool kAny(const SegmentedObject&, const SegmentedObject&) { return true; }
+
 TEST(ObjectOps, ObjectsMostOtherCutsHoldAsOneAreJoinedIntoTheLargest) {
   // The cut to mend: a rectangle's halves (the right one larger), and a
   // square apart. Of three other cuts, two hold the rectangle whole and
@@ -277,19 +281,50 @@ TEST(ObjectOps, ObjectsMostOtherCutsHoldAsOneAreJoinedIntoTheLargest) {
   const std::vector<SegmentedObject> halves = {
       Held(Sq(2, 2, 4)), Held(Sq(6, 2, 4)), Held(Sq(14, 14, 4))};
   std::vector<SegmentedObject> found = mend();
-  EXPECT_EQ(JoinWhereMostHoldAsOne({whole, halves, whole}, found), 1);
+  EXPECT_EQ(JoinWhereMostHoldAsOne({whole, halves, whole}, kAny, found), 1);
   ASSERT_EQ(found.size(), 2u);
   EXPECT_EQ(found[0].area, 36);
   EXPECT_EQ(found[0].box, cv::Rect(2, 2, 8, 5));
   EXPECT_EQ(found[1].box, cv::Rect(14, 14, 4, 4));
   // One of three, or two of four, is no majority.
   found = mend();
-  EXPECT_EQ(JoinWhereMostHoldAsOne({whole, halves, halves}, found), 0);
+  EXPECT_EQ(JoinWhereMostHoldAsOne({whole, halves, halves}, kAny, found), 0);
   EXPECT_EQ(found.size(), 3u);
-  EXPECT_EQ(JoinWhereMostHoldAsOne({whole, halves, halves, whole}, found), 0);
+  EXPECT_EQ(JoinWhereMostHoldAsOne({whole, halves, halves, whole}, kAny, found),
+            0);
   EXPECT_EQ(found.size(), 3u);
   // No other cut: nothing joins.
-  EXPECT_EQ(JoinWhereMostHoldAsOne({}, found), 0);
+  EXPECT_EQ(JoinWhereMostHoldAsOne({}, kAny, found), 0);
+  // Nor when `may_join` forbids it.
+  EXPECT_EQ(
+      JoinWhereMostHoldAsOne(
+          {whole, halves, whole},
+          [](const SegmentedObject&, const SegmentedObject&) { return false; },
+          found),
+      0);
+  EXPECT_EQ(found.size(), 3u);
+}
+
+TEST(ObjectOps, TheBorderBetweenTwoObjectsIsCountedInPairsOfNeighbours) {
+  // Two 4 x 4 squares side by side: 4 pairs across their shared border.
+  // At one depth none jumps; with the right one 5 cm further, all do, but
+  // for a row with no depth on it.
+  const SegmentedObject left = Sq(2, 2, 4);
+  const SegmentedObject right = Sq(6, 2, 4);
+  cv::Mat depth(20, 20, CV_32FC1, cv::Scalar(1.0f));
+  const auto beyond_1cm = [](float z, float z2) {
+    return std::abs(z - z2) > 0.01f;
+  };
+  BorderJumps border = CountBorderJumps(left, right, depth, beyond_1cm);
+  EXPECT_EQ(border.pairs, 4);
+  EXPECT_EQ(border.jumps, 0);
+  depth(right.box).setTo(1.05f);
+  depth.row(3).setTo(0.0f);
+  border = CountBorderJumps(right, left, depth, beyond_1cm);
+  EXPECT_EQ(border.pairs, 3);
+  EXPECT_EQ(border.jumps, 3);
+  // Squares apart share no border.
+  EXPECT_EQ(CountBorderJumps(left, Sq(14, 14, 4), depth, beyond_1cm).pairs, 0);
 }
 
 }  // namespace
