@@ -147,12 +147,12 @@ struct TrackerOptions {
   // two objects of the refined cut join when most of those cuts and the
   // period's first hold them as one (an object covering more than half of
   // each), unless most of the border between them is a jump in depth beyond
-  // the sensor's noise (DepthChanged, on the mean). The cut of the mean is the better cut where the noise that
-  // differs frame to frame misleads INC; single frames' cuts err apart
-  // where INC is unsure whatever the noise (an object in two pieces in one
-  // frame, whole in the next), and most of them hold it whole when the
-  // mean's does not. Only joins: an object the single frames miss, or cut
-  // in pieces alike, is as the mean's cut has it. The last frames, so that
+  // the sensor's noise (DepthChanged, on the mean). The cut of the mean is the
+  // better cut where the noise that differs frame to frame misleads INC; single
+  // frames' cuts err apart where INC is unsure whatever the noise (an object in
+  // two pieces in one frame, whole in the next), and most of them hold it whole
+  // when the mean's does not. Only joins: an object the single frames miss, or
+  // cut in pieces alike, is as the mean's cut has it. The last frames, so that
   // a period that ends before its refined cut seldom paid for votes. 0: the
   // cut of the mean alone; at most refine_frames - 2 are cut, whatever this
   // asks.
