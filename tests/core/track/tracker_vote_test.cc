@@ -54,38 +54,44 @@ TEST(TrackerVote, AStillSceneIsCutForTheVoteOnTheFramesBeforeItsRefinedCut) {
   EXPECT_FALSE(Validate(off).ok());
 }
 
+// The pixels of truth object k of `truth` (labels as SequenceLabels's,
+// 10 (k + 2)).
+cv::Mat TruthPixels(const synth::SequenceFrame& truth, size_t k) {
+  return truth.frame.labels == 10 * (static_cast<int>(k) + 2);
+}
+
+// Whether `mask` matches truth `pixels`: IoU at least 1/2.
+bool Matches(const cv::Mat& pixels, const cv::Mat& mask) {
+  const int both = cv::countNonZero(pixels & mask);
+  const int either = cv::countNonZero(pixels | mask);
+  return either > 0 && 2 * both >= either;
+}
+
 // How many of `frame`'s objects (not gone) match no truth object of
-// `truth` (IoU below 1/2; truth labels as SequenceLabels's, 10 (k + 2)).
+// `truth`.
 int Unmatched(const TrackedFrame& frame, const synth::SequenceFrame& truth) {
   int unmatched = 0;
   for (const TrackedObject& o : frame.objects) {
     if (o.state == TrackState::kGone) continue;
     bool matched = false;
     for (size_t k = 0; k < truth.object_ids.size() && !matched; ++k) {
-      const cv::Mat pixels =
-          truth.frame.labels == 10 * (static_cast<int>(k) + 2);
-      const int both = cv::countNonZero(pixels & o.object.mask);
-      const int either = cv::countNonZero(pixels | o.object.mask);
-      matched = 2 * both >= either && either > 0;
+      matched = Matches(TruthPixels(truth, k), o.object.mask);
     }
     unmatched += matched ? 0 : 1;
   }
   return unmatched;
 }
 
-// How many truth objects of `truth` no object of `frame` matches (IoU at
-// least 1/2).
+// How many truth objects of `truth` (in view) no object of `frame` matches.
 int Missed(const TrackedFrame& frame, const synth::SequenceFrame& truth) {
   int missed = 0;
   for (size_t k = 0; k < truth.object_ids.size(); ++k) {
-    const cv::Mat pixels = truth.frame.labels == 10 * (static_cast<int>(k) + 2);
+    const cv::Mat pixels = TruthPixels(truth, k);
     if (cv::countNonZero(pixels) == 0) continue;
     bool matched = false;
     for (const TrackedObject& o : frame.objects) {
       if (o.state == TrackState::kGone) continue;
-      const int both = cv::countNonZero(pixels & o.object.mask);
-      const int either = cv::countNonZero(pixels | o.object.mask);
-      matched = matched || 2 * both >= either;
+      matched = matched || Matches(pixels, o.object.mask);
     }
     missed += matched ? 0 : 1;
   }
