@@ -227,6 +227,14 @@ int OverlapWithHeld(const cv::Mat& mask, const SegmentedObject& held) {
   return cv::countNonZero(both);
 }
 
+SegmentedObject OutlineOf(const SegmentedObject& held) {
+  SegmentedObject outline;
+  outline.mask = held.mask;
+  outline.box = held.box;
+  outline.area = held.area;
+  return outline;
+}
+
 bool HeldAsOne(const std::vector<SegmentedObject>& cut,
                const SegmentedObject& a, const SegmentedObject& b) {
   return std::any_of(cut.begin(), cut.end(), [&](const SegmentedObject& o) {

@@ -96,6 +96,11 @@ cv::Mat MaskAtSize(const SegmentedObject& held, cv::Size size);
 // mask.
 int OverlapWithHeld(const cv::Mat& mask, const SegmentedObject& held);
 
+// Of a held object (CropMaskToBox), what a vote on cuts looks at: its
+// mask, box and area (not its points or geometry, which a stream may ask
+// for and a vote does not need to keep).
+SegmentedObject OutlineOf(const SegmentedObject& held);
+
 // Whether `cut` (objects held, CropMaskToBox) holds `a` and `b` (masks at
 // the frame's size) as one: one of its objects covers more than half of
 // each.

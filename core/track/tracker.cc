@@ -264,12 +264,18 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
     }
     if (out.voted) {
       // A cut that fails is no vote; the frame is answered all the same.
+      // Its objects' points are not taken: the vote looks at masks.
+      IncrementalOptions vote_options = options_.segment;
+      vote_options.object_points = ObjectPointsOptions{};
       std::vector<SegmentedObject> cut;
-      if (Segment(frame, options_.segment, camera_to_world,
+      if (Segment(frame, std::move(vote_options), camera_to_world,
                   out.changed_fraction, cut, interrupt)
               .ok()) {
-        for (SegmentedObject& o : cut) CropMaskToBox(o);
-        votes_.push_back(std::move(cut));
+        std::vector<SegmentedObject>& vote = votes_.emplace_back();
+        for (SegmentedObject& o : cut) {
+          CropMaskToBox(o);
+          vote.push_back(OutlineOf(o));
+        }
       } else {
         out.voted = false;
       }

@@ -207,7 +207,9 @@ void Tracker::JoinAsVoted(const std::vector<Track>& tracks,
                           std::vector<SegmentedObject>& found) {
   std::vector<std::vector<SegmentedObject>> cuts(1);
   for (const Track& t : tracks) {
-    if (t.last_seen_frame == frame_index_ - 1) cuts[0].push_back(t.object);
+    if (t.last_seen_frame == frame_index_ - 1) {
+      cuts[0].push_back(OutlineOf(t.object));
+    }
   }
   for (std::vector<SegmentedObject>& vote : votes_) {
     cuts.push_back(std::move(vote));
