@@ -138,5 +138,12 @@ TEST(ChangedTruths, WhatMovedOrAppearedAndNotWhatLostPixels) {
   EXPECT_TRUE(ChangedTruths(before, shifted, 100).empty());
 }
 
+TEST(TotalCost, CountsTheFewFullCutsTheMedianHides) {
+  // Three cheap frames and one full cut: the median frame costs 1/50 of a
+  // fresh call, the stream (1 + 1 + 1 + 100) / (50 + 50 + 50 + 100).
+  EXPECT_DOUBLE_EQ(TotalCost({1, 1, 1, 100}, {50, 50, 50, 100}), 0.412);
+  EXPECT_DOUBLE_EQ(TotalCost({1, 2}, {}), 0.0);
+}
+
 }  // namespace
 }  // namespace fovea::eval

@@ -118,7 +118,8 @@ int RunTrackCommand() {
       "object-frames | "
       "overlap F (track / single frame) | joined / split | reused / region | "
       "ms per "
-      "frame (track / fresh) | cost | changed first (track / fresh) "
+      "frame (track / fresh) | cost (median / total) | changed first (track / "
+      "fresh) "
       "|\n|---|---|---|---|---|---|---|---|---|---|---|\n");
   // Runs and prints one kind's figures; false on error.
   const auto report = [&](const absl::StatusOr<TrackFigures>& f) {
@@ -135,13 +136,14 @@ int RunTrackCommand() {
         "| %s | %d | %d | %.3f (%.3f) | %.2f | %.3f / %.3f | %lld / %lld | "
         "%.2f / %.2f | "
         "%.1f / "
-        "%.1f | %.2fx | %s |\n",
+        "%.1f | %.2fx / %.2fx | %s |\n",
         f->kind.c_str(), f->sequences, f->frames, Idf1(f->identities),
         DetectionF1(*f), switches, f->overlap_f, f->single_frame_f,
         static_cast<long long>(f->joined), static_cast<long long>(f->split),
         f->reused_fraction, f->region_fraction, f->median_track_ms,
         f->median_fresh_ms,
         f->median_fresh_ms > 0 ? f->median_track_ms / f->median_fresh_ms : 0.0,
+        f->total_cost,
         f->change_frames == 0
             ? "-"
             : absl::StrFormat("%d / %d of %d", f->changed_first,
@@ -156,13 +158,13 @@ int RunTrackCommand() {
           "%.4f,\"joined\":%lld,\"split\":%lld,\"reused\":%.3f,"
           "\"region\":%.3f,"
           "\"track_ms\":%.2f,"
-          "\"fresh_ms\":%.2f,\"change_frames\":%d,\"changed_first\":%d,"
-          "\"fresh_changed_first\":%d}\n",
+          "\"fresh_ms\":%.2f,\"total_cost\":%.3f,\"change_frames\":%d,"
+          "\"changed_first\":%d,\"fresh_changed_first\":%d}\n",
           f->kind.c_str(), f->sequences, f->frames, Idf1(f->identities),
           DetectionF1(*f), switches, f->overlap_f, f->single_frame_f,
           static_cast<long long>(f->joined), static_cast<long long>(f->split),
           f->reused_fraction, f->region_fraction, f->median_track_ms,
-          f->median_fresh_ms, f->change_frames, f->changed_first,
+          f->median_fresh_ms, f->total_cost, f->change_frames, f->changed_first,
           f->fresh_changed_first);
     }
     return true;

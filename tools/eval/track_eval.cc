@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <numeric>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -430,7 +431,15 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
   }
   figures.median_track_ms = Median(track_ms);
   figures.median_fresh_ms = Median(fresh_ms);
+  figures.total_cost = TotalCost(track_ms, fresh_ms);
   return figures;
+}
+
+double TotalCost(const std::vector<double>& track_ms,
+                 const std::vector<double>& fresh_ms) {
+  const double fresh = std::accumulate(fresh_ms.begin(), fresh_ms.end(), 0.0);
+  if (fresh <= 0.0) return 0.0;
+  return std::accumulate(track_ms.begin(), track_ms.end(), 0.0) / fresh;
 }
 
 }  // namespace fovea::eval

@@ -71,6 +71,11 @@ std::vector<cv::Mat> ChangedTruths(const synth::SequenceFrame& before,
 // Whether `mask` overlaps one of `truths` with IoU >= 0.5 (false when
 // empty).
 bool Covers(const cv::Mat& mask, const std::vector<cv::Mat>& truths);
+// The tracker's whole time over the fresh calls' on the same frames (0
+// when the fresh calls took none): what a stream costs, where the median
+// frame's ratio says what a typical frame does.
+double TotalCost(const std::vector<double>& track_ms,
+                 const std::vector<double>& fresh_ms);
 
 struct TrackFigures {
   std::string kind;
@@ -92,6 +97,9 @@ struct TrackFigures {
   double region_fraction = 0.0;
   double median_track_ms = 0.0;
   double median_fresh_ms = 0.0;
+  // Their sums' ratio: the stream's whole time against fresh calls' (the
+  // median hides a few full cuts among many cheap frames, or the reverse).
+  double total_cost = 0.0;
   // Frames of a still camera (the same pose as the frame before) where
   // some objects appeared or moved and others did not (ChangedTruths), and
   // of those, the frames whose first object segmented was one that
