@@ -113,7 +113,21 @@ absl::Status Validate(const TrackerOptions& options) {
         absl::StrCat("track.refine_frames: ", options.refine_frames,
                      " is not 0 or in [2, 64]"));
   }
+  if (options.refine_first_frames < 0 || options.refine_first_frames == 1 ||
+      options.refine_first_frames > 64) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("track.refine_first_frames: ", options.refine_first_frames,
+                     " is not 0 or in [2, 64]"));
+  }
   return absl::OkStatus();
+}
+
+int Tracker::RefineFrames() const {
+  if (cuts_in_view_ != 1 || options_.refine_first_frames == 0 ||
+      options_.refine_frames == 0) {
+    return options_.refine_frames;
+  }
+  return options_.refine_first_frames;
 }
 
 Tracker::Tracker(const TrackerOptions& options, const RbfSvm* relation_svm)
@@ -211,6 +225,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
     }
     tracks.clear();
     support_.reset();
+    cuts_in_view_ = 0;
   }
   // A camera known to have moved sees every pixel change: not looked at.
   const bool still = same_size && CameraStill(camera_to_world);
@@ -223,17 +238,17 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
   // the segmentation succeeds, the mean so far is left as it was (the
   // refining frame averages into a copy).
   RgbdFrame mean;
-  if (reuse && options_.refine_frames > 0 && !refined_) {
+  const int refine_frames = RefineFrames();
+  if (reuse && refine_frames > 0 && !refined_) {
     if (still_frames_ == 0) {
       still_count_ = cv::Mat(reference_.depth.size(), CV_8UC1, cv::Scalar(0));
       AverageInto(reference_.depth, reference_.depth, still_count_);
       still_frames_ = 1;
     }
-    if (still_frames_ + 1 < options_.refine_frames) {
+    if (still_frames_ + 1 < refine_frames) {
       AverageInto(frame.depth, reference_.depth, still_count_);
       ++still_frames_;
-      out.voted =
-          options_.refine_frames - still_frames_ <= options_.refine_votes;
+      out.voted = refine_frames - still_frames_ <= options_.refine_votes;
     } else {
       mean.intrinsics = frame.intrinsics;
       mean.color = reference_.color;
@@ -536,6 +551,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
     still_count_.release();
     votes_.clear();
     refined_ = out.refined;
+    cuts_in_view_ = std::min(cuts_in_view_ + 1, 2);
     reference_pose_ = camera_to_world;
     ++segmentations_;
     clock.Lap("associate");

@@ -142,6 +142,14 @@ struct TrackerOptions {
   // segmented (which the change test compares with), plus a count per
   // pixel. 0: never; else 2 to 64.
   int refine_frames = 6;
+  // The stream's first still period (and the first after a new camera) is
+  // refined after this many frames instead: everything in view then comes
+  // from one frame's cut, while later periods keep the refined objects of
+  // what did not change. Only the first: a period that ends before its
+  // refined cut paid for its votes (refine_votes applies as to
+  // refine_frames), and in a scene changed every few frames most would.
+  // 0: as refine_frames; else 2 to 64.
+  int refine_first_frames = 4;
   // The refined cut is voted on: the last refine_votes frames of the still
   // period before it are cut too, unseen (each is answered as reused), and
   // two objects of the refined cut join when most of those cuts and the
@@ -374,6 +382,11 @@ class Tracker {
   int still_frames_ = 0;
   cv::Mat still_count_;
   bool refined_ = false;
+  // Segmentations since the stream began or the camera changed: 1 during
+  // the first still period (TrackerOptions::refine_first_frames).
+  int cuts_in_view_ = 0;
+  // The still period's length before its refined cut.
+  int RefineFrames() const;
   // TrackerOptions::refine_votes: the still period's frames cut so far for
   // the vote (their objects held, CropMaskToBox).
   std::vector<std::vector<SegmentedObject>> votes_;

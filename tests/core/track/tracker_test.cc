@@ -27,10 +27,11 @@ namespace {
 
 TEST(Tracker, AStillSceneIsSegmentedOnceAndKeepsItsIdentities) {
   ASSERT_NE(Models(), nullptr);
-  const Sequence sequence = GenerateSequence(SequenceKind::kStatic, 3, 4);
+  // Three frames: the fourth is refined (refine_first_frames).
+  const Sequence sequence = GenerateSequence(SequenceKind::kStatic, 3, 3);
   std::vector<TrackedFrame> frames;
   const std::map<int, std::set<int>> tracks = Play(sequence, false, &frames);
-  ASSERT_EQ(frames.size(), 4u);
+  ASSERT_EQ(frames.size(), 3u);
   EXPECT_FALSE(frames[0].reused);
   ASSERT_FALSE(frames[0].objects.empty());
   for (size_t t = 1; t < frames.size(); ++t) {
@@ -71,16 +72,20 @@ double MeanBestF(const synth::SequenceFrame& frame,
 }
 
 TEST(Tracker, AStillSceneIsCutAgainOnceOnTheMeanOfItsFrames) {
-  // Six unchanged frames in a row: their mean is segmented at the sixth,
-  // once, and the masks fit the objects better than the first frame's,
-  // whose noise the mean averages down by sqrt(6).
+  // Six unchanged frames in a row (a still period after the stream's first:
+  // refine_first_frames 0): their mean is segmented at the sixth, once, and
+  // the masks fit the objects better than the first frame's, whose noise
+  // the mean averages down by sqrt(6).
   ASSERT_NE(Models(), nullptr);
+  TrackerOptions options;
+  options.refine_first_frames = 0;
   double first = 0.0;
   double refined = 0.0;
   for (const uint64_t seed : {1, 2, 3, 4}) {
     const Sequence sequence = GenerateSequence(SequenceKind::kStatic, seed, 9);
     std::vector<TrackedFrame> frames;
-    const std::map<int, std::set<int>> tracks = Play(sequence, false, &frames);
+    const std::map<int, std::set<int>> tracks =
+        Play(sequence, false, &frames, options);
     ASSERT_EQ(frames.size(), 9u);
     for (size_t t = 0; t < frames.size(); ++t) {
       EXPECT_EQ(frames[t].refined, t == 5) << "seed " << seed << " frame " << t;
@@ -92,7 +97,7 @@ TEST(Tracker, AStillSceneIsCutAgainOnceOnTheMeanOfItsFrames) {
   }
   // Summed over the 4 scenes: 3.36 and 3.63 when this was written.
   EXPECT_GT(refined - first, 0.12) << first << " -> " << refined;
-  // Off: cut once.
+  // Off: cut once (refine_first_frames does not turn it on).
   TrackerOptions off;
   off.refine_frames = 0;
   std::vector<TrackedFrame> frames;
@@ -102,25 +107,60 @@ TEST(Tracker, AStillSceneIsCutAgainOnceOnTheMeanOfItsFrames) {
   EXPECT_FALSE(Validate(off).ok());
   off.refine_frames = 1;
   EXPECT_FALSE(Validate(off).ok());
+  off.refine_frames = 6;
+  off.refine_first_frames = 1;
+  EXPECT_FALSE(Validate(off).ok());
+  off.refine_first_frames = 65;
+  EXPECT_FALSE(Validate(off).ok());
+}
+
+TEST(Tracker, TheStreamsFirstStillPeriodIsRefinedSooner) {
+  // Everything in view at the first still period comes from one frame's
+  // cut: it is refined at its fourth frame (refine_first_frames 4). A
+  // later still period (here, after the whole scene changed) waits six.
+  ASSERT_NE(Models(), nullptr);
+  const Sequence a = GenerateSequence(SequenceKind::kStatic, 1, 5);
+  const Sequence b = GenerateSequence(SequenceKind::kStatic, 2, 7);
+  ASSERT_EQ(a.frames[0].frame.frame.depth.size(),
+            b.frames[0].frame.frame.depth.size());
+  Tracker tracker(TrackerOptions{}, &*Models()->inc);
+  std::vector<bool> refined;
+  std::vector<bool> reused;
+  for (const Sequence* s : {&a, &b}) {
+    for (const synth::SequenceFrame& f : s->frames) {
+      const absl::StatusOr<TrackedFrame> out =
+          tracker.Process(f.frame.frame, std::nullopt);
+      ASSERT_TRUE(out.ok()) << out.status();
+      refined.push_back(out->refined);
+      reused.push_back(out->reused);
+    }
+  }
+  ASSERT_EQ(refined.size(), 12u);
+  for (size_t t = 0; t < refined.size(); ++t) {
+    EXPECT_EQ(refined[t], t == 3 || t == 10) << "frame " << t;
+    EXPECT_EQ(reused[t], t != 0 && t != 3 && t != 5 && t != 10)
+        << "frame " << t;
+  }
 }
 
 TEST(Tracker, ARefinedCutThatFailsLeavesTheStillPeriodAsItWas) {
-  // The sixth frame's refined cut is interrupted: the call fails, and the
-  // same frame sent again is refined (the sums were not consumed).
+  // The fourth frame's refined cut (the stream's first still period) is
+  // interrupted: the call fails, and the same frame sent again is refined
+  // (the sums were not consumed).
   ASSERT_NE(Models(), nullptr);
-  const Sequence sequence = GenerateSequence(SequenceKind::kStatic, 2, 6);
+  const Sequence sequence = GenerateSequence(SequenceKind::kStatic, 2, 4);
   Tracker tracker(TrackerOptions{}, &*Models()->inc);
-  for (int t = 0; t < 5; ++t) {
+  for (int t = 0; t < 3; ++t) {
     ASSERT_TRUE(
         tracker.Process(sequence.frames[t].frame.frame, std::nullopt).ok());
   }
   const absl::StatusOr<TrackedFrame> stopped =
-      tracker.Process(sequence.frames[5].frame.frame, std::nullopt,
+      tracker.Process(sequence.frames[3].frame.frame, std::nullopt,
                       [] { return absl::CancelledError("stop"); });
   EXPECT_EQ(stopped.status().code(), absl::StatusCode::kCancelled);
   EXPECT_EQ(tracker.segmentations(), 1);
   const absl::StatusOr<TrackedFrame> again =
-      tracker.Process(sequence.frames[5].frame.frame, std::nullopt);
+      tracker.Process(sequence.frames[3].frame.frame, std::nullopt);
   ASSERT_TRUE(again.ok()) << again.status();
   EXPECT_TRUE(again->refined);
   EXPECT_EQ(tracker.segmentations(), 2);

@@ -33,16 +33,27 @@ std::vector<TrackedFrame> Play(const synth::Sequence& sequence,
 
 TEST(TrackerVote, AStillSceneIsCutForTheVoteOnTheFramesBeforeItsRefinedCut) {
   ASSERT_NE(Models(), nullptr);
-  // Refined at the sixth frame (refine_frames 6), voted on the two before;
-  // every frame but the first and the refined one is answered as reused.
+  // The stream's first still period is refined at its fourth frame
+  // (refine_first_frames 4), voted on the two before; every frame but the
+  // first and the refined one is answered as reused.
   const synth::Sequence sequence =
       synth::GenerateSequence(synth::SequenceKind::kStatic, 1, 9);
   const std::vector<TrackedFrame> frames = Play(sequence, TrackerOptions{});
   ASSERT_EQ(frames.size(), 9u);
   for (size_t t = 0; t < frames.size(); ++t) {
-    EXPECT_EQ(frames[t].voted, t == 3 || t == 4) << "frame " << t;
-    EXPECT_EQ(frames[t].reused, t != 0 && t != 5) << "frame " << t;
-    EXPECT_EQ(frames[t].refined, t == 5) << "frame " << t;
+    EXPECT_EQ(frames[t].voted, t == 1 || t == 2) << "frame " << t;
+    EXPECT_EQ(frames[t].reused, t != 0 && t != 3) << "frame " << t;
+    EXPECT_EQ(frames[t].refined, t == 3) << "frame " << t;
+  }
+  // Refined at the sixth (refine_frames 6, as a later still period is):
+  // voted on the fourth and fifth.
+  TrackerOptions later;
+  later.refine_first_frames = 0;
+  const std::vector<TrackedFrame> six = Play(sequence, later);
+  ASSERT_EQ(six.size(), 9u);
+  for (size_t t = 0; t < six.size(); ++t) {
+    EXPECT_EQ(six[t].voted, t == 3 || t == 4) << "frame " << t;
+    EXPECT_EQ(six[t].refined, t == 5) << "frame " << t;
   }
   // Off: refined on the mean alone.
   TrackerOptions off;
@@ -105,10 +116,13 @@ TEST(TrackerVote, TwoObjectsADepthEdgeSeparatesAreNotJoined) {
   // lost for the seven frames after the refined cut (fovea-eval track
   // --verbose: 12 frames without a match, against 5). Most of the border
   // between them is a jump in depth beyond the sensor's noise: they stay
-  // two, and every object is matched once refined.
+  // two, and every object is matched once refined. (Refined at the sixth
+  // frame, as a later still period is: refine_first_frames 0.)
   const synth::Sequence sequence =
       synth::GenerateSequence(synth::SequenceKind::kStatic, 162, 12);
-  const std::vector<TrackedFrame> frames = Play(sequence, TrackerOptions{});
+  TrackerOptions options;
+  options.refine_first_frames = 0;
+  const std::vector<TrackedFrame> frames = Play(sequence, options);
   ASSERT_EQ(frames.size(), 12u);
   ASSERT_TRUE(frames[5].refined);
   for (size_t t = 5; t < frames.size(); ++t) {
@@ -124,15 +138,18 @@ TEST(TrackerVote, AnObjectTheMeanLeavesInTwoComesWholeByTheVote) {
   // --kinds osd-noise` plays it): the cut of the mean of its first six
   // frames leaves one of its two objects in two masks, one of which
   // matches nothing; most of the first frame's cut and the two voted
-  // frames' hold them as one, and every mask matches an object.
+  // frames' hold them as one, and every mask matches an object. (Refined
+  // at the sixth frame, as a later still period is: refine_first_frames 0.)
   absl::StatusOr<LabelledFrame> scene = LoadOsdPcd(dir + "/learn/learn5.pcd");
   ASSERT_TRUE(scene.ok()) << scene.status();
   const synth::Sequence sequence =
       synth::ReplayAsSequence(*scene, synth::ReplayKind::kNoise, 6, 12);
-  TrackerOptions off;
+  TrackerOptions options;
+  options.refine_first_frames = 0;
+  TrackerOptions off = options;
   off.refine_votes = 0;
   const std::vector<TrackedFrame> mean_alone = Play(sequence, off);
-  const std::vector<TrackedFrame> voted = Play(sequence, TrackerOptions{});
+  const std::vector<TrackedFrame> voted = Play(sequence, options);
   ASSERT_EQ(voted.size(), 12u);
   ASSERT_EQ(mean_alone.size(), 12u);
   ASSERT_TRUE(voted[5].refined);
