@@ -245,10 +245,11 @@ bool HeldAsOne(const std::vector<SegmentedObject>& cut,
 
 BorderJumps CountBorderJumps(const SegmentedObject& a, const SegmentedObject& b,
                              const cv::Mat& depth,
-                             const std::function<bool(float, float)>& jump) {
+                             const std::function<bool(float, float)>& jump,
+                             int reach) {
   BorderJumps out;
   const cv::Rect frame(0, 0, depth.cols, depth.rows);
-  const cv::Rect near = Grown(a.box, 1) & Grown(b.box, 1) & frame;
+  const cv::Rect near = Grown(a.box, reach) & Grown(b.box, reach) & frame;
   const auto pair = [&](int u, int v, int u2, int v2) {
     const bool ab = a.mask.at<uint8_t>(v, u) && b.mask.at<uint8_t>(v2, u2);
     const bool ba = b.mask.at<uint8_t>(v, u) && a.mask.at<uint8_t>(v2, u2);
@@ -261,8 +262,10 @@ BorderJumps CountBorderJumps(const SegmentedObject& a, const SegmentedObject& b,
   };
   for (int v = near.y; v < near.y + near.height; ++v) {
     for (int u = near.x; u < near.x + near.width; ++u) {
-      if (u + 1 < frame.width) pair(u, v, u + 1, v);
-      if (v + 1 < frame.height) pair(u, v, u, v + 1);
+      for (int d = 1; d <= reach; ++d) {
+        if (u + d < frame.width) pair(u, v, u + d, v);
+        if (v + d < frame.height) pair(u, v, u, v + d);
+      }
     }
   }
   return out;

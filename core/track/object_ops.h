@@ -117,16 +117,19 @@ int JoinWhereMostHoldAsOne(
         may_join,
     std::vector<SegmentedObject>& found);
 
-// Of the pairs of 4-neighbour pixels one on `a`, the other on `b` (masks at
-// the frame's size), both with depth in `depth` (CV_32FC1): how many, and
-// how many `jump` says differ.
+// Of the pairs of pixels in a row or a column at most `reach` apart (1:
+// 4-neighbours), one on `a`, the other on `b` (masks at the frame's size),
+// both with depth in `depth` (CV_32FC1): how many, and how many `jump` says
+// differ. A reach beyond 1 sees across a gap of reach - 1 pixels between
+// the two.
 struct BorderJumps {
   int pairs = 0;
   int jumps = 0;
 };
 BorderJumps CountBorderJumps(const SegmentedObject& a, const SegmentedObject& b,
                              const cv::Mat& depth,
-                             const std::function<bool(float, float)>& jump);
+                             const std::function<bool(float, float)>& jump,
+                             int reach = 1);
 
 // Whether two held objects (CropMaskToBox) of a frame of `size` touch, as
 // Touch's.

@@ -21,6 +21,7 @@ void Tracker::JoinAndSplit(
   std::vector<int>& track_of = a.track_of;
   const std::vector<Eigen::Vector3f>& displacement = a.displacement;
   std::vector<TrackState>& state = a.state;
+  const cv::Mat& a_depth = a.depth;
   std::vector<bool>& absorbed = a.absorbed;
   absorbed.assign(found.size(), false);
   std::vector<bool>& composite = a.composite;
@@ -50,6 +51,15 @@ void Tracker::JoinAndSplit(
       }
       if (!Touch(found[a].mask, found[a].box, found[b].mask, found[b].box, 3)) {
         continue;
+      }
+      // Not two objects one stands in front of: most of the border between
+      // them (as Touch sees it, across a gap of up to 3 pixels) a jump in
+      // depth.
+      if (!options_.join_across_depth_edges) {
+        const BorderJumps border = CountBorderJumps(
+            found[a], found[b], a_depth,
+            [this](float z, float z2) { return DepthChanged(z, z2); }, 4);
+        if (2 * border.jumps > border.pairs) continue;
       }
       // The larger piece's identity stays (the older's at equal size): an
       // object cut in pieces goes on as its main part, and two objects

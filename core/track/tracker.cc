@@ -448,6 +448,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
     // A refined cut replaces the last one: its parts are not joined by it.
     if (!out.refined) a.changed = changed;
     a.still = still;
+    a.depth = input.depth;
     // With a camera that moved by a known pose, what changed is told in the
     // world, and only when some object has no track.
     if (!still && same_size && camera_to_world && reference_pose_) {

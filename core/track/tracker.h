@@ -47,8 +47,9 @@ namespace fovea {
 //     its identity when its colour and size are those of a track that
 //     matched nothing (TrackerOptions::reidentify_distance).
 //   - Pieces that move rigidly together become one object: two tracks whose
-//     masks touch and that moved by the same displacement (more than
-//     moved_m, within joint_motion_m of each other) join; the larger
+//     masks touch, with no depth edge along most of the border between
+//     them, and that moved by the same displacement (more than moved_m,
+//     within joint_motion_m of each other) join; the larger
 //     one's identity stays (the older's at equal size). A joined object keeps
 //     its pieces: when INC cuts it again, a part that moved more than
 //     joint_motion_m apart from the rest (the two were separate objects swept
@@ -99,6 +100,13 @@ struct TrackerOptions {
   float match_area_ratio = 4.0f;
   float moved_m = 0.02f;
   float joint_motion_m = 0.01f;
+  // Two objects that moved together join only when most of the border
+  // between them (across a gap of up to 3 pixels) is not a jump in depth
+  // beyond the sensor's noise (DepthChanged): two objects one stands in
+  // front of are not pieces of one. True joins them all the same (as
+  // before the twenty-first session). On 30 push-apart sequences: IDF1
+  // 0.862 -> 0.897, joins 44 -> 27; drift, approach and push unchanged.
+  bool join_across_depth_edges = false;
   // The support while it fits: the plane of the last frame segmented is
   // given to the next (SupportHints::plane: no search), moved by the
   // camera's pose when given, else only when at most reuse_support_changed
@@ -285,6 +293,7 @@ class Tracker {
     // without a track (ChangedSeenFrom); empty when not known.
     cv::Mat changed;
     bool still = false;  // the camera did not move (CameraStill)
+    cv::Mat depth;       // the frame segmented (CV_32FC1)
   };
   // The rules on pieces (pieces.cc): objects that moved together and touch
   // join; an object without a track that is one of a joined track's pieces

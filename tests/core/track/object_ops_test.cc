@@ -325,6 +325,15 @@ TEST(ObjectOps, TheBorderBetweenTwoObjectsIsCountedInPairsOfNeighbours) {
   EXPECT_EQ(border.jumps, 3);
   // Squares apart share no border.
   EXPECT_EQ(CountBorderJumps(left, Sq(14, 14, 4), depth, beyond_1cm).pairs, 0);
+  // With a gap of two pixels between them (columns 6 and 7), 4-neighbours
+  // see none of it; a reach of 3 sees the pairs 3 apart across it, one a
+  // row (but for the row with no depth), all jumps.
+  const SegmentedObject gapped = Sq(8, 2, 4);
+  depth(gapped.box).setTo(1.05f);
+  EXPECT_EQ(CountBorderJumps(left, gapped, depth, beyond_1cm).pairs, 0);
+  border = CountBorderJumps(left, gapped, depth, beyond_1cm, 3);
+  EXPECT_EQ(border.pairs, 3);
+  EXPECT_EQ(border.jumps, 3);
 }
 
 }  // namespace

@@ -27,6 +27,15 @@
 namespace fovea::tracker_testing {
 namespace {
 
+// Objects swept along together join even when a depth edge separates them
+// (TrackerOptions::join_across_depth_edges): the rules on a joined track's
+// pieces, on the sequences whose pairs stand one in front of the other.
+TrackerOptions AcrossDepthEdges() {
+  TrackerOptions options;
+  options.join_across_depth_edges = true;
+  return options;
+}
+
 // The ground-truth objects of `frame` with their pixel centroids.
 std::map<int, cv::Point2d> TruthCentroids(const synth::SequenceFrame& frame) {
   std::map<int, std::pair<cv::Point2d, int>> sums;
@@ -112,8 +121,12 @@ TEST(Tracker, PartsSweptTogetherSplitWhenTheyMoveApart) {
   ASSERT_EQ(pair.size(), 2u);
   ASSERT_GE(stays, 0);
 
+  // The pair stands one in front of the other: joined only when depth
+  // edges do not keep them apart (the default since: see
+  // TwoObjectsADepthEdgeSeparatesDoNotJoinWhenSweptAlong).
   std::vector<TrackedFrame> frames;
-  const std::map<int, std::set<int>> tracks = Play(sequence, true, &frames);
+  const std::map<int, std::set<int>> tracks =
+      Play(sequence, true, &frames, AcrossDepthEdges());
   const auto [joined, split] = JoinedAndSplit(frames);
   EXPECT_GT(joined, 0);  // what moved as one was one object
   EXPECT_GT(split, 0);
@@ -167,11 +180,12 @@ TEST(Tracker, TwoObjectsSweptAlongAsOneGoOnAsTheLargerOfThem) {
   // identity through the join and the split. When the older identity was
   // kept instead (here the smaller one's), the larger object's changed at
   // the join and back at the split (2 switches).
+  // (Joined only when depth edges do not keep them apart.)
   const Sequence sequence = GenerateSequence(SequenceKind::kPushApart, 25, 12);
   const std::vector<int> pair = SweptPair(sequence);
   ASSERT_EQ(pair.size(), 2u);
   std::vector<TrackedFrame> frames;
-  Play(sequence, true, &frames);
+  Play(sequence, true, &frames, AcrossDepthEdges());
   int checked = 0;
   for (size_t t = 1; t < frames.size(); ++t) {
     if (frames[t].joined == 0) continue;
@@ -234,10 +248,12 @@ TEST(Tracker, AHiddenPieceIsCarriedAlongUntilItsPartComesBack) {
   // object of the frame is its piece (the track's mask holds the large
   // one only), and at frame 4 it is found alone again. Its piece is
   // carried along meanwhile, so it comes back under its identity. When the
-  // pieces were only those of the frame, it came back new.
+  // pieces were only those of the frame, it came back new. (Joined only
+  // when depth edges do not keep the two apart: by default it is not, and
+  // comes back new.)
   const Sequence sequence = GenerateSequence(SequenceKind::kPushApart, 16, 12);
   std::vector<TrackedFrame> frames;
-  Play(sequence, true, &frames);
+  Play(sequence, true, &frames, AcrossDepthEdges());
   const std::map<int, int> first =
       IdsOfTruths(sequence.frames[1], frames[1], {0});
   ASSERT_EQ(first.size(), 1u);
@@ -258,9 +274,10 @@ TEST(Tracker, AHiddenPieceIsCarriedAlongUntilItsPartComesBack) {
 
 // The identities that truth `truth` of the `kind` sequence `seed` (12
 // frames, the pose sent) had (Play); none when it was never found.
-std::set<int> IdentitiesOfTruth(SequenceKind kind, int seed, int truth) {
+std::set<int> IdentitiesOfTruth(SequenceKind kind, int seed, int truth,
+                                const TrackerOptions& options = {}) {
   const std::map<int, std::set<int>> tracks =
-      Play(GenerateSequence(kind, seed, 12), true);
+      Play(GenerateSequence(kind, seed, 12), true, nullptr, options);
   const auto it = tracks.find(truth);
   return it == tracks.end() ? std::set<int>() : it->second;
 }
@@ -273,7 +290,12 @@ TEST(Tracker, ASmallPartPushedAlongIsToldByItsPieceMovedWithTheRest) {
   // piece was seen, overlapped it no longer, and came back as a new object
   // (identities 3, 4, 5, 3: three switches). Found among the pieces moved
   // as the large one moved, it joins again, and keeps one identity.
-  EXPECT_EQ(IdentitiesOfTruth(SequenceKind::kPushApart, 41, 2).size(), 1u);
+  // (Joined only when depth edges do not keep the two apart: by default
+  // it is joined later, and comes back new once.)
+  EXPECT_EQ(IdentitiesOfTruth(SequenceKind::kPushApart, 41, 2,
+                              AcrossDepthEdges())
+                .size(),
+            1u);
 }
 
 TEST(Tracker, AnUnchangedObjectCutInTwoIsOnePieceAndKeepsItsIdentity) {
@@ -381,6 +403,28 @@ TEST(Tracker, PartsThatMovedApartFromAnUnmatchedJoinedTrackTakeTheirPieces) {
   ASSERT_EQ(pair.size(), 2u);
   const std::map<int, std::set<int>> tracks = Play(sequence, true);
   ExpectOneIdentityEach(tracks, pair);
+}
+
+TEST(Tracker, TwoObjectsADepthEdgeSeparatesDoNotJoinWhenSweptAlong) {
+  // push-apart seed 14: two objects swept along side by side, then one
+  // pulled back. Most of the border between them is a jump in depth (one
+  // stands in front of the other), so they are not taken for pieces of one
+  // object and not joined: each keeps one identity throughout. Joined, the
+  // pair went on as one and the smaller lost its identity (fovea-eval
+  // track --verbose: 2 switches, 14 frames of a truth unmatched).
+  ASSERT_NE(Models(), nullptr);
+  const Sequence sequence = GenerateSequence(SequenceKind::kPushApart, 14, 12);
+  const std::vector<int> pair = SweptPair(sequence);
+  ASSERT_EQ(pair.size(), 2u);
+  const std::map<int, std::set<int>> tracks = Play(sequence, true);
+  ASSERT_EQ(tracks.size(), sequence.frames[0].object_ids.size());
+  for (const auto& [truth, ids] : tracks) {
+    EXPECT_EQ(ids.size(), 1u) << "object " << truth;
+  }
+  // Joined all the same, the smaller of the pair loses its identity.
+  const std::map<int, std::set<int>> joined =
+      Play(sequence, true, nullptr, AcrossDepthEdges());
+  EXPECT_GT(joined.at(pair[0]).size() + joined.at(pair[1]).size(), 2u);
 }
 
 }  // namespace
