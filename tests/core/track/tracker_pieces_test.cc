@@ -292,10 +292,10 @@ TEST(Tracker, ASmallPartPushedAlongIsToldByItsPieceMovedWithTheRest) {
   // as the large one moved, it joins again, and keeps one identity.
   // (Joined only when depth edges do not keep the two apart: by default
   // it is joined later, and comes back new once.)
-  EXPECT_EQ(IdentitiesOfTruth(SequenceKind::kPushApart, 41, 2,
-                              AcrossDepthEdges())
-                .size(),
-            1u);
+  EXPECT_EQ(
+      IdentitiesOfTruth(SequenceKind::kPushApart, 41, 2, AcrossDepthEdges())
+          .size(),
+      1u);
 }
 
 TEST(Tracker, AnUnchangedObjectCutInTwoIsOnePieceAndKeepsItsIdentity) {
