@@ -21,7 +21,7 @@ void Tracker::JoinAndSplit(
   std::vector<int>& track_of = a.track_of;
   const std::vector<Eigen::Vector3f>& displacement = a.displacement;
   std::vector<TrackState>& state = a.state;
-  const cv::Mat& a_depth = a.depth;
+  const cv::Mat& depth = a.depth;
   std::vector<bool>& absorbed = a.absorbed;
   absorbed.assign(found.size(), false);
   std::vector<bool>& composite = a.composite;
@@ -52,14 +52,11 @@ void Tracker::JoinAndSplit(
       if (!Touch(found[a].mask, found[a].box, found[b].mask, found[b].box, 3)) {
         continue;
       }
-      // Not two objects one stands in front of: most of the border between
-      // them (as Touch sees it, across a gap of up to 3 pixels) a jump in
-      // depth.
-      if (!options_.join_across_depth_edges) {
-        const BorderJumps border = CountBorderJumps(
-            found[a], found[b], a_depth,
-            [this](float z, float z2) { return DepthChanged(z, z2); }, 4);
-        if (2 * border.jumps > border.pairs) continue;
+      // Not two objects one stands in front of (across the gap of up to 3
+      // pixels that Touch allows).
+      if (!options_.join_across_depth_edges &&
+          DepthEdgeBetween(found[a], found[b], depth, 4)) {
+        continue;
       }
       // The larger piece's identity stays (the older's at equal size): an
       // object cut in pieces goes on as its main part, and two objects

@@ -319,6 +319,13 @@ class Tracker {
   // Whether depth `z` moved from `z0` (both > 0) by more than
   // max(change_min_m, change_sigmas sigma(z0)).
   bool DepthChanged(float z, float z0) const;
+  // Whether two objects (masks at the frame's size) are two that one stands
+  // in front of: along more than half of the border between them (pixel
+  // pairs up to `reach` apart: CountBorderJumps) `depth` jumps
+  // (DepthChanged). Guards the vote's joins and those of pieces that moved
+  // together.
+  bool DepthEdgeBetween(const SegmentedObject& a, const SegmentedObject& b,
+                        const cv::Mat& depth, int reach) const;
   // With a camera that moved by a known pose (`pose`, the last frame
   // segmented's known): the pixels of `frame` within `area` whose point,
   // moved into the last frame's view, falls where that frame saw no depth or
@@ -394,8 +401,6 @@ class Tracker {
   // Segmentations since the stream began or the camera changed: 1 during
   // the first still period (TrackerOptions::refine_first_frames).
   int cuts_in_view_ = 0;
-  // The still period's length before its refined cut.
-  int RefineFrames() const;
   // TrackerOptions::refine_votes: the still period's frames cut so far for
   // the vote (their objects held, CropMaskToBox).
   std::vector<std::vector<SegmentedObject>> votes_;
@@ -403,6 +408,9 @@ class Tracker {
   // (CV_8UC1) counts the frames averaged at each pixel. `depth` may be
   // `mean` itself (with `count` 0: counts its pixels with depth).
   static void AverageInto(const cv::Mat& depth, cv::Mat& mean, cv::Mat& count);
+  // The still period's length before its refined cut: refine_frames, or
+  // refine_first_frames in the first still period (cuts_in_view_ 1).
+  int RefineFrames() const;
 };
 
 }  // namespace fovea

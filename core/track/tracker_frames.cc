@@ -215,15 +215,21 @@ void Tracker::JoinAsVoted(const std::vector<Track>& tracks,
     cuts.push_back(std::move(vote));
   }
   votes_.clear();
-  // Not two objects one occludes: most of the border between them a jump
-  // in depth beyond the sensor's noise.
+  // Not two objects one occludes (4-neighbours across their border).
   const auto may_join = [&](const SegmentedObject& a,
                             const SegmentedObject& b) {
-    const BorderJumps border = CountBorderJumps(
-        a, b, depth, [this](float z, float z2) { return DepthChanged(z, z2); });
-    return 2 * border.jumps <= border.pairs;
+    return !DepthEdgeBetween(a, b, depth, 1);
   };
   JoinWhereMostHoldAsOne(cuts, may_join, found);
+}
+
+bool Tracker::DepthEdgeBetween(const SegmentedObject& a,
+                               const SegmentedObject& b, const cv::Mat& depth,
+                               int reach) const {
+  const BorderJumps border = CountBorderJumps(
+      a, b, depth, [this](float z, float z2) { return DepthChanged(z, z2); },
+      reach);
+  return 2 * border.jumps > border.pairs;
 }
 
 absl::StatusOr<bool> Tracker::SegmentRegion(
