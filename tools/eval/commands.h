@@ -24,12 +24,13 @@ std::optional<DetectOptions> DetectOptionsFromFlags();
 // message. segment_command.cc.
 std::optional<std::vector<LabelledFrame>> ScenesFromFlags();
 
-int RunDetectEval();    // detect_command.cc
-int RunSegmentEval();   // segment_command.cc
-int RunRoomsCommand();  // rooms_command.cc
-int RunRawCommand();    // rooms_command.cc
-int RunSweepCommand();  // rooms_command.cc
-int RunTrackCommand();  // track_command.cc
+int RunDetectEval();      // detect_command.cc
+int RunSegmentEval();     // segment_command.cc
+int RunRoomsCommand();    // rooms_command.cc
+int RunRawCommand();      // rooms_command.cc
+int RunSweepCommand();    // rooms_command.cc
+int RunTrackCommand();    // track_command.cc
+int RunRealismCommand();  // realism_command.cc
 
 }  // namespace fovea::eval
 

@@ -276,6 +276,13 @@ std::vector<Command> Commands() {
        "synthetic frame streams with identities: IDF1, switches, overlap F "
        "beside single-frame INC, cost per frame",
        [](const std::vector<char*>&) { return RunTrackCommand(); }},
+      {"realism",
+       "[--data DIR] [--realsense DIR] [--synthetic 20] [--json] "
+       "[--verbose]",
+       "synthetic frames of each sensor against its real ones: depth noise "
+       "against range, missing depth, normals, the table scene, patches and "
+       "relation features; one KS distance per statistic",
+       [](const std::vector<char*>&) { return RunRealismCommand(); }},
       {"scorecard",
        "[--short] [--sets osd,...] [--methods inc,cos] [--baseline "
        "docs/scorecard.json] [--write_json F] [--out DIR]",
