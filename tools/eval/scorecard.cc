@@ -22,6 +22,7 @@
 #include "core/pipeline/incremental.h"
 #include "core/segmentation/relations.h"
 #include "core/segmentation/svm_training.h"
+#include "core/synth/osd_crop.h"
 #include "core/synth/room.h"
 #include "core/synth/stacked_scene.h"
 #include "core/synth/synth_scene.h"
@@ -309,11 +310,17 @@ absl::Status RunSyntheticSets(const SetContext& ctx) {
   }
   const synth::RoomSensor sensors[] = {synth::RoomSensor::kKinectV1,
                                        synth::RoomSensor::kActiveStereo};
-  if (Wants(o, "stacked")) {
+  // The stacked piles as generated, and with OSD's crop (the table seen
+  // only in front of the pile's middle).
+  const std::pair<std::string,
+                  synth::StackedPile (*)(uint64_t, synth::RoomSensor)>
+      stacked_sets[] = {{"stacked", &synth::GenerateStackedPile},
+                        {"stacked-crop", &synth::GenerateCroppedPile}};
+  for (const auto& [set, generate] : stacked_sets) {
+    if (!Wants(o, set)) continue;
     for (const synth::RoomSensor sensor : sensors) {
       for (int k = 0; k < o.stacked; ++k) {
-        const synth::StackedPile pile =
-            synth::GenerateStackedPile(1 + k, sensor);
+        const synth::StackedPile pile = generate(1 + k, sensor);
         // Object k has label 10 (k + 2), ObjectId k + 2.
         const auto describe = [&pile](int id) {
           const int k = id - 2;
@@ -326,7 +333,7 @@ absl::Status RunSyntheticSets(const SetContext& ctx) {
                          : std::string(synth::StackedKindName(pile.kinds[on])));
         };
         FOVEA_RETURN_IF_ERROR(ScoreLabelledScene(
-            ctx, "stacked", std::string(synth::RoomSensorName(sensor)),
+            ctx, set, std::string(synth::RoomSensorName(sensor)),
             pile.scene.frame, models, describe));
       }
     }
