@@ -8,6 +8,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/base/parallel.h"
 #include "core/scene/hull_lookup.h"
+#include "core/scene/table_scene_internal.h"
 
 namespace fovea {
 
@@ -35,6 +36,16 @@ absl::Status Validate(const TableSceneOptions& options) {
     return absl::InvalidArgumentError(
         "table_scene.structure_tolerance_deg must be in [0, 90], "
         "structure_min_area_m2 and structure_max_planes >= 0");
+  }
+  if (!(options.rest_beyond_hull_m >= 0.0f)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("table_scene.rest_beyond_hull_m must be >= 0, got ",
+                     options.rest_beyond_hull_m));
+  }
+  if (!(options.max_resting_size_m > 0.0f)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("table_scene.max_resting_size_m must be > 0, got ",
+                     options.max_resting_size_m));
   }
   if (!(options.hull_margin >= 0.0f)) {
     return absl::InvalidArgumentError(absl::StrCat(
@@ -134,6 +145,10 @@ std::vector<TableScene::Plane> FindStructures(const OrganizedCloud& cloud,
   return structures;
 }
 
+}  // namespace
+
+namespace table_scene_internal {
+
 // Whether p (normal m, NaN when none) lies on one of the structures.
 bool OnStructure(const std::vector<TableScene::Plane>& structures,
                  const Eigen::Vector3f& p, const cv::Vec3f& m,
@@ -149,7 +164,10 @@ bool OnStructure(const std::vector<TableScene::Plane>& structures,
   return false;
 }
 
-}  // namespace
+}  // namespace table_scene_internal
+
+using table_scene_internal::AddWhatRestsBeyondHull;
+using table_scene_internal::OnStructure;
 
 TableScene PrepareTableScene(const OrganizedCloud& cloud,
                              const SupportPlane& plane,
@@ -214,6 +232,7 @@ TableScene PrepareTableScene(const OrganizedCloud& cloud,
     }
   });
   for (const int c : candidates) scene.candidate_count += c;
+  AddWhatRestsBeyondHull(cloud, plane, options, scene);
   return scene;
 }
 

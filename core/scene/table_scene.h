@@ -20,10 +20,13 @@ namespace fovea {
 //              its boundary. Only these get saliency.
 //   standing:  CV_8UC1, 255 where a point stands on the table as a
 //              candidate does, but with no margin inside the hull (the
-//              candidates' superset).
+//              candidates' superset); and on what rests on the table
+//              beyond the hull (TableSceneOptions::rest_beyond_hull_m),
+//              which is a candidate too.
 //   region:    CV_8UC1, 255 on the support region (SupportPlane::inliers)
 //              and on what may stand on it: points below max_object_height
-//              whose projection lies inside the hull. Everything else
+//              whose projection lies inside the hull, and what rests on
+//              the table beyond it (as standing). Everything else
 //              (floor, walls, other tables, chairs beside it) is outside
 //              the scene segmentation works on.
 //   structures: large vertical planes that extend beyond what can stand on
@@ -69,6 +72,31 @@ struct TableSceneOptions {
   float structure_tolerance_deg = 15.0f;
   float structure_min_area_m2 = 0.15f;
   int structure_max_planes = 3;
+  // What rests on the table beyond the hull of the table the camera sees:
+  // where books, trays and objects cover most of a table, or the table's
+  // far end is cut off (OSD's crop), the visible top is a few fragments
+  // and the objects behind them project outside their hull. Points above
+  // the table (as candidates, within max_object_height, on no structure)
+  // outside the hull but at most this far from it in the plane join the
+  // scene (region, standing and candidate) when they are connected in the
+  // image, without a jump in depth, to candidates (hull_margin inside it,
+  // so not through a wall rising at the table's edge): the pile is one
+  // scene, whatever of the table shows, metres (a
+  // book's width and a half; 0 disables).
+  float rest_beyond_hull_m = 0.35f;
+  // ... and so do parts (connected without a jump in depth, within that
+  // reach, followed through their feet at the table's level) that touch
+  // nothing in the scene but stand on the table where the camera does not
+  // see it: their lowest point within 2 cm of the height where the table
+  // ends, at most max_resting_size_m across in the plane (the support
+  // search's object size: larger is furniture, a wall above the table's
+  // back edge), bordering no visible table top (what does stands behind
+  // the table's edge or on another table) and not going on beyond the
+  // reach or above max_object_height. Parts that the candidates reach are
+  // held to the same size, and to 60 pixels at 640 x 480 at least (the
+  // specks of a wall that its depth noise carries inside the hull).
+  bool rest_on_hidden_table = true;
+  float max_resting_size_m = 0.5f;
 };
 
 absl::Status Validate(const TableSceneOptions& options);
