@@ -337,14 +337,15 @@ absl::Status Validate(const NoiseOptions& options) {
 NoiseOptions KinectV1Noise() {
   NoiseOptions noise;
   noise.shadow_baseline_m = 0.075f;
+  noise.noise_correlation_px = 2.0f;
   return noise;
 }
 
 NoiseOptions ActiveStereoNoise() {
   NoiseOptions noise;
-  noise.sigma0_m = 0.001f;
-  noise.sigma_per_z2 = 2.5e-3f;
-  noise.noise_correlation_px = 1.5f;
+  noise.sigma0_m = 0.0005f;
+  noise.sigma_per_z2 = 1.25e-3f;
+  noise.noise_correlation_px = 3.0f;
   noise.baseline_m = 0.05f;
   noise.disparity_step_px = 0.05f;
   noise.edge_dropout_px = 1;

@@ -163,9 +163,15 @@ struct NoiseOptions {
 // baseline or disparity step, probabilities outside [0, 1]).
 absl::Status Validate(const NoiseOptions& options);
 
-// The two sensors rooms are rendered with. Kinect v1: the defaults above
-// with its projector's shadow (7.5 cm baseline). Active stereo (RealSense
-// D4xx-like): sigma 1 mm + 2.5e-3 z^2 correlated over 1.5 px, sub-pixel
+// The two sensors rooms are rendered with, each measured against the
+// sensor's real frames (`fovea-eval realism`, docs/realism.md). Kinect v1:
+// the defaults above with its projector's shadow (7.5 cm baseline) and the
+// noise correlated over 2 px (the structured light's correlation window:
+// uncorrelated, the table's normals spread 1.0 degree against OSD's 2.8;
+// now 3.2). Active stereo (RealSense D4xx-like): sigma 0.5 mm + 1.25e-3 z^2
+// correlated over 3 px (the four RealSense frames: 0.36-0.48 mm about an
+// 8 px cell's plane at 0.4-1.4 m and normals spread 4.7 degrees; 1 mm +
+// 2.5e-3 z^2 over 1.5 px gave 0.8-1.8 mm and 7.5 degrees), sub-pixel
 // disparity steps of 1/20 px over a 5 cm baseline, shadows and the left
 // border band, dark surfaces losing depth more often.
 NoiseOptions KinectV1Noise();
