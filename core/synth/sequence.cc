@@ -215,7 +215,8 @@ Sequence GenerateSequence(SequenceKind kind, uint64_t seed, int frames) {
     SequenceFrame frame;
     const SceneSpec spec = WithObjects(moved, present, frame.object_ids);
     frame.camera_to_world = spec.camera_pose;
-    SynthScene scene = RenderScene(spec, KinectV1Noise(), seed * 1000 + t);
+    SynthScene scene =
+        RenderScene(spec, IndependentKinectV1Noise(), seed * 1000 + t);
     frame.frame = std::move(scene.frame);
     frame.frame.name = absl::StrCat(sequence.name, "-", t);
     sequence.frames.push_back(std::move(frame));

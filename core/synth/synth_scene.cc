@@ -341,6 +341,12 @@ NoiseOptions KinectV1Noise() {
   return noise;
 }
 
+NoiseOptions IndependentKinectV1Noise() {
+  NoiseOptions noise = KinectV1Noise();
+  noise.noise_correlation_px = 0.0f;
+  return noise;
+}
+
 NoiseOptions ActiveStereoNoise() {
   NoiseOptions noise;
   noise.sigma0_m = 0.0005f;
