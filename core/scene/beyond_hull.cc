@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "core/base/parallel.h"
 #include "core/scene/table_scene_internal.h"
 
 namespace fovea::table_scene_internal {
@@ -111,6 +112,30 @@ bool AtFootLevel(const OrganizedCloud& cloud, const SupportPlane& plane,
          o.rest_beyond_hull_m;
 }
 
+// What each pixel is to the search beyond the hull, computed once: kAbove
+// where it may rest beyond the hull (MayRestBeyondHull), kFoot where it is
+// at the table's level there (AtFootLevel), else kNotResting. CV_8UC1.
+enum RestKind : uint8_t { kNotResting = 0, kAbove = 1, kFoot = 2 };
+cv::Mat ClassifyBeyondHull(const OrganizedCloud& cloud,
+                           const SupportPlane& plane,
+                           const TableSceneOptions& options,
+                           const TableScene& scene) {
+  cv::Mat kind(cloud.height(), cloud.width(), CV_8UC1, cv::Scalar(0));
+  ParallelForRanges(cloud.height(), [&](int begin, int end) {
+    for (int v = begin; v < end; ++v) {
+      uint8_t* k = kind.ptr<uint8_t>(v);
+      for (int u = 0; u < cloud.width(); ++u) {
+        if (MayRestBeyondHull(cloud, plane, options, scene, u, v)) {
+          k[u] = kAbove;
+        } else if (AtFootLevel(cloud, plane, options, scene, cv::Point(u, v))) {
+          k[u] = kFoot;
+        }
+      }
+    }
+  });
+  return kind;
+}
+
 // Whether `part` (a depth-connected part of the points that may rest beyond
 // the hull) is bounded as an object on a hidden table is: no pixel
 // 4-adjacent to it shows a table top (the support's inliers, or a surface
@@ -182,44 +207,61 @@ bool StandsOnTheTable(const OrganizedCloud& cloud, const SupportPlane& plane,
 }
 
 // The points beyond the hull that rest on the table through the candidates
-// (TableSceneOptions::rest_beyond_hull_m): a flood fill over 4-neighbours
-// without a depth jump. Seeds are the candidates' interiors (the mask
-// opened by kRestSeedOpening px), hull_margin inside the hull: not every
-// standing point, since a wall rising at the table's edge stands on the
-// hull's boundary, and not the specks of such a wall that its depth noise
-// carries inside the hull. The fill passes through the other standing
-// points (an object's outer 2 cm) without taking them. CV_8UC1, 255 on the
-// points taken.
-cv::Mat GrowBeyondHull(const OrganizedCloud& cloud, const SupportPlane& plane,
-                       const TableSceneOptions& options,
-                       const TableScene& scene) {
+// (TableSceneOptions::rest_beyond_hull_m): the parts of them connected,
+// over 4-neighbours without a depth jump and through standing points (an
+// object's outer 2 cm, which are not taken), to a seed. Seeds are the
+// candidates' interiors (the mask opened by kRestSeedOpening px),
+// hull_margin inside the hull: not every standing point, since a wall
+// rising at the table's edge stands on the hull's boundary, and not the
+// specks of such a wall that its depth noise carries inside the hull. The
+// fill starts from the points beyond the hull, so that it costs what lies
+// there, not what stands on the table. CV_8UC1, 255 on the points taken.
+cv::Mat GrowBeyondHull(const OrganizedCloud& cloud, const TableScene& scene,
+                       const cv::Mat& kind) {
   const int w = cloud.width(), h = cloud.height();
   cv::Mat grown(h, w, CV_8UC1, cv::Scalar(0));
-  cv::Mat reached;
-  cv::morphologyEx(scene.candidate, reached, cv::MORPH_OPEN,
+  cv::Mat seeds;
+  cv::morphologyEx(scene.candidate, seeds, cv::MORPH_OPEN,
                    cv::getStructuringElement(
                        cv::MORPH_RECT, cv::Size(2 * kRestSeedOpening + 1,
                                                 2 * kRestSeedOpening + 1)));
-  std::vector<cv::Point> frontier;
-  cv::findNonZero(reached, frontier);
+  cv::Mat visited(h, w, CV_8UC1, cv::Scalar(0));
   const int du[4] = {1, -1, 0, 0}, dv[4] = {0, 0, 1, -1};
-  while (!frontier.empty()) {
-    const cv::Point at = frontier.back();
-    frontier.pop_back();
-    const float z = cloud.xyz.at<cv::Vec3f>(at.y, at.x)[2];
-    const float step = std::max(kRestDepthStep, kRestDepthFraction * z);
-    for (int k = 0; k < 4; ++k) {
-      const int u = at.x + du[k], v = at.y + dv[k];
-      if (u < 0 || v < 0 || u >= w || v >= h) continue;
-      if (reached.at<uint8_t>(v, u) != 0) continue;
-      if (!(std::abs(cloud.xyz.at<cv::Vec3f>(v, u)[2] - z) <= step)) continue;
-      const bool standing = scene.standing.at<uint8_t>(v, u) != 0;
-      if (!standing && !MayRestBeyondHull(cloud, plane, options, scene, u, v)) {
-        continue;
+  std::vector<cv::Point> part, frontier;
+  for (int v0 = 0; v0 < h; ++v0) {
+    for (int u0 = 0; u0 < w; ++u0) {
+      if (visited.at<uint8_t>(v0, u0) != 0) continue;
+      if (kind.at<uint8_t>(v0, u0) != kAbove) continue;
+      visited.at<uint8_t>(v0, u0) = 255;
+      part.assign(1, cv::Point(u0, v0));
+      frontier.assign(1, cv::Point(u0, v0));
+      bool seeded = false;
+      while (!frontier.empty()) {
+        const cv::Point at = frontier.back();
+        frontier.pop_back();
+        const float z = cloud.xyz.at<cv::Vec3f>(at)[2];
+        const float step = std::max(kRestDepthStep, kRestDepthFraction * z);
+        for (int k = 0; k < 4; ++k) {
+          const int u = at.x + du[k], v = at.y + dv[k];
+          if (u < 0 || v < 0 || u >= w || v >= h) continue;
+          if (visited.at<uint8_t>(v, u) != 0) continue;
+          const float zq = cloud.xyz.at<cv::Vec3f>(v, u)[2];
+          if (!(std::abs(zq - z) <= std::max(step, kRestDepthFraction * zq))) {
+            continue;
+          }
+          const bool standing = scene.standing.at<uint8_t>(v, u) != 0;
+          if (!standing && kind.at<uint8_t>(v, u) != kAbove) continue;
+          visited.at<uint8_t>(v, u) = 255;
+          if (standing) {
+            seeded = seeded || seeds.at<uint8_t>(v, u) != 0;
+          } else {
+            part.emplace_back(u, v);
+          }
+          frontier.emplace_back(u, v);
+        }
       }
-      reached.at<uint8_t>(v, u) = 255;
-      if (!standing) grown.at<uint8_t>(v, u) = 255;
-      frontier.emplace_back(u, v);
+      if (!seeded) continue;
+      for (const cv::Point& q : part) grown.at<uint8_t>(q) = 255;
     }
   }
   return grown;
@@ -236,7 +278,8 @@ cv::Mat GrowBeyondHull(const OrganizedCloud& cloud, const SupportPlane& plane,
 void AddStandingOnHiddenTable(const OrganizedCloud& cloud,
                               const SupportPlane& plane,
                               const TableSceneOptions& options,
-                              const TableScene& scene, cv::Mat& grown) {
+                              const TableScene& scene, const cv::Mat& kind,
+                              cv::Mat& grown) {
   const int w = cloud.width(), h = cloud.height();
   const int min_pixels = std::max(1, kRestMinPixels * w / 640 * h / 480);
   cv::Mat visited = grown.clone();
@@ -248,7 +291,7 @@ void AddStandingOnHiddenTable(const OrganizedCloud& cloud,
     for (int u0 = 0; u0 < w; ++u0) {
       if (visited.at<uint8_t>(v0, u0) != 0) continue;
       visited.at<uint8_t>(v0, u0) = 255;
-      if (!MayRestBeyondHull(cloud, plane, options, scene, u0, v0)) continue;
+      if (kind.at<uint8_t>(v0, u0) != kAbove) continue;
       part.assign(1, cv::Point(u0, v0));
       above.assign(1, cv::Point(u0, v0));
       frontier.assign(1, cv::Point(u0, v0));
@@ -264,12 +307,8 @@ void AddStandingOnHiddenTable(const OrganizedCloud& cloud,
           if (!(std::abs(cloud.xyz.at<cv::Vec3f>(v, u)[2] - z) <= step)) {
             continue;
           }
-          const bool may_rest =
-              MayRestBeyondHull(cloud, plane, options, scene, u, v);
-          if (!may_rest &&
-              !AtFootLevel(cloud, plane, options, scene, cv::Point(u, v))) {
-            continue;
-          }
+          const bool may_rest = kind.at<uint8_t>(v, u) == kAbove;
+          if (!may_rest && kind.at<uint8_t>(v, u) != kFoot) continue;
           visited.at<uint8_t>(v, u) = 255;
           part.emplace_back(u, v);
           if (may_rest) above.emplace_back(u, v);
@@ -335,10 +374,11 @@ void AddWhatRestsBeyondHull(const OrganizedCloud& cloud,
                             const TableSceneOptions& options,
                             TableScene& scene) {
   if (options.rest_beyond_hull_m <= 0.0f || plane.hull.size() < 3) return;
-  cv::Mat grown = GrowBeyondHull(cloud, plane, options, scene);
+  const cv::Mat kind = ClassifyBeyondHull(cloud, plane, options, scene);
+  cv::Mat grown = GrowBeyondHull(cloud, scene, kind);
   DropPartsUnlikeObjects(cloud, plane, options, grown);
   if (options.rest_on_hidden_table) {
-    AddStandingOnHiddenTable(cloud, plane, options, scene, grown);
+    AddStandingOnHiddenTable(cloud, plane, options, scene, kind, grown);
   }
   scene.region.setTo(cv::Scalar(255), grown);
   scene.standing.setTo(cv::Scalar(255), grown);

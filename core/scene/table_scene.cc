@@ -188,6 +188,9 @@ TableScene PrepareTableScene(const OrganizedCloud& cloud,
   const HullLookup in_hull_by_margin(plane, options.hull_margin);
   // Rows in parallel ranges; each range counts its own candidates.
   std::vector<int> candidates(h, 0);
+  // Per row, the points above the table's noise band outside its hull:
+  // without any, nothing can rest beyond it and that search is skipped.
+  std::vector<int> beyond(h, 0);
   ParallelForRanges(h, [&](int begin, int end) {
     for (int v = begin; v < end; ++v) {
       const cv::Vec3f* p = cloud.xyz.ptr<cv::Vec3f>(v);
@@ -216,7 +219,10 @@ TableScene PrepareTableScene(const OrganizedCloud& cloud,
         if (hgt > options.max_object_height) continue;
         if (hgt <= min_height && (on_plane || hgt < -min_height)) continue;
         const Eigen::Vector3f q(p[u][0], p[u][1], p[u][2]);
-        if (!in_hull.Contains(q)) continue;
+        if (!in_hull.Contains(q)) {
+          if (hgt > min_height) ++beyond[v];
+          continue;
+        }
         if (!scene.structures.empty() &&
             OnStructure(scene.structures, q, normals[u], options)) {
           continue;
@@ -232,7 +238,9 @@ TableScene PrepareTableScene(const OrganizedCloud& cloud,
     }
   });
   for (const int c : candidates) scene.candidate_count += c;
-  AddWhatRestsBeyondHull(cloud, plane, options, scene);
+  if (std::any_of(beyond.begin(), beyond.end(), [](int n) { return n > 0; })) {
+    AddWhatRestsBeyondHull(cloud, plane, options, scene);
+  }
   return scene;
 }
 

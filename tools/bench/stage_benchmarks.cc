@@ -525,29 +525,42 @@ void RegisterFrameCases(
     const SweepOptions& sweep) {
   for (const auto& [name, scenes] : sets) {
     if (scenes->empty()) continue;
-    Register("BM_Frame/detect/" + name, scenes, name, sweep, kDetectMs,
-             [](const BenchScene& scene) {
-               FOVEA_ASSIGN_OR_RETURN(
-                   RgbdFrame frame,
-                   DecodeFrame(scene.raw_wire, BenchFrameLimits()));
-               absl::StatusOr<DetectResult> result =
-                   RunDetect(frame, DetectOptions{});
-               benchmark::DoNotOptimize(result);
-               return result.status();
-             });
+    // Detect, and beside it without what rests beyond the visible table's
+    // hull (TableSceneOptions::rest_beyond_hull_m 0: the table scene as it
+    // was before it): what that costs.
+    for (const bool beyond : {true, false}) {
+      DetectOptions options;
+      if (!beyond) options.table_scene.rest_beyond_hull_m = 0.0f;
+      Register(absl::StrCat("BM_Frame/detect",
+                            beyond ? "" : "_without_rest_beyond_hull", "/",
+                            name),
+               scenes, name, sweep, kDetectMs,
+               [options](const BenchScene& scene) {
+                 FOVEA_ASSIGN_OR_RETURN(
+                     RgbdFrame frame,
+                     DecodeFrame(scene.raw_wire, BenchFrameLimits()));
+                 absl::StatusOr<DetectResult> result =
+                     RunDetect(frame, options);
+                 benchmark::DoNotOptimize(result);
+                 return result.status();
+               });
+    }
     // Whole-scene INC, and beside it without the pieces within an object's
-    // footprint joining it (IncOptions::pieces_within), or without a
-    // body's cross-section in the footprint: what each costs.
+    // footprint joining it (IncOptions::pieces_within), without a body's
+    // cross-section in the footprint, or without what rests beyond the
+    // visible table's hull: what each costs.
     const struct {
       const char* suffix;
-      bool pieces, body;
-    } variants[] = {{"", true, true},
-                    {"_without_pieces", false, false},
-                    {"_without_body_footprint", true, false}};
+      bool pieces, body, beyond;
+    } variants[] = {{"", true, true, true},
+                    {"_without_pieces", false, false, true},
+                    {"_without_body_footprint", true, false, true},
+                    {"_without_rest_beyond_hull", true, true, false}};
     for (const auto& variant : variants) {
       IncrementalOptions options;
       options.inc.pieces_within.enabled = variant.pieces;
       options.inc.pieces_within.body_footprint = variant.body;
+      if (!variant.beyond) options.detect.table_scene.rest_beyond_hull_m = 0.0f;
       Register(absl::StrCat("BM_Frame/inc", variant.suffix, "/", name), scenes,
                name, sweep, kSegmentMs, [options](const BenchScene& scene) {
                  const absl::StatusOr<LoadedModels>& models = BenchModels();
