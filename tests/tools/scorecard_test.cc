@@ -133,3 +133,47 @@ TEST(ScorecardMarkdownTest, OneLinePerRowUnderAHeader) {
 
 }  // namespace
 }  // namespace fovea::eval
+
+namespace fovea::eval {
+namespace {
+
+RealismComparison Realism(const std::string& synthetic, double ks) {
+  RealismComparison c;
+  c.sensor = "kinect_v1";
+  c.real = "osd";
+  c.synthetic = synthetic;
+  RealismDistance a, b;
+  a.statistic = "plane_noise";
+  a.ks = ks;
+  b.statistic = "normal_angle";
+  b.ks = ks;
+  c.rows = {a, b};
+  return c;
+}
+
+TEST(CompareRealismRowsTest, SyntheticFramesMovingAwayFromRealOnesIsAFall) {
+  const std::string json =
+      ScorecardJson({Row("osd", "boxes", 0.95, 1.1)},
+                    {Realism("piles", 0.30), Realism("rooms", 0.40)});
+  EXPECT_NE(json.find("\"realism\""), std::string::npos);
+  // The same, and closer to the real frames: no fall.
+  EXPECT_TRUE(CompareRealismRows({Realism("piles", 0.30)}, json)->empty());
+  EXPECT_TRUE(CompareRealismRows({Realism("piles", 0.10)}, json)->empty());
+  // Piles farther by more than the margin; rooms within it.
+  absl::StatusOr<std::vector<std::string>> falls =
+      CompareRealismRows({Realism("piles", 0.30 + 2 * kRealismMargin),
+                          Realism("rooms", 0.40 + kRealismMargin / 2)},
+                         json);
+  ASSERT_TRUE(falls.ok()) << falls.status();
+  ASSERT_EQ(falls->size(), 1u);
+  EXPECT_NE((*falls)[0].find("realism/osd/piles mean_ks"), std::string::npos);
+  // A baseline without realism rows compares none.
+  EXPECT_TRUE(CompareRealismRows({Realism("piles", 0.9)},
+                                 ScorecardJson({Row("osd", "boxes", 0.9, 1.0)}))
+                  ->empty());
+  EXPECT_EQ(CompareRealismRows({}, "{not json").status().code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace fovea::eval

@@ -7,6 +7,7 @@
 #include "absl/status/statusor.h"
 #include "core/eval/uois_metrics.h"
 #include "core/pipeline/models.h"
+#include "tools/eval/realism_eval.h"
 #include "tools/eval/scene_runner.h"
 
 namespace fovea::eval {
@@ -106,6 +107,26 @@ absl::StatusOr<std::vector<ScorecardRow>> RunScorecard(
 // document {"rows": [...]} (docs/scorecard.json), numbers to 4 decimals.
 std::string ScorecardMarkdown(const std::vector<ScorecardRow>& rows);
 std::string ScorecardJson(const std::vector<ScorecardRow>& rows);
+
+// The realism rows (`fovea-eval realism`, docs/realism.md), one per
+// comparison of a real set with a synthetic one: the mean and the largest
+// KS distance over its statistics. The full scorecard runs them (set
+// `realism`); the short form does not.
+std::string RealismMarkdown(const std::vector<RealismComparison>& realism);
+// ScorecardJson with a "realism" array beside "rows": sensor, real,
+// synthetic, mean_ks, max_ks, worst.
+std::string ScorecardJson(const std::vector<ScorecardRow>& rows,
+                          const std::vector<RealismComparison>& realism);
+// A realism row's mean KS may rise by at most this before it counts as a
+// fall (the synthetic frames moved away from the real ones).
+inline constexpr double kRealismMargin = 0.02;
+// Every realism row whose mean KS rose beyond kRealismMargin above the
+// baseline's row of the same real and synthetic sets, one line each; rows
+// absent from either side, or a baseline without "realism", are not
+// compared. INVALID_ARGUMENT when the baseline does not parse.
+absl::StatusOr<std::vector<std::string>> CompareRealismRows(
+    const std::vector<RealismComparison>& realism,
+    const std::string& baseline_json);
 
 // Margins of CompareScorecard: how far a figure may move the wrong way
 // before it counts as a fall. F, ratios and recalls may fall by at most

@@ -10,10 +10,13 @@
 
 #include "absl/flags/declare.h"
 #include "absl/flags/flag.h"
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "core/pipeline/models.h"
 #include "tools/eval/commands.h"
+#include "tools/eval/realsense_frames.h"
 #include "tools/eval/scorecard.h"
 
 ABSL_DECLARE_FLAG(std::string, data);
@@ -27,8 +30,9 @@ ABSL_FLAG(bool, short, false,
           "stacked and realsense, each exactly as in the full form).");
 ABSL_FLAG(std::string, sets, "",
           "scorecard: sets to run, comma-separated (osd, osd-rot90, "
-          "osd-rot180, osd-half, piles, stacked, rooms, realsense); empty: "
-          "all (or the short form's with --short).");
+          "osd-rot180, osd-half, piles, stacked, stacked-crop, rooms, "
+          "realsense, realism); empty: all (or the short form's with "
+          "--short).");
 ABSL_FLAG(std::string, methods, "inc",
           "scorecard: methods, comma-separated (inc, cos, ebs).");
 ABSL_FLAG(int, synthetic, 0,
@@ -115,11 +119,32 @@ int RunScorecardCommand() {
       options.osd_dir.empty() ? "; no OSD data: osd sets skipped" : "",
       options.realsense_dir.empty() ? "; no RealSense frames: skipped" : "");
   std::printf("%s", ScorecardMarkdown(*rows).c_str());
+  // The realism rows: with the full form, or when --sets names them.
+  std::vector<RealismComparison> realism;
+  const bool wants_realism =
+      sets.empty()
+          ? !absl::GetFlag(FLAGS_short)
+          : absl::StrContains(absl::StrCat(",", sets, ","), ",realism,");
+  if (wants_realism &&
+      !(options.osd_dir.empty() && options.realsense_dir.empty())) {
+    RealismEvalOptions realism_options;
+    realism_options.osd_dir = options.osd_dir;
+    realism_options.realsense_dir = RealSenseDir(options.realsense_dir);
+    absl::StatusOr<std::vector<RealismComparison>> r =
+        RunRealism(realism_options);
+    if (!r.ok()) {
+      std::fprintf(stderr, "fovea-eval: realism: %s\n",
+                   r.status().ToString().c_str());
+      return kRunError;
+    }
+    realism = *std::move(r);
+    std::printf("\n%s", RealismMarkdown(realism).c_str());
+  }
   if (absl::GetFlag(FLAGS_json)) {
-    std::printf("%s\n", ScorecardJson(*rows).c_str());
+    std::printf("%s\n", ScorecardJson(*rows, realism).c_str());
   }
   if (const std::string path = absl::GetFlag(FLAGS_write_json); !path.empty()) {
-    if (!WriteText(path, ScorecardJson(*rows) + "\n")) {
+    if (!WriteText(path, ScorecardJson(*rows, realism) + "\n")) {
       std::fprintf(stderr, "fovea-eval: cannot write %s\n", path.c_str());
       return kRunError;
     }
@@ -143,10 +168,16 @@ int RunScorecardCommand() {
   text << in.rdbuf();
   absl::StatusOr<std::vector<std::string>> falls =
       CompareScorecard(*rows, text.str());
-  if (!falls.ok()) {
-    std::fprintf(stderr, "fovea-eval: %s\n", falls.status().ToString().c_str());
+  absl::StatusOr<std::vector<std::string>> realism_falls =
+      CompareRealismRows(realism, text.str());
+  if (!falls.ok() || !realism_falls.ok()) {
+    std::fprintf(stderr, "fovea-eval: %s\n",
+                 (!falls.ok() ? falls.status() : realism_falls.status())
+                     .ToString()
+                     .c_str());
     return kRunError;
   }
+  falls->insert(falls->end(), realism_falls->begin(), realism_falls->end());
   if (falls->empty()) {
     std::printf("scorecard: no figure fell beyond its margin against %s\n",
                 baseline.c_str());

@@ -68,6 +68,73 @@ std::string ScorecardMarkdown(const std::vector<ScorecardRow>& rows) {
   return out;
 }
 
+std::string RealismMarkdown(const std::vector<RealismComparison>& realism) {
+  std::string out =
+      "| realism: sensor | real | synthetic | mean KS | largest KS | "
+      "(statistic) |\n|---|---|---|---|---|---|\n";
+  for (const RealismComparison& c : realism) {
+    const RealismSummary s = SummarizeRealism(c.rows, "");
+    absl::StrAppend(
+        &out,
+        absl::StrFormat("| %s | %s | %s | %.3f | %.3f | %s |\n", c.sensor,
+                        c.real, c.synthetic, s.mean_ks, s.max_ks, s.worst));
+  }
+  return out;
+}
+
+std::string ScorecardJson(const std::vector<ScorecardRow>& rows,
+                          const std::vector<RealismComparison>& realism) {
+  nlohmann::ordered_json doc =
+      nlohmann::ordered_json::parse(ScorecardJson(rows));
+  if (realism.empty()) return doc.dump(1);
+  doc["realism"] = nlohmann::ordered_json::array();
+  for (const RealismComparison& c : realism) {
+    const RealismSummary s = SummarizeRealism(c.rows, "");
+    nlohmann::ordered_json row;
+    row["sensor"] = c.sensor;
+    row["real"] = c.real;
+    row["synthetic"] = c.synthetic;
+    row["mean_ks"] = Round4(s.mean_ks);
+    row["max_ks"] = Round4(s.max_ks);
+    row["worst"] = s.worst;
+    doc["realism"].push_back(std::move(row));
+  }
+  return doc.dump(1);
+}
+
+absl::StatusOr<std::vector<std::string>> CompareRealismRows(
+    const std::vector<RealismComparison>& realism,
+    const std::string& baseline_json) {
+  const nlohmann::json doc =
+      nlohmann::json::parse(baseline_json, nullptr, /*allow_exceptions=*/false);
+  if (doc.is_discarded() || !doc.is_object()) {
+    return absl::InvalidArgumentError(
+        "scorecard baseline: not a JSON document");
+  }
+  std::vector<std::string> falls;
+  if (!doc.contains("realism") || !doc["realism"].is_array()) return falls;
+  for (const nlohmann::json& b : doc["realism"]) {
+    if (!b.is_object() || !b.contains("real") || !b.contains("synthetic") ||
+        !b.contains("mean_ks") || !b["mean_ks"].is_number()) {
+      continue;
+    }
+    for (const RealismComparison& c : realism) {
+      if (c.real != b["real"].get<std::string>() ||
+          c.synthetic != b["synthetic"].get<std::string>()) {
+        continue;
+      }
+      const double base = b["mean_ks"].get<double>();
+      const double now = Round4(SummarizeRealism(c.rows, "").mean_ks);
+      if (now > base + kRealismMargin + 1e-9) {
+        falls.push_back(absl::StrFormat(
+            "realism/%s/%s mean_ks %.4f -> %.4f (baseline %.4f, margin %.2f)",
+            c.real, c.synthetic, base, now, base, kRealismMargin));
+      }
+    }
+  }
+  return falls;
+}
+
 std::string ScorecardJson(const std::vector<ScorecardRow>& rows) {
   nlohmann::ordered_json doc;
   doc["rows"] = nlohmann::ordered_json::array();
