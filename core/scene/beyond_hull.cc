@@ -51,6 +51,8 @@ constexpr int kRestMinPixels = 60;
 // A table top's normals are within 25 degrees of the support's (as the
 // support's inliers, SupportPlaneOptions::max_normal_angle_deg).
 constexpr float kTableTopCos = 0.906f;
+// A part's foot: its points within this of its lowest, metres.
+constexpr float kFootBand = 0.01f;
 
 // Whether the point at (u, v), not yet in the scene, may rest on the table
 // beyond its hull: above the table as a candidate, within reach of the
@@ -179,11 +181,45 @@ bool BoundedAsAnObject(const OrganizedCloud& cloud, const SupportPlane& plane,
   return true;
 }
 
+// Whether, of `part`'s lowest pixels (within kFootBand of `lowest`) that
+// lie on a jump in depth, most border something of the scene (its region,
+// or `grown` beyond the hull) nearer to the camera: the part's foot is
+// hidden behind what stands in front of it (a box behind an open box, an
+// object behind a row of books). Pixels beside no depth (OSD's crop) do
+// not count either way.
+bool FootHiddenByTheScene(const OrganizedCloud& cloud, const TableScene& scene,
+                          const cv::Mat& grown,
+                          const std::vector<cv::Point>& part, float lowest) {
+  const int du[4] = {1, -1, 0, 0}, dv[4] = {0, 0, 1, -1};
+  int edges = 0, hidden = 0;
+  for (const cv::Point& q : part) {
+    if (scene.height.at<float>(q) > lowest + kFootBand) continue;
+    const float z = cloud.xyz.at<cv::Vec3f>(q)[2];
+    const float step = std::max(kRestDepthStep, kRestDepthFraction * z);
+    bool edge = false, behind = false;
+    for (int k = 0; k < 4; ++k) {
+      const int u = q.x + du[k], v = q.y + dv[k];
+      if (u < 0 || v < 0 || u >= cloud.width() || v >= cloud.height()) {
+        continue;
+      }
+      const float zn = cloud.xyz.at<cv::Vec3f>(v, u)[2];
+      if (std::isnan(zn) || std::abs(zn - z) <= step) continue;
+      edge = true;
+      behind = behind || (zn < z && (scene.region.at<uint8_t>(v, u) != 0 ||
+                                     grown.at<uint8_t>(v, u) != 0));
+    }
+    edges += edge;
+    hidden += behind;
+  }
+  return hidden > 0 && 2 * hidden > edges;
+}
+
 // Whether `part` (pixels of points that may rest beyond the hull, and their
 // feet) stands on the table: its lowest point near the table, no wider than
 // an object, and bounded as an object (BoundedAsAnObject).
 bool StandsOnTheTable(const OrganizedCloud& cloud, const SupportPlane& plane,
                       const TableSceneOptions& o, const TableScene& scene,
+                      const cv::Mat& grown,
                       const std::vector<cv::Point>& part) {
   const float inf = std::numeric_limits<float>::infinity();
   float lowest = inf, contact = inf;
@@ -202,8 +238,12 @@ bool StandsOnTheTable(const OrganizedCloud& cloud, const SupportPlane& plane,
     lo = lo.cwiseMin(xy);
     hi = hi.cwiseMax(xy);
   }
-  return lowest <= contact && (hi - lo).norm() <= o.max_resting_size_m &&
-         BoundedAsAnObject(cloud, plane, o, scene, part);
+  if (!((hi - lo).norm() <= o.max_resting_size_m)) return false;
+  if (!(lowest <= contact) &&
+      !FootHiddenByTheScene(cloud, scene, grown, part, lowest)) {
+    return false;
+  }
+  return BoundedAsAnObject(cloud, plane, o, scene, part);
 }
 
 // The points beyond the hull that rest on the table through the candidates
@@ -316,7 +356,7 @@ void AddStandingOnHiddenTable(const OrganizedCloud& cloud,
         }
       }
       if (static_cast<int>(above.size()) < min_pixels) continue;
-      if (StandsOnTheTable(cloud, plane, options, scene, part)) {
+      if (StandsOnTheTable(cloud, plane, options, scene, grown, part)) {
         for (const cv::Point& q : above) grown.at<uint8_t>(q) = 255;
       }
     }

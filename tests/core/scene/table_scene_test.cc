@@ -115,6 +115,47 @@ TEST(TableSceneTest, ABoxOnTheHiddenTableIsInTheSceneAFloatingOneIsNot) {
       0.0);
 }
 
+TEST(TableSceneTest, ABoxWhoseFootAnotherHidesIsInTheScene) {
+  // A tall box in front (label 20, 20 cm, standing across the crop line)
+  // hides the lower part of a taller one 10 cm behind it (label 30, 25 cm,
+  // beyond the crop): its lowest visible point is far above the table, but
+  // what hides its foot is in the scene.
+  synth::SceneSpec spec;
+  spec.camera_pose = synth::LookAt({0.0f, -0.75f, 0.75f}, {0.0f, 0.0f, 0.0f});
+  spec.objects.push_back(synth::BoxPrimitive(Vector3f(0.0f, 0.0f, 0.10f),
+                                             Vector3f(0.08f, 0.06f, 0.10f),
+                                             Vector3f(0.2f, 0.3f, 0.7f)));
+  spec.objects.push_back(synth::BoxPrimitive(Vector3f(0.0f, 0.20f, 0.125f),
+                                             Vector3f(0.05f, 0.04f, 0.125f),
+                                             Vector3f(0.8f, 0.3f, 0.2f)));
+  synth::NoiseOptions noise;
+  noise.enabled = false;
+  synth::SynthScene scene = synth::RenderScene(spec, noise, 1);
+  synth::CropLikeOsd(spec, 0.02f, scene);
+  absl::StatusOr<OrganizedCloud> cloud =
+      BuildOrganizedCloud(scene.frame.frame, {});
+  ASSERT_TRUE(cloud.ok());
+  absl::StatusOr<SupportPlane> plane = FindSupportPlane(*cloud, {});
+  ASSERT_TRUE(plane.ok()) << plane.status();
+  const TableScene with = PrepareTableScene(*cloud, *plane, {});
+  const cv::Mat& labels = scene.frame.labels;
+  float lowest = 1.0f;
+  for (int v = 0; v < labels.rows; ++v) {
+    for (int u = 0; u < labels.cols; ++u) {
+      if (labels.at<int>(v, u) == 30) {
+        lowest = std::min(lowest, with.height.at<float>(v, u));
+      }
+    }
+  }
+  EXPECT_GT(lowest, 0.08f);  // no foot in sight
+  EXPECT_GT(ShareIn(with.region, labels, 30), 0.95);
+  TableSceneOptions options;
+  options.rest_on_hidden_table = false;
+  EXPECT_EQ(
+      ShareIn(PrepareTableScene(*cloud, *plane, options).region, labels, 30),
+      0.0);
+}
+
 TEST(TableSceneTest, ValidateNamesRestBeyondHull) {
   TableSceneOptions options;
   options.rest_beyond_hull_m = -0.1f;
