@@ -531,19 +531,17 @@ void RegisterFrameCases(
     for (const bool beyond : {true, false}) {
       DetectOptions options;
       if (!beyond) options.table_scene.rest_beyond_hull_m = 0.0f;
-      Register(absl::StrCat("BM_Frame/detect",
-                            beyond ? "" : "_without_rest_beyond_hull", "/",
-                            name),
-               scenes, name, sweep, kDetectMs,
-               [options](const BenchScene& scene) {
-                 FOVEA_ASSIGN_OR_RETURN(
-                     RgbdFrame frame,
-                     DecodeFrame(scene.raw_wire, BenchFrameLimits()));
-                 absl::StatusOr<DetectResult> result =
-                     RunDetect(frame, options);
-                 benchmark::DoNotOptimize(result);
-                 return result.status();
-               });
+      Register(
+          absl::StrCat("BM_Frame/detect",
+                       beyond ? "" : "_without_rest_beyond_hull", "/", name),
+          scenes, name, sweep, kDetectMs, [options](const BenchScene& scene) {
+            FOVEA_ASSIGN_OR_RETURN(
+                RgbdFrame frame,
+                DecodeFrame(scene.raw_wire, BenchFrameLimits()));
+            absl::StatusOr<DetectResult> result = RunDetect(frame, options);
+            benchmark::DoNotOptimize(result);
+            return result.status();
+          });
     }
     // Whole-scene INC, and beside it without the pieces within an object's
     // footprint joining it (IncOptions::pieces_within), without a body's

@@ -4,6 +4,7 @@
 // The commands of fovea-eval (main.cc defines the flags they read).
 
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "core/frame/osd_pcd.h"
@@ -23,6 +24,9 @@ std::optional<DetectOptions> DetectOptionsFromFlags();
 // the kinds) or of --piles (synthetic piles from --seed); nullopt after a
 // message. segment_command.cc.
 std::optional<std::vector<LabelledFrame>> ScenesFromFlags();
+
+// `flag` when set, else the environment variable `name` ("" when unset).
+std::string FlagOrEnv(const std::string& flag, const char* name);
 
 int RunDetectEval();      // detect_command.cc
 int RunSegmentEval();     // segment_command.cc

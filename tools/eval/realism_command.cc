@@ -23,12 +23,6 @@ namespace {
 // Scenes per synthetic set when --synthetic is 0 (its default).
 constexpr int kDefaultSyntheticScenes = 20;
 
-std::string FlagOrEnv(const std::string& flag, const char* name) {
-  if (!flag.empty()) return flag;
-  const char* env = std::getenv(name);
-  return env == nullptr ? "" : env;
-}
-
 }  // namespace
 
 int RunRealismCommand() {

@@ -55,12 +55,6 @@ namespace {
 
 constexpr int kFell = 3;
 
-std::string FromEnv(const std::string& flag, const char* name) {
-  if (!flag.empty()) return flag;
-  const char* env = std::getenv(name);
-  return env == nullptr ? "" : env;
-}
-
 bool WriteText(const std::string& path, const std::string& text) {
   std::ofstream out(path);
   out << text;
@@ -68,6 +62,12 @@ bool WriteText(const std::string& path, const std::string& text) {
 }
 
 }  // namespace
+
+std::string FlagOrEnv(const std::string& flag, const char* name) {
+  if (!flag.empty()) return flag;
+  const char* env = std::getenv(name);
+  return env == nullptr ? "" : env;
+}
 
 int RunScorecardCommand() {
   ScorecardOptions options;
@@ -92,9 +92,9 @@ int RunScorecardCommand() {
   } else if (absl::GetFlag(FLAGS_short)) {
     options.sets = {"osd", "osd-rot90", "stacked", "realsense"};
   }
-  options.osd_dir = FromEnv(absl::GetFlag(FLAGS_data), "FOVEA_OSD_DIR");
+  options.osd_dir = FlagOrEnv(absl::GetFlag(FLAGS_data), "FOVEA_OSD_DIR");
   options.realsense_dir =
-      FromEnv(absl::GetFlag(FLAGS_realsense), "FOVEA_REALSENSE_DIR");
+      FlagOrEnv(absl::GetFlag(FLAGS_realsense), "FOVEA_REALSENSE_DIR");
   absl::StatusOr<LoadedModels> models = LoadModels(absl::GetFlag(FLAGS_models));
   if (!models.ok()) {
     std::fprintf(stderr, "fovea-eval: %s\n",
