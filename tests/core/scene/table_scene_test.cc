@@ -15,10 +15,9 @@ using Eigen::Vector3f;
 // A book lying flat (30 x 24 x 4 cm) whose front edge is 2 cm in front of
 // the origin, a box standing on its back half (label 30), and, when
 // `lone_box`, a box standing alone on the table far to the right and
-// behind (label 40; `lift` metres above it); the table seen only in front of y
-// = 2 cm (OSD's crop), as where books cover the table. Camera as in BoxOnTable,
-// no noise.
-synth::SynthScene BookWithABoxOnIt(bool lone_box, float lift = 0.0f) {
+// behind (label 40; `lift` metres above it). Camera as in BoxOnTable;
+// Prepare crops the table as where books cover it.
+synth::SceneSpec BookWithABoxOnIt(bool lone_box, float lift = 0.0f) {
   synth::SceneSpec spec;
   spec.camera_pose = synth::LookAt({0.0f, -0.75f, 0.75f}, {0.0f, 0.0f, 0.0f});
   spec.objects.push_back(synth::BoxPrimitive(Vector3f(0.0f, 0.10f, 0.02f),
@@ -32,11 +31,7 @@ synth::SynthScene BookWithABoxOnIt(bool lone_box, float lift = 0.0f) {
         Vector3f(0.40f, 0.25f, 0.05f + lift), Vector3f(0.04f, 0.04f, 0.05f),
         Vector3f(0.2f, 0.7f, 0.3f)));
   }
-  synth::NoiseOptions noise;
-  noise.enabled = false;
-  synth::SynthScene scene = synth::RenderScene(spec, noise, 1);
-  synth::CropLikeOsd(spec, 0.02f, scene);
-  return scene;
+  return spec;
 }
 
 // Share of the pixels labelled `label` that `mask` holds.
@@ -58,8 +53,13 @@ struct Prepared {
   SupportPlane plane;
 };
 
-Prepared Prepare(bool lone_box, float lift = 0.0f) {
-  Prepared p{BookWithABoxOnIt(lone_box, lift), {}, {}};
+// `spec` rendered without noise, the table cropped beyond y = 2 cm (OSD's
+// crop), its cloud and support.
+Prepared Prepare(const synth::SceneSpec& spec) {
+  synth::NoiseOptions noise;
+  noise.enabled = false;
+  Prepared p{synth::RenderScene(spec, noise, 1), {}, {}};
+  synth::CropLikeOsd(spec, 0.02f, p.scene);
   absl::StatusOr<OrganizedCloud> cloud =
       BuildOrganizedCloud(p.scene.frame.frame, {});
   EXPECT_TRUE(cloud.ok());
@@ -71,7 +71,7 @@ Prepared Prepare(bool lone_box, float lift = 0.0f) {
 }
 
 TEST(TableSceneTest, WhatRestsOnABookBeyondTheVisibleTableIsInTheScene) {
-  const Prepared p = Prepare(false);
+  const Prepared p = Prepare(BookWithABoxOnIt(false));
   ASSERT_GT(p.plane.inlier_count, 0);
   TableSceneOptions without;
   without.rest_beyond_hull_m = 0.0f;
@@ -92,7 +92,7 @@ TEST(TableSceneTest, WhatRestsOnABookBeyondTheVisibleTableIsInTheScene) {
 }
 
 TEST(TableSceneTest, ABoxOnTheHiddenTableIsInTheSceneAFloatingOneIsNot) {
-  const Prepared p = Prepare(true);
+  const Prepared p = Prepare(BookWithABoxOnIt(true));
   const cv::Mat& labels = p.scene.frame.labels;
   const TableScene scene = PrepareTableScene(p.cloud, p.plane, {});
   EXPECT_GT(ShareIn(scene.region, labels, 30), 0.95);
@@ -108,7 +108,7 @@ TEST(TableSceneTest, ABoxOnTheHiddenTableIsInTheSceneAFloatingOneIsNot) {
       0.0);
   // 12 cm up, it would not stand on the table (a shelf's box).
   options.rest_on_hidden_table = true;
-  const Prepared floating = Prepare(true, 0.12f);
+  const Prepared floating = Prepare(BookWithABoxOnIt(true, 0.12f));
   EXPECT_EQ(
       ShareIn(PrepareTableScene(floating.cloud, floating.plane, options).region,
               floating.scene.frame.labels, 40),
@@ -128,17 +128,9 @@ TEST(TableSceneTest, ABoxWhoseFootAnotherHidesIsInTheScene) {
   spec.objects.push_back(synth::BoxPrimitive(Vector3f(0.0f, 0.20f, 0.125f),
                                              Vector3f(0.05f, 0.04f, 0.125f),
                                              Vector3f(0.8f, 0.3f, 0.2f)));
-  synth::NoiseOptions noise;
-  noise.enabled = false;
-  synth::SynthScene scene = synth::RenderScene(spec, noise, 1);
-  synth::CropLikeOsd(spec, 0.02f, scene);
-  absl::StatusOr<OrganizedCloud> cloud =
-      BuildOrganizedCloud(scene.frame.frame, {});
-  ASSERT_TRUE(cloud.ok());
-  absl::StatusOr<SupportPlane> plane = FindSupportPlane(*cloud, {});
-  ASSERT_TRUE(plane.ok()) << plane.status();
-  const TableScene with = PrepareTableScene(*cloud, *plane, {});
-  const cv::Mat& labels = scene.frame.labels;
+  const Prepared p = Prepare(spec);
+  const TableScene with = PrepareTableScene(p.cloud, p.plane, {});
+  const cv::Mat& labels = p.scene.frame.labels;
   float lowest = 1.0f;
   for (int v = 0; v < labels.rows; ++v) {
     for (int u = 0; u < labels.cols; ++u) {
@@ -152,7 +144,7 @@ TEST(TableSceneTest, ABoxWhoseFootAnotherHidesIsInTheScene) {
   TableSceneOptions options;
   options.rest_on_hidden_table = false;
   EXPECT_EQ(
-      ShareIn(PrepareTableScene(*cloud, *plane, options).region, labels, 30),
+      ShareIn(PrepareTableScene(p.cloud, p.plane, options).region, labels, 30),
       0.0);
 }
 
