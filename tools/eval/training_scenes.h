@@ -2,6 +2,7 @@
 #define FOVEA_TOOLS_EVAL_TRAINING_SCENES_H_
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "core/frame/osd_pcd.h"
@@ -18,12 +19,28 @@ namespace fovea::eval {
 // the scorecard's leave-one-kind-out folds add the same ones.
 inline constexpr uint64_t kTrainingSceneSeed = 1000001;
 
+// The training pile of `seed`: GeneratePile's scene rendered with
+// independent Kinect noise (synth::IndependentKinectV1Noise), as the
+// shipped INC model was trained. Rendered with the correlated noise that
+// docs/realism.md measured closer to OSD's, the training piles lowered the
+// real figures: the leave-one-kind-out OSD folds 0.934 -> 0.923 INC
+// overlap F (osd-rot90 0.919 -> 0.910), and a model retrained on them the
+// RealSense frames' masks per object 1.85 -> 1.96. So the piles evaluated
+// are the measured ones, the piles trained on stay as they were.
+inline LabelledFrame TrainingPile(uint64_t seed) {
+  synth::SynthScene scene =
+      synth::RenderScene(synth::RandomSceneSpec(seed, synth::PileOptions()),
+                         synth::IndependentKinectV1Noise(), seed);
+  scene.frame.name = "pile-" + std::to_string(seed);
+  return std::move(scene.frame);
+}
+
 // `piles` piles and `stacked` stacked piles per sensor, in that order.
 inline std::vector<LabelledFrame> SyntheticTrainingScenes(int piles,
                                                           int stacked) {
   std::vector<LabelledFrame> scenes;
   for (int k = 0; k < piles; ++k) {
-    scenes.push_back(synth::GeneratePile(kTrainingSceneSeed + k).frame);
+    scenes.push_back(TrainingPile(kTrainingSceneSeed + k));
   }
   for (const synth::RoomSensor sensor :
        {synth::RoomSensor::kKinectV1, synth::RoomSensor::kActiveStereo}) {
