@@ -102,11 +102,14 @@ void SampleMissingDepth(const OrganizedCloud& cloud, const cv::Mat& hull,
                         const RealismOptions& o, RealismSamples& out) {
   const int w = cloud.width(), h = cloud.height();
   cv::Mat missing(h, w, CV_8UC1, cv::Scalar(0));
+  // Without a colour image of the cloud's size, no pixel counts as dark.
+  const bool have_color =
+      cloud.color.type() == CV_8UC3 && cloud.color.size() == cloud.xyz.size();
   int inside = 0, missing_count = 0, dark = 0, dark_missing = 0;
   for (int v = 0; v < h; ++v) {
     const uint8_t* in = hull.ptr<uint8_t>(v);
     const cv::Vec3f* p = cloud.xyz.ptr<cv::Vec3f>(v);
-    const cv::Vec3b* c = cloud.color.ptr<cv::Vec3b>(v);
+    const cv::Vec3b* c = have_color ? cloud.color.ptr<cv::Vec3b>(v) : nullptr;
     uint8_t* m = missing.ptr<uint8_t>(v);
     for (int u = 0; u < w; ++u) {
       if (in[u] == 0) continue;
@@ -116,7 +119,7 @@ void SampleMissingDepth(const OrganizedCloud& cloud, const cv::Mat& hull,
         m[u] = 255;
         ++missing_count;
       }
-      if ((c[u][0] + c[u][1] + c[u][2]) < 3 * o.dark_grey) {
+      if (c != nullptr && (c[u][0] + c[u][1] + c[u][2]) < 3 * o.dark_grey) {
         ++dark;
         if (hole) ++dark_missing;
       }
@@ -177,8 +180,8 @@ void SampleNormals(const OrganizedCloud& cloud, const SupportPlane& plane,
       angles.push_back(std::acos(std::min(1.0, c)) * kRadToDeg);
     }
   }
-  const size_t stride = std::max<size_t>(
-      1, (angles.size() + o.max_point_samples - 1) / o.max_point_samples);
+  const size_t most = static_cast<size_t>(std::max(1, o.max_point_samples));
+  const size_t stride = std::max<size_t>(1, (angles.size() + most - 1) / most);
   for (size_t k = 0; k < angles.size(); k += stride) {
     out.normal_angle.push_back(angles[k]);
   }
@@ -261,8 +264,6 @@ RealismSamples CollectRealismSamples(const OrganizedCloud& cloud,
                        SupportImageHull(plane.inliers, options.hull_erode_px),
                        options, out);
     SampleNormals(cloud, plane, options, out);
-  } else {
-    out.missing_fraction = out.missing_at_edges = out.missing_on_dark = kNaN;
   }
   const int region = table.region.empty() ? 0 : cv::countNonZero(table.region);
   out.table_share = region > 0 && have_inliers

@@ -1,6 +1,7 @@
 #ifndef FOVEA_CORE_EVAL_REALISM_H_
 #define FOVEA_CORE_EVAL_REALISM_H_
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -55,19 +56,20 @@ struct RealismOptions {
 };
 
 // One frame's samples. Per-frame figures are one value each (NaN when the
-// frame has none of what they count, e.g. no dark pixel); per-cell, per-
-// point and per-object ones many.
+// frame has none of what they count, e.g. no dark pixel, or no support at
+// all); per-cell, per-point and per-object ones many.
 struct RealismSamples {
+  static constexpr double kNoSample = std::numeric_limits<double>::quiet_NaN();
   // Label-free.
   std::vector<double> plane_noise;        // per cell: sigma / z^2, 1/m
   std::vector<double> plane_noise_depth;  // per cell: its mean z, m
-  double missing_fraction = 0.0;          // missing share inside the hull
-  double missing_at_edges = 0.0;     // share of missing pixels in edge holes
-  double missing_on_dark = 0.0;      // missing share of the dark pixels
-  std::vector<double> normal_angle;  // support points: normal vs plane, deg
+  double missing_fraction = kNoSample;    // missing share inside the hull
+  double missing_at_edges = kNoSample;  // share of missing pixels in edge holes
+  double missing_on_dark = kNoSample;   // missing share of the dark pixels
+  std::vector<double> normal_angle;     // support points: normal vs plane, deg
   // Share of the table scene's pixels (TableScene::region) on the support
   // plane itself: how much of the table stays visible.
-  double table_share = 0.0;
+  double table_share = kNoSample;
   // With labels: per ground-truth object, the share of its pixels the
   // table scene holds (TableScene::region; 1: the whole object is in the
   // scene segmentation works on) and the share the standing test marks

@@ -83,7 +83,13 @@ bool MayRestBeyondHull(const OrganizedCloud& cloud, const SupportPlane& plane,
 bool IsTableTop(const OrganizedCloud& cloud, const SupportPlane& plane,
                 const TableSceneOptions& o, const TableScene& scene,
                 cv::Point q) {
-  if (!plane.inliers.empty() && plane.inliers.at<uint8_t>(q) != 0) return true;
+  // The support's inliers are at the frame's resolution; a pyramid level's
+  // cloud (ChannelComputer) is smaller, and there only the level test below
+  // applies.
+  if (plane.inliers.size() == cloud.xyz.size() &&
+      plane.inliers.at<uint8_t>(q) != 0) {
+    return true;
+  }
   const float z = cloud.xyz.at<cv::Vec3f>(q)[2];
   const float band =
       std::max(o.min_object_height,
@@ -329,9 +335,11 @@ void AddStandingOnHiddenTable(const OrganizedCloud& cloud,
   std::vector<cv::Point> part, above, frontier;
   for (int v0 = 0; v0 < h; ++v0) {
     for (int u0 = 0; u0 < w; ++u0) {
+      // Only a point above the band starts a part; the feet it reaches
+      // stay free for the fill until then.
       if (visited.at<uint8_t>(v0, u0) != 0) continue;
-      visited.at<uint8_t>(v0, u0) = 255;
       if (kind.at<uint8_t>(v0, u0) != kAbove) continue;
+      visited.at<uint8_t>(v0, u0) = 255;
       part.assign(1, cv::Point(u0, v0));
       above.assign(1, cv::Point(u0, v0));
       frontier.assign(1, cv::Point(u0, v0));

@@ -114,7 +114,8 @@ absl::StatusOr<std::vector<std::string>> CompareRealismRows(
   std::vector<std::string> falls;
   if (!doc.contains("realism") || !doc["realism"].is_array()) return falls;
   for (const nlohmann::json& b : doc["realism"]) {
-    if (!b.is_object() || !b.contains("real") || !b.contains("synthetic") ||
+    if (!b.is_object() || !b.contains("real") || !b["real"].is_string() ||
+        !b.contains("synthetic") || !b["synthetic"].is_string() ||
         !b.contains("mean_ks") || !b["mean_ks"].is_number()) {
       continue;
     }
@@ -125,7 +126,8 @@ absl::StatusOr<std::vector<std::string>> CompareRealismRows(
       }
       const double base = b["mean_ks"].get<double>();
       const double now = Round4(SummarizeRealism(c.rows, "").mean_ks);
-      if (now > base + kRealismMargin + 1e-9) {
+      // A statistic that had samples and has none now is a fall too.
+      if (std::isnan(now) || now > base + kRealismMargin + 1e-9) {
         falls.push_back(absl::StrFormat(
             "realism/%s/%s mean_ks %.4f -> %.4f (baseline %.4f, margin %.2f)",
             c.real, c.synthetic, base, now, base, kRealismMargin));
