@@ -39,6 +39,9 @@ float DistanceOutsideHull(const std::vector<Eigen::Vector2f>& hull,
 // a surface seen at a grazing angle changes faster.
 constexpr float kRestDepthStep = 0.02f;
 constexpr float kRestDepthFraction = 0.03f;
+float RestStep(float z) {
+  return std::max(kRestDepthStep, kRestDepthFraction * z);
+}
 // The candidates the fill starts from are those left by an opening of this
 // radius, pixels: an object's face keeps its inside, a speck does not.
 constexpr int kRestSeedOpening = 2;
@@ -64,9 +67,7 @@ bool MayRestBeyondHull(const OrganizedCloud& cloud, const SupportPlane& plane,
   const float z = p[2];
   if (std::isnan(z) || scene.region.at<uint8_t>(v, u) != 0) return false;
   const float hgt = scene.height.at<float>(v, u);
-  const float min_height =
-      std::max(o.min_object_height,
-               o.min_height_sigmas * (o.sigma0_m + o.sigma_per_z2 * z * z));
+  const float min_height = TableNoiseBand(z, o);
   if (!(hgt > min_height && hgt <= o.max_object_height)) return false;
   const Eigen::Vector3f q(p[0], p[1], p[2]);
   if (DistanceOutsideHull(plane.hull, plane.ToPlane(q)) >
@@ -91,9 +92,7 @@ bool IsTableTop(const OrganizedCloud& cloud, const SupportPlane& plane,
     return true;
   }
   const float z = cloud.xyz.at<cv::Vec3f>(q)[2];
-  const float band =
-      std::max(o.min_object_height,
-               o.min_height_sigmas * (o.sigma0_m + o.sigma_per_z2 * z * z));
+  const float band = TableNoiseBand(z, o);
   const cv::Vec3f& n = cloud.normals.at<cv::Vec3f>(q);
   return std::abs(scene.height.at<float>(q)) <= band &&
          std::abs(plane.normal.x() * n[0] + plane.normal.y() * n[1] +
@@ -110,9 +109,7 @@ bool AtFootLevel(const OrganizedCloud& cloud, const SupportPlane& plane,
                  cv::Point q) {
   const cv::Vec3f& p = cloud.xyz.at<cv::Vec3f>(q);
   if (std::isnan(p[2]) || scene.region.at<uint8_t>(q) != 0) return false;
-  const float band = std::max(
-      o.min_object_height,
-      o.min_height_sigmas * (o.sigma0_m + o.sigma_per_z2 * p[2] * p[2]));
+  const float band = TableNoiseBand(p[2], o);
   if (!(std::abs(scene.height.at<float>(q)) <= band)) return false;
   if (IsTableTop(cloud, plane, o, scene, q)) return false;
   return DistanceOutsideHull(
@@ -158,7 +155,7 @@ bool BoundedAsAnObject(const OrganizedCloud& cloud, const SupportPlane& plane,
   const int du[4] = {1, -1, 0, 0}, dv[4] = {0, 0, 1, -1};
   for (const cv::Point& q : part) {
     const float zq = cloud.xyz.at<cv::Vec3f>(q)[2];
-    const float step = std::max(kRestDepthStep, kRestDepthFraction * zq);
+    const float step = RestStep(zq);
     for (int k = 0; k < 4; ++k) {
       const int u = q.x + du[k], v = q.y + dv[k];
       if (u < 0 || v < 0 || u >= cloud.width() || v >= cloud.height()) {
@@ -168,9 +165,7 @@ bool BoundedAsAnObject(const OrganizedCloud& cloud, const SupportPlane& plane,
       if (std::isnan(p[2])) continue;
       if (IsTableTop(cloud, plane, o, scene, cv::Point(u, v))) return false;
       const float hgt = scene.height.at<float>(v, u);
-      const float band = std::max(
-          o.min_object_height,
-          o.min_height_sigmas * (o.sigma0_m + o.sigma_per_z2 * p[2] * p[2]));
+      const float band = TableNoiseBand(p[2], o);
       if (!(std::abs(p[2] - zq) <= step) ||
           scene.region.at<uint8_t>(v, u) != 0) {
         continue;
@@ -201,7 +196,7 @@ bool FootHiddenByTheScene(const OrganizedCloud& cloud, const TableScene& scene,
   for (const cv::Point& q : part) {
     if (scene.height.at<float>(q) > lowest + kFootBand) continue;
     const float z = cloud.xyz.at<cv::Vec3f>(q)[2];
-    const float step = std::max(kRestDepthStep, kRestDepthFraction * z);
+    const float step = RestStep(z);
     bool edge = false, behind = false;
     for (int k = 0; k < 4; ++k) {
       const int u = q.x + du[k], v = q.y + dv[k];
@@ -235,10 +230,7 @@ bool StandsOnTheTable(const OrganizedCloud& cloud, const SupportPlane& plane,
     const float hgt = scene.height.at<float>(q);
     if (hgt < lowest) {
       lowest = hgt;
-      contact = std::max(o.min_object_height,
-                         o.min_height_sigmas *
-                             (o.sigma0_m + o.sigma_per_z2 * p[2] * p[2])) +
-                kRestContactGap;
+      contact = TableNoiseBand(p[2], o) + kRestContactGap;
     }
     const Eigen::Vector2f xy = plane.ToPlane(Eigen::Vector3f(p[0], p[1], p[2]));
     lo = lo.cwiseMin(xy);
@@ -286,13 +278,12 @@ cv::Mat GrowBeyondHull(const OrganizedCloud& cloud, const TableScene& scene,
         const cv::Point at = frontier.back();
         frontier.pop_back();
         const float z = cloud.xyz.at<cv::Vec3f>(at)[2];
-        const float step = std::max(kRestDepthStep, kRestDepthFraction * z);
         for (int k = 0; k < 4; ++k) {
           const int u = at.x + du[k], v = at.y + dv[k];
           if (u < 0 || v < 0 || u >= w || v >= h) continue;
           if (visited.at<uint8_t>(v, u) != 0) continue;
           const float zq = cloud.xyz.at<cv::Vec3f>(v, u)[2];
-          if (!(std::abs(zq - z) <= std::max(step, kRestDepthFraction * zq))) {
+          if (!(std::abs(zq - z) <= RestStep(std::max(z, zq)))) {
             continue;
           }
           const bool standing = scene.standing.at<uint8_t>(v, u) != 0;
@@ -347,7 +338,7 @@ void AddStandingOnHiddenTable(const OrganizedCloud& cloud,
         const cv::Point at = frontier.back();
         frontier.pop_back();
         const float z = cloud.xyz.at<cv::Vec3f>(at.y, at.x)[2];
-        const float step = std::max(kRestDepthStep, kRestDepthFraction * z);
+        const float step = RestStep(z);
         for (int k = 0; k < 4; ++k) {
           const int u = at.x + du[k], v = at.y + dv[k];
           if (u < 0 || v < 0 || u >= w || v >= h) continue;

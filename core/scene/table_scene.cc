@@ -168,6 +168,7 @@ bool OnStructure(const std::vector<TableScene::Plane>& structures,
 
 using table_scene_internal::AddWhatRestsBeyondHull;
 using table_scene_internal::OnStructure;
+using table_scene_internal::TableNoiseBand;
 
 TableScene PrepareTableScene(const OrganizedCloud& cloud,
                              const SupportPlane& plane,
@@ -210,10 +211,7 @@ TableScene PrepareTableScene(const OrganizedCloud& cloud,
             n.x() * p[u][0] + n.y() * p[u][1] + n.z() * p[u][2] + plane.d;
         height[u] = hgt;
         const float z = p[u][2];
-        const float min_height =
-            std::max(options.min_object_height,
-                     options.min_height_sigmas *
-                         (options.sigma0_m + options.sigma_per_z2 * z * z));
+        const float min_height = TableNoiseBand(z, options);
         const bool on_plane = inlier != nullptr && inlier[u];
         if (on_plane) region[u] = 255;
         if (hgt > options.max_object_height) continue;

@@ -4,6 +4,7 @@
 // What table_scene.cc and beyond_hull.cc share; not part of core's API.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -12,6 +13,14 @@
 #include "core/scene/table_scene.h"
 
 namespace fovea::table_scene_internal {
+
+// Within this height of the support a point at depth z is table:
+// max(min_object_height, min_height_sigmas * (sigma0_m + sigma_per_z2 z^2)),
+// metres (TableSceneOptions::min_object_height).
+inline float TableNoiseBand(float z, const TableSceneOptions& o) {
+  return std::max(o.min_object_height,
+                  o.min_height_sigmas * (o.sigma0_m + o.sigma_per_z2 * z * z));
+}
 
 // Whether p (normal m, NaN when none) lies on one of the structures.
 bool OnStructure(const std::vector<TableScene::Plane>& structures,
