@@ -154,6 +154,18 @@ absl::Status Validate(const IncOptions& options) {
     return absl::InvalidArgumentError(
         "pieces_within: margin_m, top_m and max_below_m must be >= 0");
   }
+  const IncOptions::WholeObject& whole = options.whole_object;
+  if (!(whole.rest_band_m >= 0.0) || !(whole.low_band_m >= 0.0) ||
+      !(whole.beneath_radius_m > 0.0) || !(whole.beneath_gap_m >= 0.0) ||
+      !(whole.min_resting_share >= 0.0 && whole.min_resting_share <= 1.0) ||
+      !(whole.min_touching >= 0.0 && whole.min_touching <= 1.0) ||
+      !(whole.min_convexity >= 0.0 && whole.min_convexity <= 1.0) ||
+      !(whole.max_sharp_concave >= 0.0 && whole.max_sharp_concave <= 1.0)) {
+    return absl::InvalidArgumentError(
+        "whole_object: rest_band_m, low_band_m and beneath_gap_m must be >= "
+        "0, beneath_radius_m > 0, and min_resting_share, min_touching, "
+        "min_convexity and max_sharp_concave in [0, 1]");
+  }
   if (options.max_growth_steps < 1) {
     return absl::InvalidArgumentError(absl::StrCat(
         "max_growth_steps must be positive, got ", options.max_growth_steps));
@@ -216,6 +228,7 @@ absl::StatusOr<IncScene> BuildIncScene(CosScene surfaces,
   scene.relations = std::make_unique<RelationComputer>(
       cloud, object_labels, n, plane.normal, options.relations);
   scene.up = plane.normal;
+  scene.support_d = plane.d;
   // Eq. 3.6: a surface's saliency is the mean saliency of its points.
   std::vector<double> sum(n, 0.0);
   std::vector<int> count(n, 0);
@@ -445,7 +458,14 @@ absl::StatusOr<std::optional<IncObject>> IncSegmenter::Next(
         seed = static_cast<int>(s);
       }
     }
-    if (seed < 0) return std::nullopt;
+    if (seed < 0) {
+      // What no later object took is an object after all.
+      if (held_.empty()) return std::nullopt;
+      IncObject object = std::move(held_.front());
+      held_.erase(held_.begin());
+      Finish(object);
+      return object;
+    }
 
     IncObject object;
     object.seed_surface = seed;
@@ -481,11 +501,47 @@ absl::StatusOr<std::optional<IncObject>> IncSegmenter::Next(
     object.surfaces = group;
     removed_points_ += points;
     if (points < options_.min_object_points) continue;  // noise: next
-    object.mask = PatchesMask(scene_.surfaces, group);
-    object.box = PatchesBox(scene_.surfaces, group);
-    object.seed = CentralPixel(object.mask, object.box);
+    if (options_.whole_object.enabled) {
+      TakeHeldNeighbours(object);  // their pixels left the scene already
+      if (!RestsOnSomething(object.surfaces)) {
+        held_.push_back(std::move(object));
+        continue;
+      }
+    }
+    if (options_.whole_object.enabled) {
+      removed_points_ += TakeHangingNeighbours(object);
+    }
+    Finish(object);
     return object;
   }
+}
+
+void IncSegmenter::Finish(IncObject& object) const {
+  object.mask = PatchesMask(scene_.surfaces, object.surfaces);
+  object.box = PatchesBox(scene_.surfaces, object.surfaces);
+  object.seed = CentralPixel(object.mask, object.box);
+}
+
+int IncSegmenter::TakeHeldNeighbours(IncObject& object) {
+  // A held piece that borders only a piece taken before it is taken too.
+  int pixels = 0;
+  bool took = true;
+  while (took) {
+    took = false;
+    for (auto it = held_.begin(); it != held_.end();) {
+      if (!TouchesIn3d(it->surfaces, object.surfaces)) {
+        ++it;
+        continue;
+      }
+      for (const int s : it->surfaces) pixels += scene_.pixels[s];
+      object.surfaces.insert(object.surfaces.end(), it->surfaces.begin(),
+                             it->surfaces.end());
+      std::sort(object.surfaces.begin(), object.surfaces.end());
+      it = held_.erase(it);
+      took = true;
+    }
+  }
+  return pixels;
 }
 
 std::vector<SvmSample> IncTrainingSamples(const IncScene& scene,

@@ -128,6 +128,49 @@ struct IncOptions {
     bool body_footprint = true;
   };
   PiecesWithin pieces_within;
+  // Each object checked as a whole before it is reported: a piece that
+  // rests on nothing is part of the object it hangs from. A piece hangs
+  // when its lowest points are above the support's noise band and no
+  // horizontal face of another surface (a normal within 30 degrees of the
+  // support's) lies beneath them (within `beneath_radius_m` on the
+  // support's plane and `beneath_gap_m` below): a mug's handle, the upper
+  // half of a mug's wall cut from its lower half, a drill's top on its
+  // handle. It joins an object it touches (below; or that lies on one
+  // body with it across a gap). A can on a tin rests on the tin's top face
+  // and stays apart; a box behind another, its foot hidden, meets it at a
+  // concave fold or across a depth jump and stays apart. Both orders: a hanging
+  // piece made before its object is held back until an object that touches it
+  // takes it (what nothing took is reported after the rest); an object made
+  // first takes the hanging groups around it before it is reported.
+  struct WholeObject {
+    bool enabled = true;
+    // Bottom (1st percentile of heights) at most this above the support:
+    // it stands on it, m.
+    double rest_band_m = 0.015;
+    // The lowest points: within this of the bottom, m.
+    double low_band_m = 0.01;
+    // A horizontal face is beneath a low point when one of its points lies
+    // within this on the support's plane ...
+    double beneath_radius_m = 0.015;
+    // ... and at most this below it (or 5 mm above), m.
+    double beneath_gap_m = 0.03;
+    // Resting: at least this share of the low points have a face beneath,
+    // [0, 1].
+    double min_resting_share = 0.1;
+    // Touching: a border with depth continuous along at least this share
+    // of it (border_3d_fraction) ...
+    double min_touching = 0.5;
+    // ... whose surfaces continue each other or fold away from each other
+    // (border_convexity, 0.5 flat) ...
+    double min_convexity = 0.5;
+    // ... and no border of the two that folds sharply concave along more
+    // than this share of it: there two objects meet (a can standing in a
+    // bowl, a box on another; LCCP's criterion), [0, 1]. Scorecard: 0.5
+    // joined a stacked OSD box to its neighbour (recall 1.0 -> 0.95), 0.1
+    // does not.
+    double max_sharp_concave = 0.1;
+  };
+  WholeObject whole_object;
   // Objects of fewer points leave the scene without being emitted (noise
   // surfaces), pixels.
   int min_object_points = 150;
@@ -152,6 +195,7 @@ struct IncScene {
   std::vector<std::vector<Eigen::Vector3f>> points;
   int object_points = 0;  // pixels of non-support surfaces
   Eigen::Vector3f up = Eigen::Vector3f::UnitZ();  // the support's normal
+  float support_d = 0.0f;  // height above the support: up . p + support_d
   // Per surface, sorted: its neighbours (CosScene::neighbours) and the
   // surfaces across a gap on one body with it (IncOptions::body_join).
   std::vector<std::vector<int>> neighbours;
@@ -222,6 +266,20 @@ class IncSegmenter {
   // its top (IncOptions::PiecesWithin; inc_pieces.cc); they leave the
   // scene. Their pixels.
   int AddPiecesWithin(std::vector<int>& group);
+  // Whether the surfaces `group` rest on the support or on a horizontal
+  // face of another surface (IncOptions::WholeObject; inc_pieces.cc).
+  bool RestsOnSomething(const std::vector<int>& group);
+  // Whether a surface of `piece` borders one of `object` (sorted) with
+  // depth continuous along the border, or lies on one body with it.
+  bool TouchesIn3d(const std::vector<int>& piece,
+                   const std::vector<int>& object);
+  // Takes into `object` every held object that touches it; their pixels.
+  int TakeHeldNeighbours(IncObject& object);
+  // Takes into `object` the groups of surfaces still in the scene around
+  // it that hang from it; their pixels.
+  int TakeHangingNeighbours(IncObject& object);
+  // The mask, box and seed pixel of `object`'s surfaces.
+  void Finish(IncObject& object) const;
   // p(same object) of two neighbouring surfaces: the SVM's, raised to
   // convex_join.joined_probability or body_join.joined_probability where
   // that criterion holds; cached.
@@ -248,6 +306,19 @@ class IncSegmenter {
   std::vector<char> fitted_;
   std::vector<std::optional<SurfaceModel>> models_;
   std::unordered_map<uint64_t, bool> fused_;  // pair -> one B-spline
+  // Objects held back (IncOptions::WholeObject), in the order they were
+  // made; reported after every other object when no later one took them.
+  std::vector<IncObject> held_;
+  // Every object surface's points seen along the support's normal (an even
+  // sample): per grid cell of beneath_radius_m, (x, y, height, surface);
+  // built when first needed.
+  struct FlatPoint {
+    float x, y, height;
+    int surface;
+    bool horizontal;  // its surface's normal within 30 degrees of up
+  };
+  std::unordered_map<uint64_t, std::vector<FlatPoint>> flat_grid_;
+  bool flat_grid_built_ = false;
 };
 
 // Relation SVM training examples of one labelled frame: every pair of

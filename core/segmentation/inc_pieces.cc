@@ -9,6 +9,8 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <optional>
+#include <set>
+#include <utility>
 #include <vector>
 
 #include "core/segmentation/inc.h"
@@ -275,6 +277,165 @@ int IncSegmenter::AddPiecesWithin(std::vector<int>& group) {
   }
   group.insert(group.end(), joined.begin(), joined.end());
   std::sort(group.begin(), group.end());
+  return pixels;
+}
+
+bool IncSegmenter::RestsOnSomething(const std::vector<int>& group) {
+  const IncOptions::WholeObject& options = options_.whole_object;
+  const PlaneAxes axes(scene_.up);
+  const float cell = static_cast<float>(options.beneath_radius_m);
+  const auto key = [](int64_t x, int64_t y) {
+    return (static_cast<uint64_t>(x) << 32) ^ static_cast<uint32_t>(y);
+  };
+  const auto cell_of = [cell](float v) {
+    return static_cast<int64_t>(std::floor(v / cell));
+  };
+  std::vector<Eigen::Vector3f> sample =
+      EvenSample(scene_, group, kObjectFootprintPoints);
+  if (sample.empty()) return true;  // nothing to tell: as it was
+  std::vector<float> heights;
+  heights.reserve(sample.size());
+  for (const Eigen::Vector3f& p : sample) {
+    heights.push_back(axes.up.dot(p) + scene_.support_d);
+  }
+  std::vector<float> sorted = heights;
+  const auto first =
+      sorted.begin() + static_cast<ptrdiff_t>(0.01 * (sorted.size() - 1));
+  std::nth_element(sorted.begin(), first, sorted.end());
+  const float bottom = *first;
+  if (bottom <= options.rest_band_m) return true;  // on the support
+  if (!flat_grid_built_) {
+    flat_grid_built_ = true;
+    std::vector<int> all;
+    for (size_t s = 0; s < scene_.points.size(); ++s) {
+      if (!scene_.surfaces.support[s]) all.push_back(static_cast<int>(s));
+    }
+    size_t total = 0;
+    for (const int s : all) total += scene_.points[s].size();
+    constexpr float kCos30 = 0.866f;
+    std::vector<char> horizontal(scene_.points.size(), 0);
+    for (const int s : all) {
+      horizontal[s] =
+          std::abs(scene_.surfaces.patches.patches[s].normal.dot(axes.up)) >=
+          kCos30;
+    }
+    const size_t stride =
+        std::max<size_t>(1, (total + 4 * kObjectFootprintPoints - 1) /
+                                (4 * kObjectFootprintPoints));
+    for (const int s : all) {
+      const std::vector<Eigen::Vector3f>& points = scene_.points[s];
+      for (size_t i = 0; i < points.size(); i += stride) {
+        const cv::Point2f f = axes.Flat(points[i]);
+        flat_grid_[key(cell_of(f.x), cell_of(f.y))].push_back(
+            {f.x, f.y, axes.up.dot(points[i]) + scene_.support_d, s,
+             horizontal[s] != 0});
+      }
+    }
+  }
+  const float low = bottom + static_cast<float>(options.low_band_m);
+  const float r2 = cell * cell;
+  const float gap = static_cast<float>(options.beneath_gap_m);
+  constexpr float kAbove = 0.005f;  // a support's top a little above: noise
+  int lows = 0;
+  int resting = 0;
+  for (size_t i = 0; i < sample.size(); ++i) {
+    if (heights[i] > low) continue;
+    ++lows;
+    const cv::Point2f f = axes.Flat(sample[i]);
+    const int64_t cx = cell_of(f.x);
+    const int64_t cy = cell_of(f.y);
+    bool beneath = false;
+    for (int64_t dx = -1; dx <= 1 && !beneath; ++dx) {
+      for (int64_t dy = -1; dy <= 1 && !beneath; ++dy) {
+        const auto found = flat_grid_.find(key(cx + dx, cy + dy));
+        if (found == flat_grid_.end()) continue;
+        for (const FlatPoint& q : found->second) {
+          if (!q.horizontal ||
+              std::binary_search(group.begin(), group.end(), q.surface)) {
+            continue;
+          }
+          const float ddx = q.x - f.x;
+          const float ddy = q.y - f.y;
+          if (ddx * ddx + ddy * ddy <= r2 && q.height <= heights[i] + kAbove &&
+              q.height >= heights[i] - gap) {
+            beneath = true;
+            break;
+          }
+        }
+      }
+    }
+    if (beneath) ++resting;
+  }
+  return lows == 0 ||
+         resting >= options.min_resting_share * static_cast<double>(lows);
+}
+
+bool IncSegmenter::TouchesIn3d(const std::vector<int>& piece,
+                               const std::vector<int>& object) {
+  const IncOptions::WholeObject& whole = options_.whole_object;
+  const std::vector<std::pair<int, int>>& bordering =
+      scene_.relations->adjacent_pairs();
+  bool touching = false;
+  for (const int p : piece) {
+    for (const int o : scene_.neighbours[p]) {
+      if (!std::binary_search(object.begin(), object.end(), o)) continue;
+      if (std::binary_search(bordering.begin(), bordering.end(),
+                             std::make_pair(std::min(p, o), std::max(p, o)))) {
+        const std::vector<double> relation = scene_.relations->Relate(p, o);
+        // A sharply concave fold anywhere along the contact: two objects
+        // meet there.
+        if (relation[kBorderSharpConcaveFeature] > whole.max_sharp_concave) {
+          return false;
+        }
+        // Depth continuous along the border, and the surfaces continue
+        // each other there or fold away (a wall cut across, a handle's
+        // root), as one object's parts do.
+        touching = touching ||
+                   (relation[kBorder3dFractionFeature] >= whole.min_touching &&
+                    relation[kBorderConvexityFeature] >= whole.min_convexity);
+      } else if (!touching && options_.body_join.enabled) {
+        touching = OnOneBody(scene_.points[p], scene_.points[o], scene_.up,
+                             options_.body_join.fit);  // across a gap
+      }
+    }
+  }
+  return touching;
+}
+
+int IncSegmenter::TakeHangingNeighbours(IncObject& object) {
+  int pixels = 0;
+  std::vector<int> around;
+  for (const int s : object.surfaces) {
+    for (const int t : scene_.neighbours[s]) {
+      if (!removed_[t]) around.push_back(t);
+    }
+  }
+  std::sort(around.begin(), around.end());
+  around.erase(std::unique(around.begin(), around.end()), around.end());
+  for (const int s : around) {
+    if (removed_[s]) continue;  // taken with an earlier one
+    // The group INC would grow from it, within two steps.
+    std::set<int> near = {s};
+    for (int step = 0; step < 2; ++step) {
+      const std::vector<int> ring(near.begin(), near.end());
+      for (const int r : ring) {
+        for (const int t : scene_.neighbours[r]) {
+          if (!removed_[t]) near.insert(t);
+        }
+      }
+    }
+    const std::vector<int> piece =
+        GroupOf(std::vector<int>(near.begin(), near.end()), s, nullptr);
+    if (RestsOnSomething(piece) || !TouchesIn3d(piece, object.surfaces)) {
+      continue;
+    }
+    for (const int t : piece) {
+      removed_[t] = true;
+      pixels += scene_.pixels[t];
+    }
+    object.surfaces.insert(object.surfaces.end(), piece.begin(), piece.end());
+    std::sort(object.surfaces.begin(), object.surfaces.end());
+  }
   return pixels;
 }
 

@@ -153,5 +153,64 @@ TEST(IncTest, ABowlsFootprintKeepsItTogetherWhereTheSvmWouldSplitIt) {
   EXPECT_GT(whole_iou, split_iou + 0.3);
 }
 
+// A bottle of two colours (a cylinder 6 cm across: its lower 6 cm red, its
+// upper 5 cm blue, as a label or a cap cuts one) and beside it a can
+// standing on a tin. The bottle's upper part rests on nothing (no face
+// beneath it, its bottom above the table) and continues its lower part
+// across their border: it is part of the bottle. The can rests on the
+// tin's top face: it is an object of its own, and so is the tin
+// (IncOptions::WholeObject).
+TEST(IncTest, APartThatRestsOnNothingJoinsItsObjectAndACanOnATinStaysApart) {
+  synth::SceneSpec spec;
+  spec.camera_pose = synth::LookAt({0.05f, -0.6f, 0.55f}, {0.05f, 0.0f, 0.05f});
+  synth::Primitive bottle;
+  bottle.shape = synth::Shape::kCylinder;
+  bottle.radius = 0.03f;
+  bottle.half_extents = {0.03f, 0.03f, 0.03f};
+  bottle.pose.translation() = Eigen::Vector3f(-0.06f, 0.0f, 0.03f);
+  bottle.rgb = {0.8f, 0.2f, 0.2f};
+  synth::Primitive upper = bottle;
+  upper.half_extents = {0.03f, 0.03f, 0.025f};
+  upper.pose.translation() = Eigen::Vector3f(-0.06f, 0.0f, 0.085f);
+  upper.rgb = {0.2f, 0.3f, 0.8f};
+  synth::Primitive tin;
+  tin.shape = synth::Shape::kBox;
+  tin.half_extents = {0.05f, 0.04f, 0.025f};
+  tin.pose.translation() = Eigen::Vector3f(0.1f, 0.02f, 0.025f);
+  tin.rgb = {0.8f, 0.6f, 0.2f};
+  synth::Primitive can;
+  can.shape = synth::Shape::kCylinder;
+  can.radius = 0.03f;
+  can.half_extents = {0.03f, 0.03f, 0.05f};
+  can.pose.translation() = Eigen::Vector3f(0.1f, 0.02f, 0.1f);
+  can.rgb = {0.8f, 0.2f, 0.2f};
+  spec.objects = {bottle, tin, can};
+  spec.object_parts = {{upper, 0}};
+  const Scene scene =
+      Prepare(synth::RenderScene(spec, synth::NoiseOptions{}, 3));
+  const auto masks = [&scene](const IncOptions& options) {
+    return MasksPerObject(scene, options, {20, 30, 40});
+  };
+  IncOptions with;
+  IncOptions without = with;
+  without.whole_object.enabled = false;
+  std::map<int, std::pair<int, double>> whole = masks(with);
+  for (const int label : {20, 30, 40}) {
+    EXPECT_EQ(whole[label].first, 1) << "label " << label;
+    EXPECT_GT(whole[label].second, 0.9) << "label " << label;
+  }
+  // An SVM that calls every border two objects' (ContrarySvm), the
+  // bottle's parts neither on one body nor convex: the upper part joins
+  // the lower only because it rests on nothing.
+  with.convex_join.enabled = false;
+  with.body_join.enabled = false;
+  without.convex_join.enabled = false;
+  without.body_join.enabled = false;
+  const auto [split_masks, split_iou] = MasksOnObject(scene, without);
+  const auto [whole_masks, whole_iou] = MasksOnObject(scene, with);
+  EXPECT_LT(whole_masks, split_masks);
+  EXPECT_GT(whole_iou, split_iou);
+}
+
 }  // namespace
 }  // namespace fovea

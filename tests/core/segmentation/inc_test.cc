@@ -304,6 +304,14 @@ TEST(IncOptionsTest, ValidateNamesTheField) {
   EXPECT_NE(Validate(options).message().find("pieces_within"),
             std::string::npos);
   options = {};
+  options.whole_object.max_sharp_concave = 2.0;
+  EXPECT_NE(Validate(options).message().find("whole_object"),
+            std::string::npos);
+  options = {};
+  options.whole_object.beneath_radius_m = 0.0;
+  EXPECT_NE(Validate(options).message().find("whole_object"),
+            std::string::npos);
+  options = {};
   options.body_join.fit.max_radius_m = 0.0f;
   EXPECT_NE(Validate(options).message().find("body_join"), std::string::npos);
   EXPECT_TRUE(Validate(IncOptions{}).ok());
