@@ -502,7 +502,7 @@ absl::StatusOr<std::optional<IncObject>> IncSegmenter::Next(
     removed_points_ += points;
     if (points < options_.min_object_points) continue;  // noise: next
     if (options_.whole_object.enabled) {
-      TakeHeldNeighbours(object);  // their pixels left the scene already
+      TakeHeldNeighbours(object);
       if (!RestsOnSomething(object.surfaces)) {
         held_.push_back(std::move(object));
         continue;
@@ -522,9 +522,8 @@ void IncSegmenter::Finish(IncObject& object) const {
   object.seed = CentralPixel(object.mask, object.box);
 }
 
-int IncSegmenter::TakeHeldNeighbours(IncObject& object) {
+void IncSegmenter::TakeHeldNeighbours(IncObject& object) {
   // A held piece that borders only a piece taken before it is taken too.
-  int pixels = 0;
   bool took = true;
   while (took) {
     took = false;
@@ -533,7 +532,6 @@ int IncSegmenter::TakeHeldNeighbours(IncObject& object) {
         ++it;
         continue;
       }
-      for (const int s : it->surfaces) pixels += scene_.pixels[s];
       object.surfaces.insert(object.surfaces.end(), it->surfaces.begin(),
                              it->surfaces.end());
       std::sort(object.surfaces.begin(), object.surfaces.end());
@@ -541,7 +539,6 @@ int IncSegmenter::TakeHeldNeighbours(IncObject& object) {
       took = true;
     }
   }
-  return pixels;
 }
 
 std::vector<SvmSample> IncTrainingSamples(const IncScene& scene,

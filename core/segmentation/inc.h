@@ -255,6 +255,7 @@ class IncSegmenter {
   // `max_points` of the surfaces' points.
   struct Footprint {
     std::vector<cv::Point2f> flat;
+    std::vector<float> heights;  // per flat point, up . p
     cv::Rect2f box;
     float bottom = 0.0f;
     float top = 0.0f;
@@ -273,8 +274,11 @@ class IncSegmenter {
   // depth continuous along the border, or lies on one body with it.
   bool TouchesIn3d(const std::vector<int>& piece,
                    const std::vector<int>& object);
-  // Takes into `object` every held object that touches it; their pixels.
-  int TakeHeldNeighbours(IncObject& object);
+  // Takes into `object` every held object that touches it (their pixels
+  // left the scene when they were made).
+  void TakeHeldNeighbours(IncObject& object);
+  // Fills flat_grid_.
+  void BuildFlatGrid();
   // Takes into `object` the groups of surfaces still in the scene around
   // it that hang from it; their pixels.
   int TakeHangingNeighbours(IncObject& object);

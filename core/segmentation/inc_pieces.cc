@@ -40,13 +40,20 @@ struct PlaneAxes {
 
 // Every stride-th point of each of `surfaces`, the stride such that at most
 // about `max_points` are kept: an even sample.
+// The stride of that sample and the surfaces' points in all.
+size_t EvenStride(const IncScene& scene, const std::vector<int>& surfaces,
+                  size_t max_points, size_t* total_points = nullptr) {
+  size_t total = 0;
+  for (const int s : surfaces) total += scene.points[s].size();
+  if (total_points != nullptr) *total_points = total;
+  return std::max<size_t>(1, (total + max_points - 1) / max_points);
+}
+
 std::vector<Eigen::Vector3f> EvenSample(const IncScene& scene,
                                         const std::vector<int>& surfaces,
                                         size_t max_points) {
   size_t total = 0;
-  for (const int s : surfaces) total += scene.points[s].size();
-  const size_t stride =
-      std::max<size_t>(1, (total + max_points - 1) / max_points);
+  const size_t stride = EvenStride(scene, surfaces, max_points, &total);
   std::vector<Eigen::Vector3f> sample;
   sample.reserve(total / stride + surfaces.size());
   for (const int s : surfaces) {
@@ -56,6 +63,15 @@ std::vector<Eigen::Vector3f> EvenSample(const IncScene& scene,
     }
   }
   return sample;
+}
+
+// IncSegmenter::flat_grid_'s cells: a coordinate's cell of `size`, and a
+// cell's key.
+int64_t FlatCell(float v, float size) {
+  return static_cast<int64_t>(std::floor(v / size));
+}
+uint64_t FlatCellKey(int64_t x, int64_t y) {
+  return (static_cast<uint64_t>(x) << 32) ^ static_cast<uint32_t>(y);
 }
 
 // A disc on the support's plane (PlaneAxes::Flat), metres.
@@ -155,12 +171,12 @@ IncSegmenter::Footprint IncSegmenter::FootprintOf(
     const std::vector<int>& surfaces, size_t max_points) const {
   const PlaneAxes axes(scene_.up);
   Footprint f;
-  std::vector<float> heights;
   for (const Eigen::Vector3f& p : EvenSample(scene_, surfaces, max_points)) {
     f.flat.push_back(axes.Flat(p));
-    heights.push_back(axes.up.dot(p));
+    f.heights.push_back(axes.up.dot(p));
   }
   if (f.flat.empty()) return f;
+  std::vector<float> heights = f.heights;
   const auto at = [&heights](double q) {
     const auto it =
         heights.begin() +
@@ -280,74 +296,55 @@ int IncSegmenter::AddPiecesWithin(std::vector<int>& group) {
   return pixels;
 }
 
+void IncSegmenter::BuildFlatGrid() {
+  const PlaneAxes axes(scene_.up);
+  const float cell = static_cast<float>(options_.whole_object.beneath_radius_m);
+  std::vector<int> all;
+  for (size_t s = 0; s < scene_.points.size(); ++s) {
+    if (!scene_.surfaces.support[s]) all.push_back(static_cast<int>(s));
+  }
+  const size_t stride = EvenStride(scene_, all, 4 * kObjectFootprintPoints);
+  constexpr float kCos30 = 0.866f;
+  for (const int s : all) {
+    const bool horizontal =
+        std::abs(scene_.surfaces.patches.patches[s].normal.dot(axes.up)) >=
+        kCos30;
+    const std::vector<Eigen::Vector3f>& points = scene_.points[s];
+    for (size_t i = 0; i < points.size(); i += stride) {
+      const cv::Point2f f = axes.Flat(points[i]);
+      flat_grid_[FlatCellKey(FlatCell(f.x, cell), FlatCell(f.y, cell))]
+          .push_back({f.x, f.y, axes.up.dot(points[i]) + scene_.support_d, s,
+                      horizontal});
+    }
+  }
+  flat_grid_built_ = true;
+}
+
 bool IncSegmenter::RestsOnSomething(const std::vector<int>& group) {
   const IncOptions::WholeObject& options = options_.whole_object;
-  const PlaneAxes axes(scene_.up);
-  const float cell = static_cast<float>(options.beneath_radius_m);
-  const auto key = [](int64_t x, int64_t y) {
-    return (static_cast<uint64_t>(x) << 32) ^ static_cast<uint32_t>(y);
-  };
-  const auto cell_of = [cell](float v) {
-    return static_cast<int64_t>(std::floor(v / cell));
-  };
-  std::vector<Eigen::Vector3f> sample =
-      EvenSample(scene_, group, kObjectFootprintPoints);
-  if (sample.empty()) return true;  // nothing to tell: as it was
-  std::vector<float> heights;
-  heights.reserve(sample.size());
-  for (const Eigen::Vector3f& p : sample) {
-    heights.push_back(axes.up.dot(p) + scene_.support_d);
-  }
-  std::vector<float> sorted = heights;
-  const auto first =
-      sorted.begin() + static_cast<ptrdiff_t>(0.01 * (sorted.size() - 1));
-  std::nth_element(sorted.begin(), first, sorted.end());
-  const float bottom = *first;
+  const Footprint footprint = FootprintOf(group, kObjectFootprintPoints);
+  if (footprint.flat.empty()) return true;  // nothing to tell: as it was
+  const float bottom = footprint.bottom + scene_.support_d;
   if (bottom <= options.rest_band_m) return true;  // on the support
-  if (!flat_grid_built_) {
-    flat_grid_built_ = true;
-    std::vector<int> all;
-    for (size_t s = 0; s < scene_.points.size(); ++s) {
-      if (!scene_.surfaces.support[s]) all.push_back(static_cast<int>(s));
-    }
-    size_t total = 0;
-    for (const int s : all) total += scene_.points[s].size();
-    constexpr float kCos30 = 0.866f;
-    std::vector<char> horizontal(scene_.points.size(), 0);
-    for (const int s : all) {
-      horizontal[s] =
-          std::abs(scene_.surfaces.patches.patches[s].normal.dot(axes.up)) >=
-          kCos30;
-    }
-    const size_t stride =
-        std::max<size_t>(1, (total + 4 * kObjectFootprintPoints - 1) /
-                                (4 * kObjectFootprintPoints));
-    for (const int s : all) {
-      const std::vector<Eigen::Vector3f>& points = scene_.points[s];
-      for (size_t i = 0; i < points.size(); i += stride) {
-        const cv::Point2f f = axes.Flat(points[i]);
-        flat_grid_[key(cell_of(f.x), cell_of(f.y))].push_back(
-            {f.x, f.y, axes.up.dot(points[i]) + scene_.support_d, s,
-             horizontal[s] != 0});
-      }
-    }
-  }
+  if (!flat_grid_built_) BuildFlatGrid();
+  const float cell = static_cast<float>(options.beneath_radius_m);
   const float low = bottom + static_cast<float>(options.low_band_m);
   const float r2 = cell * cell;
   const float gap = static_cast<float>(options.beneath_gap_m);
   constexpr float kAbove = 0.005f;  // a support's top a little above: noise
   int lows = 0;
   int resting = 0;
-  for (size_t i = 0; i < sample.size(); ++i) {
-    if (heights[i] > low) continue;
+  for (size_t i = 0; i < footprint.flat.size(); ++i) {
+    const float height = footprint.heights[i] + scene_.support_d;
+    if (height > low) continue;
     ++lows;
-    const cv::Point2f f = axes.Flat(sample[i]);
-    const int64_t cx = cell_of(f.x);
-    const int64_t cy = cell_of(f.y);
+    const cv::Point2f& f = footprint.flat[i];
+    const int64_t cx = FlatCell(f.x, cell);
+    const int64_t cy = FlatCell(f.y, cell);
     bool beneath = false;
     for (int64_t dx = -1; dx <= 1 && !beneath; ++dx) {
       for (int64_t dy = -1; dy <= 1 && !beneath; ++dy) {
-        const auto found = flat_grid_.find(key(cx + dx, cy + dy));
+        const auto found = flat_grid_.find(FlatCellKey(cx + dx, cy + dy));
         if (found == flat_grid_.end()) continue;
         for (const FlatPoint& q : found->second) {
           if (!q.horizontal ||
@@ -356,8 +353,8 @@ bool IncSegmenter::RestsOnSomething(const std::vector<int>& group) {
           }
           const float ddx = q.x - f.x;
           const float ddy = q.y - f.y;
-          if (ddx * ddx + ddy * ddy <= r2 && q.height <= heights[i] + kAbove &&
-              q.height >= heights[i] - gap) {
+          if (ddx * ddx + ddy * ddy <= r2 && q.height <= height + kAbove &&
+              q.height >= height - gap) {
             beneath = true;
             break;
           }
