@@ -160,11 +160,15 @@ absl::Status Validate(const IncOptions& options) {
       !(whole.min_resting_share >= 0.0 && whole.min_resting_share <= 1.0) ||
       !(whole.min_touching >= 0.0 && whole.min_touching <= 1.0) ||
       !(whole.min_convexity >= 0.0 && whole.min_convexity <= 1.0) ||
-      !(whole.max_sharp_concave >= 0.0 && whole.max_sharp_concave <= 1.0)) {
+      !(whole.max_sharp_concave >= 0.0 && whole.max_sharp_concave <= 1.0) ||
+      !(whole.max_compactness_loss_m >= 0.0) || !(whole.hidden_drop_m >= 0.0) ||
+      !(whole.hidden_margin_m >= 0.0) ||
+      !(whole.min_hidden_share >= 0.0 && whole.min_hidden_share <= 1.0)) {
     return absl::InvalidArgumentError(
-        "whole_object: rest_band_m, low_band_m and beneath_gap_m must be >= "
-        "0, beneath_radius_m > 0, and min_resting_share, min_touching, "
-        "min_convexity and max_sharp_concave in [0, 1]");
+        "whole_object: rest_band_m, low_band_m, beneath_gap_m, "
+        "max_compactness_loss_m, hidden_drop_m and hidden_margin_m must be "
+        ">= 0, beneath_radius_m > 0, and min_resting_share, min_touching, "
+        "min_convexity, max_sharp_concave and min_hidden_share in [0, 1]");
   }
   if (options.max_growth_steps < 1) {
     return absl::InvalidArgumentError(absl::StrCat(
@@ -229,6 +233,8 @@ absl::StatusOr<IncScene> BuildIncScene(CosScene surfaces,
       cloud, object_labels, n, plane.normal, options.relations);
   scene.up = plane.normal;
   scene.support_d = plane.d;
+  scene.xyz = cloud.xyz;
+  scene.intrinsics = cloud.intrinsics;
   // Eq. 3.6: a surface's saliency is the mean saliency of its points.
   std::vector<double> sum(n, 0.0);
   std::vector<int> count(n, 0);
@@ -528,7 +534,7 @@ void IncSegmenter::TakeHeldNeighbours(IncObject& object) {
   while (took) {
     took = false;
     for (auto it = held_.begin(); it != held_.end();) {
-      if (!TouchesIn3d(it->surfaces, object.surfaces)) {
+      if (!HangsFrom(it->surfaces, object.surfaces)) {
         ++it;
         continue;
       }

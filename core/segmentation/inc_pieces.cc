@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/segmentation/inc.h"
+#include "core/segmentation/patch_features.h"
 
 namespace fovea {
 namespace {
@@ -38,28 +39,30 @@ struct PlaneAxes {
   Eigen::Vector3f up, x, y;
 };
 
-// Every stride-th point of each of `surfaces`, the stride such that at most
-// about `max_points` are kept: an even sample.
+// Every stride-th point of each of `surfaces` (of `points`, per surface),
+// the stride such that at most about `max_points` are kept: an even
+// sample.
+using SurfacePoints = std::vector<std::vector<Eigen::Vector3f>>;
+
 // The stride of that sample and the surfaces' points in all.
-size_t EvenStride(const IncScene& scene, const std::vector<int>& surfaces,
+size_t EvenStride(const SurfacePoints& points, const std::vector<int>& surfaces,
                   size_t max_points, size_t* total_points = nullptr) {
   size_t total = 0;
-  for (const int s : surfaces) total += scene.points[s].size();
+  for (const int s : surfaces) total += points[s].size();
   if (total_points != nullptr) *total_points = total;
   return std::max<size_t>(1, (total + max_points - 1) / max_points);
 }
 
-std::vector<Eigen::Vector3f> EvenSample(const IncScene& scene,
+std::vector<Eigen::Vector3f> EvenSample(const SurfacePoints& points,
                                         const std::vector<int>& surfaces,
                                         size_t max_points) {
   size_t total = 0;
-  const size_t stride = EvenStride(scene, surfaces, max_points, &total);
+  const size_t stride = EvenStride(points, surfaces, max_points, &total);
   std::vector<Eigen::Vector3f> sample;
   sample.reserve(total / stride + surfaces.size());
   for (const int s : surfaces) {
-    const std::vector<Eigen::Vector3f>& points = scene.points[s];
-    for (size_t i = 0; i < points.size(); i += stride) {
-      sample.push_back(points[i]);
+    for (size_t i = 0; i < points[s].size(); i += stride) {
+      sample.push_back(points[s][i]);
     }
   }
   return sample;
@@ -101,7 +104,7 @@ std::optional<Disc> BodyDisc(const IncScene& scene, const BodyFitOptions& fit,
                              const std::vector<int>& surfaces, float bottom,
                              float top, const std::vector<cv::Point2f>& hull) {
   const std::vector<Eigen::Vector3f> sample =
-      EvenSample(scene, surfaces, kObjectFootprintPoints);
+      EvenSample(scene.points, surfaces, kObjectFootprintPoints);
   if (static_cast<int>(sample.size()) < fit.min_points) return std::nullopt;
   float z = 0.0f;
   for (const Eigen::Vector3f& p : sample) z += p.z();
@@ -171,7 +174,8 @@ IncSegmenter::Footprint IncSegmenter::FootprintOf(
     const std::vector<int>& surfaces, size_t max_points) const {
   const PlaneAxes axes(scene_.up);
   Footprint f;
-  for (const Eigen::Vector3f& p : EvenSample(scene_, surfaces, max_points)) {
+  for (const Eigen::Vector3f& p :
+       EvenSample(scene_.points, surfaces, max_points)) {
     f.flat.push_back(axes.Flat(p));
     f.heights.push_back(axes.up.dot(p));
   }
@@ -303,7 +307,8 @@ void IncSegmenter::BuildFlatGrid() {
   for (size_t s = 0; s < scene_.points.size(); ++s) {
     if (!scene_.surfaces.support[s]) all.push_back(static_cast<int>(s));
   }
-  const size_t stride = EvenStride(scene_, all, 4 * kObjectFootprintPoints);
+  const size_t stride =
+      EvenStride(scene_.points, all, 4 * kObjectFootprintPoints);
   constexpr float kCos30 = 0.866f;
   for (const int s : all) {
     const bool horizontal =
@@ -367,6 +372,73 @@ bool IncSegmenter::RestsOnSomething(const std::vector<int>& group) {
          resting >= options.min_resting_share * static_cast<double>(lows);
 }
 
+bool IncSegmenter::HangsFrom(const std::vector<int>& piece,
+                             const std::vector<int>& object) {
+  if (!TouchesIn3d(piece, object)) return false;
+  // The union a better object than its parts, or as good (eq. 3.3-3.4):
+  // a cylinder standing flush on a box's front face continues it as a
+  // wall cut across would, but the box's top beside it lies below the
+  // union's hull.
+  constexpr size_t kHullPoints = 600;
+  const std::vector<Eigen::Vector3f> a =
+      EvenSample(scene_.surfaces.samples, piece, kHullPoints);
+  const std::vector<Eigen::Vector3f> b =
+      EvenSample(scene_.surfaces.samples, object, kHullPoints);
+  std::vector<Eigen::Vector3f> both = a;
+  both.insert(both.end(), b.begin(), b.end());
+  const float parts =
+      std::max(CameraFacingHullDistance(a), CameraFacingHullDistance(b));
+  if (CameraFacingHullDistance(both) >
+      parts + options_.whole_object.max_compactness_loss_m) {
+    return false;
+  }
+  // A foot hidden behind another object may stand on what is hidden (a cup
+  // in an open box, a can in a bowl) unless that object is the piece's own
+  // body (a mug's front wall hides its inside's foot).
+  if (!FootHidden(FootprintOf(piece, kObjectFootprintPoints), piece)) {
+    return true;
+  }
+  return OnOneBody(EvenSample(scene_.points, piece, kObjectFootprintPoints),
+                   EvenSample(scene_.points, object, kObjectFootprintPoints),
+                   scene_.up, options_.body_join.fit);
+}
+
+bool IncSegmenter::FootHidden(const Footprint& footprint,
+                              const std::vector<int>& group) const {
+  const IncOptions::WholeObject& options = options_.whole_object;
+  if (scene_.xyz.empty()) return false;
+  const PlaneAxes axes(scene_.up);
+  const Intrinsics& k = scene_.intrinsics;
+  const float drop = static_cast<float>(options.hidden_drop_m);
+  const float margin = static_cast<float>(options.hidden_margin_m);
+  const cv::Mat& labels = scene_.surfaces.patches.labels;
+  // Of the points whose drop the camera would see off the piece (its lower
+  // outline), those where another object's surface is nearer.
+  int outline = 0;
+  int hidden = 0;
+  for (size_t i = 0; i < footprint.flat.size(); ++i) {
+    const cv::Point2f& f = footprint.flat[i];
+    const Eigen::Vector3f q =
+        axes.x * f.x + axes.y * f.y + axes.up * (footprint.heights[i] - drop);
+    if (!(q.z() > 0.0f)) continue;
+    const int u = static_cast<int>(std::lround(k.fx * q.x() / q.z() + k.cx));
+    const int v = static_cast<int>(std::lround(k.fy * q.y() / q.z() + k.cy));
+    if (u < 0 || v < 0 || u >= labels.cols || v >= labels.rows) continue;
+    const int l = labels.at<int>(v, u);
+    if (l >= 0 && std::binary_search(group.begin(), group.end(), l)) {
+      continue;  // the piece's own
+    }
+    ++outline;
+    const float seen = scene_.xyz.at<cv::Vec3f>(v, u)[2];
+    if (l >= 0 && !scene_.surfaces.support[l] && !std::isnan(seen) &&
+        seen < q.z() - margin) {
+      ++hidden;
+    }
+  }
+  return outline > 0 &&
+         hidden >= options.min_hidden_share * static_cast<double>(outline);
+}
+
 bool IncSegmenter::TouchesIn3d(const std::vector<int>& piece,
                                const std::vector<int>& object) {
   const IncOptions::WholeObject& whole = options_.whole_object;
@@ -423,7 +495,7 @@ int IncSegmenter::TakeHangingNeighbours(IncObject& object) {
     }
     const std::vector<int> piece =
         GroupOf(std::vector<int>(near.begin(), near.end()), s, nullptr);
-    if (RestsOnSomething(piece) || !TouchesIn3d(piece, object.surfaces)) {
+    if (RestsOnSomething(piece) || !HangsFrom(piece, object.surfaces)) {
       continue;
     }
     for (const int t : piece) {
