@@ -161,12 +161,14 @@ absl::Status Validate(const IncOptions& options) {
       !(whole.min_touching >= 0.0 && whole.min_touching <= 1.0) ||
       !(whole.min_convexity >= 0.0 && whole.min_convexity <= 1.0) ||
       !(whole.max_sharp_concave >= 0.0 && whole.max_sharp_concave <= 1.0) ||
-      !(whole.max_compactness_loss_m >= 0.0) || !(whole.hidden_drop_m >= 0.0) ||
+      !(whole.max_compactness_loss_m >= 0.0) ||
+      !(whole.min_inside_concavity_m >= 0.0) || !(whole.hidden_drop_m >= 0.0) ||
       !(whole.hidden_margin_m >= 0.0) ||
       !(whole.min_hidden_share >= 0.0 && whole.min_hidden_share <= 1.0)) {
     return absl::InvalidArgumentError(
         "whole_object: rest_band_m, low_band_m, beneath_gap_m, "
-        "max_compactness_loss_m, hidden_drop_m and hidden_margin_m must be "
+        "max_compactness_loss_m, hidden_drop_m, hidden_margin_m and "
+        "min_inside_concavity_m must be "
         ">= 0, beneath_radius_m > 0, and min_resting_share, min_touching, "
         "min_convexity, max_sharp_concave and min_hidden_share in [0, 1]");
   }

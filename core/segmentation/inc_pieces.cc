@@ -393,14 +393,11 @@ bool IncSegmenter::HangsFrom(const std::vector<int>& piece,
     return false;
   }
   // A foot hidden behind another object may stand on what is hidden (a cup
-  // in an open box, a can in a bowl) unless that object is the piece's own
-  // body (a mug's front wall hides its inside's foot).
-  if (!FootHidden(FootprintOf(piece, kObjectFootprintPoints), piece)) {
-    return true;
-  }
-  return OnOneBody(EvenSample(scene_.points, piece, kObjectFootprintPoints),
-                   EvenSample(scene_.points, object, kObjectFootprintPoints),
-                   scene_.up, options_.body_join.fit);
+  // in an open box, a can in a bowl), unless the piece is a vessel's inside
+  // (concave: far from its own hull), whose foot its front wall hides.
+  return CameraFacingHullDistance(a) >=
+             options_.whole_object.min_inside_concavity_m ||
+         !FootHidden(FootprintOf(piece, kObjectFootprintPoints), piece);
 }
 
 bool IncSegmenter::FootHidden(const Footprint& footprint,
