@@ -137,9 +137,11 @@ struct IncOptions {
   // hangs from an object when (1) it touches it: a border with depth
   // continuous, the surfaces continuing each other or folding away, and
   // no border of the two sharply concave (there two objects meet: LCCP);
-  // (2) their union is as compact as its parts (eq. 3.3-3.4: a cylinder
-  // standing flush on a box's front face continues it as a wall would,
-  // but the box's top beside it falls below the union's hull); and (3)
+  // (2) their union is as compact as its parts (eq. 3.3-3.4: neither
+  // part's points lie farther from the union's hull than from their own;
+  // a cylinder standing flush on a box's front face continues it as a
+  // wall would, but the box's top beside it falls below the union's
+  // hull); and (3)
   // its foot is not hidden behind another object (a cup in an open box, a
   // can in a bowl may stand on what is hidden), unless it is concave (a
   // mug's inside seen across its rim, whose foot the mug's front wall
@@ -148,8 +150,8 @@ struct IncOptions {
   // it hangs from takes it (what nothing took is reported after the
   // rest); an object made first takes the groups around it that hang from
   // it before it is reported. Scorecard (docs/scorecard.md): OSD INC
-  // overlap F 0.934 -> 0.942, rolled 90 degrees 0.919 -> 0.939, RealSense
-  // masks per object 1.85 -> 1.78, no row lower.
+  // overlap F 0.934 -> 0.939, rolled 90 degrees 0.919 -> 0.933, RealSense
+  // masks per object 1.85 -> 1.78, no row lower; frame streams held.
   struct WholeObject {
     bool enabled = true;
     // Bottom (1st percentile of heights) at most this above the support:
@@ -175,9 +177,8 @@ struct IncOptions {
     // than this share of it, [0, 1]. Scorecard: 0.5 joined a stacked OSD
     // box to its neighbour (recall 1.0 -> 0.95), 0.1 does not.
     double max_sharp_concave = 0.1;
-    // (2) The union's mean distance to its camera-facing hull at most this
-    // above the larger of its parts', m (the Kinect's noise at a metre is
-    // 3 mm; a flush stack adds 1-10 mm, a wall cut across 0-1 mm).
+    // (2) Each part's mean distance to the union's camera-facing hull at
+    // most this above its distance to its own, m.
     double max_compactness_loss_m = 0.0008;
     // (3) A hidden foot: of the piece's points whose drop by
     // `hidden_drop_m` the camera would see off the piece (its lower

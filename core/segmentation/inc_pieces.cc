@@ -375,28 +375,39 @@ bool IncSegmenter::RestsOnSomething(const std::vector<int>& group) {
 bool IncSegmenter::HangsFrom(const std::vector<int>& piece,
                              const std::vector<int>& object) {
   if (!TouchesIn3d(piece, object)) return false;
-  // The union a better object than its parts, or as good (eq. 3.3-3.4):
-  // a cylinder standing flush on a box's front face continues it as a
-  // wall cut across would, but the box's top beside it lies below the
-  // union's hull.
+  // The union as good an object as its parts (eq. 3.3-3.4): neither
+  // part's points lie farther from the union's camera-facing hull than
+  // from their own. A cylinder standing flush on a box's front face
+  // continues it as a wall cut across would, but the box's top beside it
+  // lies below the union's hull; a can beside a bowl lies below the hull
+  // spanning it and the bowl's rim.
   constexpr size_t kHullPoints = 600;
   const std::vector<Eigen::Vector3f> a =
       EvenSample(scene_.surfaces.samples, piece, kHullPoints);
   const std::vector<Eigen::Vector3f> b =
       EvenSample(scene_.surfaces.samples, object, kHullPoints);
+  if (a.empty() || b.empty()) return false;  // nothing to tell: apart
+  const float own = CameraFacingHullDistance(a);
   std::vector<Eigen::Vector3f> both = a;
   both.insert(both.end(), b.begin(), b.end());
-  const float parts =
-      std::max(CameraFacingHullDistance(a), CameraFacingHullDistance(b));
-  if (CameraFacingHullDistance(both) >
-      parts + options_.whole_object.max_compactness_loss_m) {
+  // Each part's mean distance to the union's hull against its own hull
+  // (the thesis takes each side's mean apart too, CosJoinFeatures).
+  const std::vector<float> distances = CameraFacingHullDistances(both);
+  double piece_sum = 0.0;
+  double object_sum = 0.0;
+  for (size_t i = 0; i < distances.size(); ++i) {
+    (i < a.size() ? piece_sum : object_sum) += distances[i];
+  }
+  const double loss = options_.whole_object.max_compactness_loss_m;
+  if (piece_sum / static_cast<double>(a.size()) > own + loss ||
+      object_sum / static_cast<double>(b.size()) >
+          CameraFacingHullDistance(b) + loss) {
     return false;
   }
   // A foot hidden behind another object may stand on what is hidden (a cup
   // in an open box, a can in a bowl), unless the piece is a vessel's inside
   // (concave: far from its own hull), whose foot its front wall hides.
-  return CameraFacingHullDistance(a) >=
-             options_.whole_object.min_inside_concavity_m ||
+  return own >= options_.whole_object.min_inside_concavity_m ||
          !FootHidden(FootprintOf(piece, kObjectFootprintPoints), piece);
 }
 

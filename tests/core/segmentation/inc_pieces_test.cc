@@ -68,11 +68,7 @@ TEST(IncTest, PiecesWithinAnObjectsFootprintJoinItAndNoObjectIsLost) {
     }
     return pieces_found;
   };
-  // Pieces within alone: with each object also checked as a whole
-  // (IncOptions::WholeObject) 56 of these objects are found with pieces
-  // within against 57 without, when this was written.
   IncOptions with;
-  with.whole_object.enabled = false;
   IncOptions without = with;
   without.pieces_within.enabled = false;
   std::pair<int, int> joined{0, 0};
