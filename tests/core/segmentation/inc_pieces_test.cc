@@ -188,13 +188,11 @@ TEST(IncTest, APartThatRestsOnNothingJoinsItsObjectAndACanOnATinStaysApart) {
   spec.object_parts = {{upper, 0}};
   const Scene scene =
       Prepare(synth::RenderScene(spec, synth::NoiseOptions{}, 3));
-  const auto masks = [&scene](const IncOptions& options) {
-    return MasksPerObject(scene, options, {20, 30, 40});
-  };
   IncOptions with;
   IncOptions without = with;
   without.whole_object.enabled = false;
-  std::map<int, std::pair<int, double>> whole = masks(with);
+  std::map<int, std::pair<int, double>> whole =
+      MasksPerObject(scene, with, {20, 30, 40});
   for (const int label : {20, 30, 40}) {
     EXPECT_EQ(whole[label].first, 1) << "label " << label;
     EXPECT_GT(whole[label].second, 0.9) << "label " << label;
