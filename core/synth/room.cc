@@ -492,8 +492,9 @@ SceneSpec RandomRoomSpec(uint64_t seed, const RoomOptions& options) {
 }
 
 SynthScene GenerateRoom(uint64_t seed, const RoomOptions& options) {
-  SynthScene scene = RenderScene(RandomRoomSpec(seed, options),
-                                 RoomNoise(options.sensor), seed);
+  SceneSpec spec = RandomRoomSpec(seed, options);
+  AddPrints(seed, kPrintedObjectShare, spec);
+  SynthScene scene = RenderScene(spec, RoomNoise(options.sensor), seed);
   scene.frame.name =
       absl::StrCat("room-", AbslView(RoomSensorName(options.sensor)), "-",
                    options.width, "x", options.height, "-", seed);

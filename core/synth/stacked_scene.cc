@@ -507,6 +507,7 @@ StackedPileSpec RandomStackedPileSpec(uint64_t seed, RoomSensor sensor) {
 
 StackedPile GenerateStackedPile(uint64_t seed, RoomSensor sensor) {
   StackedPileSpec pile = RandomStackedPileSpec(seed, sensor);
+  AddPrints(seed, kPrintedObjectShare, pile.spec);
   StackedPile out;
   out.scene = RenderScene(pile.spec, RoomNoise(sensor), seed);
   out.scene.frame.name = absl::StrCat(

@@ -7,6 +7,7 @@
 #include <limits>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,6 +18,7 @@
 #include "core/base/status_macros.h"
 #include "core/frame/osd_pcd.h"
 #include "core/synth/random.h"
+#include "core/synth/random_bodies.h"
 #include "core/synth/raycast.h"
 
 namespace fovea::synth {
@@ -180,8 +182,21 @@ float TextureFactor(Texture texture, const Eigen::Vector3f& p) {
                              static_cast<int>(std::floor(p.z() / 0.004f)));
     case Texture::kPaint:
       return 0.95f + 0.1f * ValueNoise(p, 0.2f);
+    case Texture::kPrint:  // a colour, not a factor: PrintWeight
+      return 1.0f;
   }
   return 1.0f;
+}
+
+// kPrint: the weight of the print colour at point `local` of the
+// primitive's frame: blobs where smooth noise of 4 cm cells rises above a
+// level that itself wanders over 12 cm, so that one face of a box is
+// mostly print and another mostly plain, as packaging's faces differ; the
+// blobs' edges are a few millimetres wide (a print's, sharper than paint).
+float PrintWeight(const Eigen::Vector3f& local) {
+  const float level = 0.3f + 0.5f * ValueNoise(local, 0.12f);
+  const float n = ValueNoise(local, 0.04f);
+  return std::clamp((n - level) / 0.04f, 0.0f, 1.0f);
 }
 
 // Axial noise and disparity quantisation of one depth, or NaN when the
@@ -208,6 +223,10 @@ absl::Status ValidatePrimitive(const Primitive& p, const std::string& field) {
   if (!IsUnitRgb(p.rgb)) {
     return absl::InvalidArgumentError(
         absl::StrCat(field, ".rgb must be in [0, 1]"));
+  }
+  if (!IsUnitRgb(p.print_rgb)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".print_rgb must be in [0, 1]"));
   }
   const bool needs_radius = p.shape != Shape::kBox;
   const bool needs_half_z = p.shape != Shape::kSphere;
@@ -387,22 +406,33 @@ SynthScene RenderScene(const SceneSpec& spec, const NoiseOptions& noise,
   // parts).
   std::vector<Eigen::Vector3f> albedo = {spec.table_rgb};
   std::vector<Texture> texture = {spec.table_texture};
+  // kPrint's colour and the world-to-primitive transform of each hit index.
+  std::vector<Eigen::Vector3f> print_rgb = {spec.table_rgb};
+  std::vector<Eigen::Isometry3f> world_to_local = {
+      Eigen::Isometry3f::Identity()};
+  const auto add_print = [&](const Primitive& p) {
+    print_rgb.push_back(p.print_rgb);
+    world_to_local.push_back(p.pose.inverse());
+  };
   std::vector<int> label = {kTableLabel};
   std::vector<int> object_of_hit = {-1};
   for (size_t k = 0; k < spec.objects.size(); ++k) {
     albedo.push_back(spec.objects[k].rgb);
+    add_print(spec.objects[k]);
     texture.push_back(spec.objects[k].texture);
     label.push_back(ObjectLabel(static_cast<int>(k)));
     object_of_hit.push_back(static_cast<int>(k));
   }
   for (const BackgroundPart& part : spec.background) {
     albedo.push_back(part.primitive.rgb);
+    add_print(part.primitive);
     texture.push_back(part.primitive.texture);
     label.push_back(part.label);
     object_of_hit.push_back(-1);
   }
   for (const ObjectPart& part : spec.object_parts) {
     albedo.push_back(part.primitive.rgb);
+    add_print(part.primitive);
     texture.push_back(part.primitive.texture);
     label.push_back(ObjectLabel(part.object));
     object_of_hit.push_back(part.object);
@@ -441,14 +471,20 @@ SynthScene RenderScene(const SceneSpec& spec, const NoiseOptions& noise,
                                                  n[1] * kLightDirection.y() +
                                                  n[2] * kLightDirection.z());
         float shade = kAmbient + kDiffuse * lambert;
+        Eigen::Vector3f surface = albedo[hit];
         if (texture[hit] != Texture::kFlat) {
           const float z = depth_row[u];
           const Eigen::Vector3f world =
               eye + cam_to_world * Eigen::Vector3f((u - cx) / fx * z,
                                                    (v - cy) / fy * z, z);
-          shade *= TextureFactor(texture[hit], world);
+          if (texture[hit] == Texture::kPrint) {
+            const float w = PrintWeight(world_to_local[hit] * world);
+            surface = (1.0f - w) * surface + w * print_rgb[hit];
+          } else {
+            shade *= TextureFactor(texture[hit], world);
+          }
         }
-        rgb = (albedo[hit] * shade).cwiseMin(1.0f);
+        rgb = (surface * shade).cwiseMin(1.0f);
         // A dark surface's dropped pixels keep their label, as a labeller
         // marks a black mug whole; an edge dropout's, like a shadow's, do
         // not (OSD labels points, and there is no point there).
@@ -506,6 +542,36 @@ SynthScene RenderScene(const SceneSpec& spec, const NoiseOptions& noise,
   return scene;
 }
 
+void AddPrints(uint64_t seed, float probability, SceneSpec& spec) {
+  FOVEA_CHECK(probability >= 0.0f && probability <= 1.0f);
+  // A stream of its own: the spec's draws are not disturbed.
+  Random rng(seed ^ 0x7072696e74735eedULL);
+  std::vector<std::optional<Eigen::Vector3f>> print(spec.objects.size());
+  for (std::optional<Eigen::Vector3f>& colour : print) {
+    if (!rng.Bernoulli(probability)) continue;
+    const int look = rng.UniformInt(0, 3);
+    if (look == 0) {
+      colour = Eigen::Vector3f(0.95f, 0.95f, 0.93f);  // white
+    } else if (look == 1) {
+      colour = Eigen::Vector3f(0.08f, 0.08f, 0.1f);  // black
+    } else {
+      colour = HsvToRgb(rng.Uniform(0.0f, 1.0f), 0.8f, 0.85f);
+    }
+  }
+  const auto apply = [](const std::optional<Eigen::Vector3f>& colour,
+                        Primitive& p) {
+    if (!colour) return;
+    p.texture = Texture::kPrint;
+    p.print_rgb = *colour;
+  };
+  for (size_t k = 0; k < spec.objects.size(); ++k) {
+    apply(print[k], spec.objects[k]);
+  }
+  for (ObjectPart& part : spec.object_parts) {
+    apply(print[static_cast<size_t>(part.object)], part.primitive);
+  }
+}
+
 SynthScene GenerateScene(uint64_t seed) {
   return RenderScene(RandomSceneSpec(seed, RandomSceneOptions{}),
                      NoiseOptions{}, seed);
@@ -527,8 +593,9 @@ RandomSceneOptions PileOptions() {
 }
 
 SynthScene GeneratePile(uint64_t seed) {
-  SynthScene scene =
-      RenderScene(RandomSceneSpec(seed, PileOptions()), KinectV1Noise(), seed);
+  SceneSpec spec = RandomSceneSpec(seed, PileOptions());
+  AddPrints(seed, kPrintedObjectShare, spec);
+  SynthScene scene = RenderScene(spec, KinectV1Noise(), seed);
   scene.frame.name = absl::StrCat("pile-", seed);
   return scene;
 }

@@ -31,6 +31,11 @@ enum class Texture {
   kWood,    // grain: stripes along world x, +-12 % brightness, 4-9 mm period
   kCarpet,  // fine speckle, +-25 % brightness per 4 mm cell
   kPaint,   // slow blotches, +-5 % over 20 cm (walls, furniture)
+  // Printed packaging or a label: blobs 2-6 cm across of
+  // Primitive::print_rgb beside the albedo, covering from none to most of
+  // a face (the share wanders over 12 cm), in the primitive's own frame
+  // (they move with it).
+  kPrint,
 };
 
 struct Primitive {
@@ -72,6 +77,8 @@ struct Primitive {
   float floor_radius = 0.0f;
   Eigen::Vector3f rgb = {0.8f, 0.2f, 0.2f};  // albedo, [0, 1]
   Texture texture = Texture::kFlat;
+  // kPrint's second albedo, [0, 1]; other textures ignore it.
+  Eigen::Vector3f print_rgb = {1.0f, 1.0f, 1.0f};
 };
 
 // Labels of what is not an object on the support table (OSD keeps 1-9
@@ -302,6 +309,20 @@ SynthScene GenerateScene(uint64_t seed);
 // compact pile, a quarter stacked, 40 % touching, some occluding or
 // leaning, seen by a Kinect from 0.7 m up and 0.65 m back.
 RandomSceneOptions PileOptions();
+
+// Prints on household objects, as real packaging, labels and mugs carry
+// them (docs/realism.md: with flat albedos, two surfaces of one synthetic
+// object were nearly always of one colour, colour similarity median 0.9995
+// against OSD's 0.868). Each object of `spec` (its parts alike) gets
+// Texture::kPrint with probability `probability` and a print colour: white,
+// black or a saturated hue. Drawn from a stream of its own derived from
+// `seed`, so that the scene's geometry is the one without prints.
+// Precondition (checked): probability in [0, 1].
+void AddPrints(uint64_t seed, float probability, SceneSpec& spec);
+
+// The share of a pile's, stacked pile's or room's objects that carry prints
+// (AddPrints).
+inline constexpr float kPrintedObjectShare = 0.7f;
 
 // RandomSceneSpec(seed, PileOptions()) rendered with KinectV1Noise();
 // frame.name "pile-<seed>". Crowded piles may hold fewer objects than

@@ -164,6 +164,9 @@ TEST(ValidateTest, NamesTheBrokenField) {
   spec.objects.push_back(
       MakePrimitive(Shape::kSphere, Vector3f::Zero(), Vector3f::Zero(), -1));
   EXPECT_THAT(Validate(spec).message(), HasSubstr("objects[0].radius"));
+  spec.objects[0].radius = 0.05f;
+  spec.objects[0].print_rgb = Vector3f(0.5f, 1.5f, 0.5f);
+  EXPECT_THAT(Validate(spec).message(), HasSubstr("objects[0].print_rgb"));
   EXPECT_TRUE(Validate(SceneSpec()).ok());
 
   NoiseOptions noise;
@@ -373,6 +376,89 @@ TEST(RenderSceneTest, FacesOfOneBoxDifferInBrightness) {
   EXPECT_GT(std::abs(top_sum / top_n - front_sum / front_n), 15.0);
   // Neither face is brighter than its albedo allows.
   EXPECT_LE(top_sum / top_n, 255.0 * 0.6 + 1);
+}
+
+// A printed box shows its albedo and its print colour, each over a share
+// of its pixels, with the same depth and labels as the plain box; the
+// print is fixed to the box: moved with it, the pattern moves too.
+TEST(RenderSceneTest, PrintedBoxShowsBothColoursAndTheSameGeometry) {
+  SceneSpec spec = EmptySpec(Vector3f(0, -0.7f, 0.5f), Vector3f::Zero());
+  const float a = 0.08f;
+  Primitive box = MakePrimitive(Shape::kBox, Vector3f(0, 0, a),
+                                Vector3f::Constant(a), 0.0f);
+  box.rgb = Vector3f(0.9f, 0.1f, 0.1f);        // red
+  box.print_rgb = Vector3f(0.1f, 0.1f, 0.9f);  // blue
+  spec.objects.push_back(box);
+  const SynthScene plain = RenderScene(spec, NoNoise(), 1);
+  spec.objects[0].texture = Texture::kPrint;
+  const SynthScene printed = RenderScene(spec, NoNoise(), 1);
+  EXPECT_TRUE(SameBytes(plain.frame.frame.depth, printed.frame.frame.depth));
+  EXPECT_TRUE(SameBytes(plain.frame.labels, printed.frame.labels));
+  int red = 0, blue = 0, object = 0;
+  for (int v = 0; v < spec.height; ++v) {
+    for (int u = 0; u < spec.width; ++u) {
+      if (printed.frame.labels.at<int>(v, u) != 20) continue;
+      ++object;
+      const cv::Vec3b rgb = printed.frame.frame.color.at<cv::Vec3b>(v, u);
+      if (rgb[0] > 2 * rgb[2]) ++red;
+      if (rgb[2] > 2 * rgb[0]) ++blue;
+    }
+  }
+  ASSERT_GT(object, 2000);
+  EXPECT_GT(red, object / 10);
+  EXPECT_GT(blue, object / 10);
+
+  // Shifted sideways by 3 cm with the camera, the box looks the same.
+  SceneSpec moved = spec;
+  const Eigen::Translation3f shift(0.03f, 0.0f, 0.0f);
+  moved.objects[0].pose = shift * moved.objects[0].pose;
+  moved.camera_pose = shift * moved.camera_pose;
+  const SynthScene seen = RenderScene(moved, NoNoise(), 1);
+  int same = 0;
+  for (int v = 0; v < spec.height; ++v) {
+    for (int u = 0; u < spec.width; ++u) {
+      if (printed.frame.labels.at<int>(v, u) != 20 ||
+          seen.frame.labels.at<int>(v, u) != 20) {
+        continue;
+      }
+      const cv::Vec3b p = printed.frame.frame.color.at<cv::Vec3b>(v, u);
+      const cv::Vec3b q = seen.frame.frame.color.at<cv::Vec3b>(v, u);
+      if (cv::norm(p, q, cv::NORM_INF) <= 2) ++same;
+    }
+  }
+  EXPECT_GT(same, object * 95 / 100);
+}
+
+// AddPrints prints about the share asked for, an object's parts alike, and
+// leaves every primitive's shape and pose as they were.
+TEST(AddPrintsTest, PrintsTheShareAskedForAndLeavesGeometryAlone) {
+  SceneSpec spec = RandomSceneSpec(7, PileOptions());
+  ASSERT_GE(spec.objects.size(), 8u);
+  spec.object_parts.push_back({spec.objects[0], 0});
+  SceneSpec none = spec;
+  AddPrints(7, 0.0f, none);
+  SceneSpec all = spec;
+  AddPrints(7, 1.0f, all);
+  int printed_total = 0, objects_total = 0;
+  for (uint64_t seed = 1; seed <= 20; ++seed) {
+    SceneSpec half = spec;
+    AddPrints(seed, 0.5f, half);
+    for (const Primitive& p : half.objects) {
+      printed_total += p.texture == Texture::kPrint ? 1 : 0;
+      ++objects_total;
+    }
+    EXPECT_EQ(half.object_parts[0].primitive.texture, half.objects[0].texture);
+  }
+  EXPECT_NEAR(static_cast<double>(printed_total) / objects_total, 0.5, 0.1);
+  for (size_t k = 0; k < spec.objects.size(); ++k) {
+    EXPECT_EQ(none.objects[k].texture, spec.objects[k].texture);
+    EXPECT_EQ(all.objects[k].texture, Texture::kPrint);
+    EXPECT_TRUE(all.objects[k].pose.isApprox(spec.objects[k].pose));
+    EXPECT_EQ(all.objects[k].half_extents, spec.objects[k].half_extents);
+    EXPECT_EQ(all.objects[k].rgb, spec.objects[k].rgb);
+    EXPECT_TRUE(Validate(all).ok());
+  }
+  EXPECT_EQ(all.object_parts[0].primitive.print_rgb, all.objects[0].print_rgb);
 }
 
 TEST(RenderSceneTest, TablePointsSatisfyReportedPlane) {
