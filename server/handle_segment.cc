@@ -90,8 +90,9 @@ absl::Status HandleSegmentIncremental(
   return Stream(
       "SegmentIncremental", request.frame(), request.request_id(), context,
       [&](const RgbdFrame& frame, const SegmentSinks& sinks) {
-        return RunSegmentIncremental(frame, options, context.models.inc, sinks,
-                                     context.interrupt, context.start);
+        return RunSegmentIncremental(
+            frame, options, context.models.IncFor(frame, options.detect.scene),
+            sinks, context.interrupt, context.start);
       });
 }
 

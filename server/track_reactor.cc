@@ -182,7 +182,7 @@ class TrackReactor final
         std::lock_guard<std::mutex> lock(mutex_);
         call_.set_request_id(request_id_);
       }
-      tracker_ = std::make_unique<Tracker>(options, config_.segment_models.inc);
+      tracker_ = std::make_unique<Tracker>(options, config_.segment_models);
       if (config_.recorder != nullptr && config_.recorder->ShouldRecord()) {
         record_stream_ = config_.recorder->NewStream();
         RecordedCall opening = StreamRecord();

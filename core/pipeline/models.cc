@@ -40,6 +40,26 @@ absl::StatusOr<std::string> ReadModelFile(const std::filesystem::path& path,
   return text.str();
 }
 
+// INC's relation model at `path`, checked to compute this build's
+// relations.
+absl::StatusOr<RbfSvm> LoadIncModel(const std::filesystem::path& path,
+                                    std::string_view how_to_make) {
+  FOVEA_ASSIGN_OR_RETURN(std::string text, ReadModelFile(path, how_to_make));
+  absl::StatusOr<RbfSvm> inc = RbfSvm::Parse(text, "inc");
+  if (!inc.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "model file ", path.string(),
+        " is not an INC relation model: ", inc.status().message()));
+  }
+  if (inc->feature_names() != RelationFeatureNames()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "model file ", path.string(),
+        " was trained on other relations than this build computes; retrain "
+        "it with fovea-train inc"));
+  }
+  return *std::move(inc);
+}
+
 }  // namespace
 
 SegmentModels LoadedModels::View() const {
@@ -47,6 +67,7 @@ SegmentModels LoadedModels::View() const {
   models.cos = cos ? &*cos : nullptr;
   models.ebs = ebs ? &*ebs : nullptr;
   models.inc = inc ? &*inc : nullptr;
+  models.inc_active_stereo = inc_active_stereo ? &*inc_active_stereo : nullptr;
   return models;
 }
 
@@ -96,24 +117,27 @@ absl::StatusOr<LoadedModels> LoadModels(const std::string& dir) {
   const std::filesystem::path inc_path =
       std::filesystem::path(dir) / kIncModelFile;
   FOVEA_ASSIGN_OR_RETURN(
-      std::string inc_text,
-      ReadModelFile(
+      RbfSvm inc,
+      LoadIncModel(
           inc_path,
           "fovea-train inc --data DIR --out models/inc_relations.txt"));
-  absl::StatusOr<RbfSvm> inc = RbfSvm::Parse(inc_text, "inc");
-  if (!inc.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "model file ", inc_path.string(),
-        " is not an INC relation model: ", inc.status().message()));
+  models.versions.emplace_back("inc_relations", inc.Version());
+  models.inc = std::move(inc);
+
+  // A sensor family's folder, when there is one, must hold its model.
+  const std::filesystem::path stereo_dir =
+      std::filesystem::path(dir) / kActiveStereoModelsDir;
+  if (std::filesystem::exists(stereo_dir, error)) {
+    FOVEA_ASSIGN_OR_RETURN(
+        RbfSvm stereo,
+        LoadIncModel(stereo_dir / kIncModelFile,
+                     "fovea-train inc --data DIR --sensor active_stereo "
+                     "--piles 100 --stacked 30 --out "
+                     "models/active_stereo/inc_relations.txt"));
+    models.versions.emplace_back("inc_relations.active_stereo",
+                                 stereo.Version());
+    models.inc_active_stereo = std::move(stereo);
   }
-  if (inc->feature_names() != RelationFeatureNames()) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "model file ", inc_path.string(),
-        " was trained on other relations than this build computes; retrain "
-        "it with fovea-train inc"));
-  }
-  models.versions.emplace_back("inc_relations", inc->Version());
-  models.inc = *std::move(inc);
   return models;
 }
 

@@ -19,11 +19,16 @@ namespace fovea {
 inline constexpr char kCosModelFile[] = "cos_svm.txt";
 inline constexpr char kEbsModelFile[] = "ebs_edges.txt";
 inline constexpr char kIncModelFile[] = "inc_relations.txt";
+// The folder of the active-stereo family's own models (INC's only, for
+// now): frames of that sensor are segmented with them
+// (SegmentModels::IncFor).
+inline constexpr char kActiveStereoModelsDir[] = "active_stereo";
 
 struct LoadedModels {
   std::optional<LinearSvm> cos;
   std::optional<EbsModel> ebs;
   std::optional<RbfSvm> inc;
+  std::optional<RbfSvm> inc_active_stereo;  // from kActiveStereoModelsDir
   // (name, version) of each model, as GetCapabilities reports them.
   std::vector<std::pair<std::string, std::string>> versions;
 
@@ -31,7 +36,8 @@ struct LoadedModels {
   SegmentModels View() const;
 };
 
-// Reads every model of `dir`. Errors name the file and what is wrong, and
+// Reads every model of `dir`, and those of the family folders it has
+// (kActiveStereoModelsDir). Errors name the file and what is wrong, and
 // say how to make it: NOT_FOUND for a missing folder or file,
 // INVALID_ARGUMENT for a file that does not parse (the parser's message).
 absl::StatusOr<LoadedModels> LoadModels(const std::string& dir);

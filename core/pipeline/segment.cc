@@ -374,6 +374,18 @@ absl::StatusOr<std::vector<AttentionPoint>> TakeSeeds(
 
 }  // namespace
 
+const RbfSvm* SegmentModels::IncFor(SensorKind noise_kind) const {
+  if (noise_kind == SensorKind::kActiveStereo && inc_active_stereo != nullptr) {
+    return inc_active_stereo;
+  }
+  return inc;
+}
+
+const RbfSvm* SegmentModels::IncFor(const RgbdFrame& frame,
+                                    const SceneOptions& scene) const {
+  return IncFor(NoiseKind(scene.sensor, frame.intrinsics));
+}
+
 absl::Span<const SegmentMethodRow> SegmentMethods() { return kSegmentMethods; }
 
 const SegmentMethodRow* FindSegmentMethod(SegmentMethod method) {

@@ -125,7 +125,20 @@ absl::Status Validate(const SegmentOptions& options);
 struct SegmentModels {
   const LinearSvm* cos = nullptr;
   const EbsModel* ebs = nullptr;
-  const RbfSvm* inc = nullptr;  // INC's relation SVM (incremental.h)
+  // INC's relation SVM (incremental.h): the structured-light (Kinect v1)
+  // family's, and every family's that has none of its own.
+  const RbfSvm* inc = nullptr;
+  // INC's relation SVM of the active-stereo family (RealSense D4xx-like;
+  // models/active_stereo/, trained on scenes that sensor sees); null:
+  // `inc` serves those frames too.
+  const RbfSvm* inc_active_stereo = nullptr;
+
+  // INC's model for a frame whose depth noise is `noise_kind`'s (NoiseKind
+  // in core/frame/sensor_model.h; kGeneric is taken as the Kinect v1).
+  const RbfSvm* IncFor(SensorKind noise_kind) const;
+  // INC's model for `frame` as `scene` declares its sensor: kGeneric is
+  // chosen from the frame's intrinsics, as the noise model is.
+  const RbfSvm* IncFor(const RgbdFrame& frame, const SceneOptions& scene) const;
 };
 
 struct SegmentedObject {

@@ -130,10 +130,14 @@ int Tracker::RefineFrames() const {
   return options_.refine_first_frames;
 }
 
-Tracker::Tracker(const TrackerOptions& options, const RbfSvm* relation_svm)
+Tracker::Tracker(const TrackerOptions& options, const SegmentModels& models)
     : options_(options),
       valid_(Validate(options)),
-      relation_svm_(relation_svm) {}
+      models_(models),
+      relation_svm_(models.inc) {}
+
+Tracker::Tracker(const TrackerOptions& options, const RbfSvm* relation_svm)
+    : Tracker(options, SegmentModels{.inc = relation_svm}) {}
 
 void Tracker::Reidentify(const cv::Mat& color,
                          const std::vector<SegmentedObject>& found,
@@ -214,6 +218,7 @@ absl::StatusOr<TrackedFrame> Tracker::Process(
   StageClock clock(out.timings);
   sensor_ =
       SensorModelFor(options_.segment.detect.scene.sensor, frame.intrinsics);
+  relation_svm_ = models_.IncFor(frame, options_.segment.detect.scene);
   std::vector<Track> tracks = tracks_;
   const bool same_size = segmentations_ > 0 && !reference_.depth.empty() &&
                          reference_.depth.size() == frame.depth.size();

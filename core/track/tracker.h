@@ -230,7 +230,11 @@ struct TrackedFrame {
 
 class Tracker {
  public:
-  // `relation_svm` (not owned) is INC's model; it outlives the tracker.
+  // `models` (not owned) hold INC's model of each sensor family; each frame
+  // is segmented with its family's (SegmentModels::IncFor). They outlive
+  // the tracker.
+  Tracker(const TrackerOptions& options, const SegmentModels& models);
+  // One INC model (not owned) for frames of every sensor.
   Tracker(const TrackerOptions& options, const RbfSvm* relation_svm);
 
   // One frame of the stream: segments it (or reuses the last segmentation)
@@ -375,7 +379,8 @@ class Tracker {
 
   TrackerOptions options_;
   absl::Status valid_;  // Validate(options_), once
-  const RbfSvm* relation_svm_;
+  SegmentModels models_;
+  const RbfSvm* relation_svm_;  // models_' for the frame being processed
   SensorModel sensor_;
   // The frame last segmented and its pose.
   RgbdFrame reference_;

@@ -75,13 +75,17 @@ TEST_F(ServerTest, CapabilitiesReportWhatCoreImplements) {
   EXPECT_THAT(capabilities.segmentation_methods(),
               ::testing::ElementsAre(v1::SEGMENTATION_METHOD_COS,
                                      v1::SEGMENTATION_METHOD_EBS));
-  ASSERT_EQ(capabilities.models_size(), 3);
+  ASSERT_EQ(capabilities.models_size(), 4);
   EXPECT_EQ(capabilities.models(0).name(), "cos_svm");
   EXPECT_THAT(capabilities.models(0).version(), ::testing::StartsWith("cos-"));
   EXPECT_EQ(capabilities.models(1).name(), "ebs_edges");
   EXPECT_THAT(capabilities.models(1).version(),
               ::testing::StartsWith("ebs-v1-"));
   EXPECT_EQ(capabilities.models(2).name(), "inc_relations");
+  // The active-stereo family's own INC model (models/active_stereo/).
+  EXPECT_EQ(capabilities.models(3).name(), "inc_relations.active_stereo");
+  EXPECT_THAT(capabilities.models(3).version(), ::testing::StartsWith("inc-"));
+  EXPECT_NE(capabilities.models(3).version(), capabilities.models(2).version());
   EXPECT_TRUE(capabilities.segment_incremental());
   EXPECT_EQ(capabilities.default_detect_options().max_points(), 100u);
 }

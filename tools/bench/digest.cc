@@ -150,8 +150,9 @@ int RunDigestCommand(int argc, char** argv) {
       const absl::StatusOr<SegmentSummary> summary =
           method == 0
               ? RunSegment(*frame, SegmentOptions{}, models->View(), sinks)
-              : RunSegmentIncremental(*frame, IncrementalOptions{},
-                                      &*models->inc, sinks);
+              : RunSegmentIncremental(
+                    *frame, IncrementalOptions{},
+                    models->View().IncFor(*frame, SceneOptions{}), sinks);
       d.Value(summary.ok());
     }
     const int points =

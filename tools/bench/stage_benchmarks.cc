@@ -546,34 +546,43 @@ void RegisterFrameCases(
     // Whole-scene INC, and beside it without the pieces within an object's
     // footprint joining it (IncOptions::pieces_within), without a body's
     // cross-section in the footprint, without what rests beyond the
-    // visible table's hull, or without each object checked as a whole
-    // (IncOptions::whole_object): what each costs.
+    // visible table's hull, without each object checked as a whole
+    // (IncOptions::whole_object), or with the base INC model instead of the
+    // frame's sensor family's (SegmentModels::IncFor; the same on Kinect
+    // frames): what each costs.
     const struct {
       const char* suffix;
-      bool pieces, body, beyond, whole;
-    } variants[] = {{"", true, true, true, true},
-                    {"_without_pieces", false, false, true, true},
-                    {"_without_body_footprint", true, false, true, true},
-                    {"_without_rest_beyond_hull", true, true, false, true},
-                    {"_without_whole_object", true, true, true, false}};
+      bool pieces, body, beyond, whole, family;
+    } variants[] = {
+        {"", true, true, true, true, true},
+        {"_without_pieces", false, false, true, true, true},
+        {"_without_body_footprint", true, false, true, true, true},
+        {"_without_rest_beyond_hull", true, true, false, true, true},
+        {"_without_whole_object", true, true, true, false, true},
+        {"_with_base_model", true, true, true, true, false}};
     for (const auto& variant : variants) {
       IncrementalOptions options;
       options.inc.pieces_within.enabled = variant.pieces;
       options.inc.pieces_within.body_footprint = variant.body;
       options.inc.whole_object.enabled = variant.whole;
       if (!variant.beyond) options.detect.table_scene.rest_beyond_hull_m = 0.0f;
-      Register(absl::StrCat("BM_Frame/inc", variant.suffix, "/", name), scenes,
-               name, sweep, kSegmentMs, [options](const BenchScene& scene) {
-                 const absl::StatusOr<LoadedModels>& models = BenchModels();
-                 if (!models.ok()) return models.status();
-                 FOVEA_ASSIGN_OR_RETURN(
-                     RgbdFrame frame,
-                     DecodeFrame(scene.raw_wire, BenchFrameLimits()));
-                 absl::StatusOr<SegmentSummary> summary = RunSegmentIncremental(
-                     frame, options, &*models->inc, SegmentSinks{});
-                 benchmark::DoNotOptimize(summary);
-                 return summary.status();
-               });
+      const bool family = variant.family;
+      Register(
+          absl::StrCat("BM_Frame/inc", variant.suffix, "/", name), scenes, name,
+          sweep, kSegmentMs, [options, family](const BenchScene& scene) {
+            const absl::StatusOr<LoadedModels>& models = BenchModels();
+            if (!models.ok()) return models.status();
+            FOVEA_ASSIGN_OR_RETURN(
+                RgbdFrame frame,
+                DecodeFrame(scene.raw_wire, BenchFrameLimits()));
+            const SegmentModels view = models->View();
+            absl::StatusOr<SegmentSummary> summary = RunSegmentIncremental(
+                frame, options,
+                family ? view.IncFor(frame, options.detect.scene) : view.inc,
+                SegmentSinks{});
+            benchmark::DoNotOptimize(summary);
+            return summary.status();
+          });
     }
   }
 }

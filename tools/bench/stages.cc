@@ -144,8 +144,9 @@ std::vector<Column> Columns(const LoadedModels& models) {
           };
           absl::StatusOr<SegmentSummary> summary =
               incremental
-                  ? RunSegmentIncremental(frame, IncrementalOptions{},
-                                          &*models.inc, sinks)
+                  ? RunSegmentIncremental(
+                        frame, IncrementalOptions{},
+                        models.View().IncFor(frame, SceneOptions{}), sinks)
                   : RunSegment(frame, SegmentOptions{}, models.View(), sinks);
           FOVEA_RETURN_IF_ERROR(summary.status());
           Add(summary->timings, out);
@@ -336,8 +337,9 @@ int RunAnytimeCommand(int argc, char** argv) {
         absl::StatusOr<SegmentSummary> summary =
             !frame.ok() ? absl::StatusOr<SegmentSummary>(frame.status())
             : method.incremental
-                ? RunSegmentIncremental(*frame, IncrementalOptions{},
-                                        &*models->inc, sinks)
+                ? RunSegmentIncremental(
+                      *frame, IncrementalOptions{},
+                      models->View().IncFor(*frame, SceneOptions{}), sinks)
                 : RunSegment(*frame, SegmentOptions{}, models->View(), sinks);
         if (!summary.ok()) {
           std::fprintf(stderr, "fovea-bench anytime: %s on %s: %s\n",

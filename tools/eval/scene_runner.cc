@@ -116,8 +116,9 @@ absl::StatusOr<SceneRun> RunOnScene(const LabelledFrame& scene,
   if (options.method == SceneMethod::kInc) {
     IncrementalOptions inc;
     inc.detect = options.detect;
-    summary =
-        RunSegmentIncremental(scene.frame, inc, options.models.inc, sinks);
+    summary = RunSegmentIncremental(
+        scene.frame, inc, options.models.IncFor(scene.frame, inc.detect.scene),
+        sinks);
   } else {
     SegmentOptions segment;
     FOVEA_ASSIGN_OR_RETURN(segment.method,

@@ -325,7 +325,7 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
   int regions = 0;
   for (int s = 0; s < count; ++s) {
     const synth::Sequence sequence = sequence_at(s);
-    Tracker tracker(options.tracker, models.inc ? &*models.inc : nullptr);
+    Tracker tracker(options.tracker, models.View());
     std::vector<FrameIdentities> identities;
     std::vector<std::pair<int, int>> events;  // joined, split per frame
     const double f_sum_before = f_sum;
@@ -350,8 +350,11 @@ absl::StatusOr<TrackFigures> EvaluateSequences(
         const SteadyClock::time_point start = SteadyClock::now();
         FOVEA_ASSIGN_OR_RETURN(
             SegmentSummary summary,
-            RunSegmentIncremental(frame.frame.frame, options.tracker.segment,
-                                  models.inc ? &*models.inc : nullptr, sinks));
+            RunSegmentIncremental(
+                frame.frame.frame, options.tracker.segment,
+                models.View().IncFor(frame.frame.frame,
+                                     options.tracker.segment.detect.scene),
+                sinks));
         fresh_ms.push_back(SecondsSince(start) * 1e3);
         for (const StageTiming& t : summary.timings) {
           stage_seconds[t.stage] += t.seconds;

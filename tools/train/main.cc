@@ -3,7 +3,7 @@
 //   fovea-train cos --data DIR --out models/cos_svm.txt [--folds 5] [--c 1]
 //   fovea-train ebs --data DIR --out models/ebs_edges.txt [--folds 5]
 //   fovea-train inc --data DIR --out models/inc_relations.txt [--grid]
-//                   [--piles N] [--stacked N]
+//                   [--piles N] [--stacked N] [--sensor FAMILY]
 //
 // Prints the k-fold cross-validated accuracy (folds by scene) and writes
 // the model trained on every scene, with that accuracy in its provenance.
@@ -45,6 +45,11 @@ ABSL_FLAG(int, piles, 0,
 ABSL_FLAG(int, stacked, 0,
           "inc: also train on this many synthetic stacked piles per sensor "
           "(core/synth GenerateStackedPile, Kinect v1 and active stereo).");
+ABSL_FLAG(std::string, sensor, "",
+          "inc: train the model of this sensor family (kinect_v1, "
+          "active_stereo; models/README.md): the synthetic piles and stacked "
+          "piles are all seen by it. Unset: piles seen by the Kinect v1 and "
+          "stacked piles of both sensors.");
 ABSL_FLAG(double, c, fovea::LinearSvmTrainingOptions().c,
           "cos: the SVM's soft-margin penalty C.");
 
@@ -264,9 +269,21 @@ int TrainInc() {
     std::fprintf(stderr, "fovea-train: --stacked must not be negative\n");
     return kUsageError;
   }
-  for (LabelledFrame& scene : eval::SyntheticTrainingScenes(piles, stacked)) {
-    scenes->push_back(std::move(scene));
+  const std::string sensor_name = absl::GetFlag(FLAGS_sensor);
+  std::vector<LabelledFrame> synthetic;
+  if (sensor_name.empty()) {
+    synthetic = eval::SyntheticTrainingScenes(piles, stacked);
+  } else {
+    absl::StatusOr<synth::RoomSensor> sensor =
+        synth::ParseRoomSensor(sensor_name);
+    if (!sensor.ok()) {
+      std::fprintf(stderr, "fovea-train: --sensor: %s\n",
+                   std::string(sensor.status().message()).c_str());
+      return kUsageError;
+    }
+    synthetic = eval::SyntheticTrainingScenes(piles, stacked, *sensor);
   }
+  for (LabelledFrame& scene : synthetic) scenes->push_back(std::move(scene));
   const IncrementalOptions options;
   std::vector<SvmSample> samples;
   for (size_t i = 0; i < scenes->size(); ++i) {
@@ -331,9 +348,10 @@ int TrainInc() {
   std::string text = trained.Serialize();
   const std::string provenance = absl::StrFormat(
       "fovea-train inc, %d scenes, %d synthetic piles and %d stacked piles "
-      "per sensor (seeds from %u), %zu samples, C %g gamma %g; %d-fold "
+      "%s (seeds from %u), %zu samples, C %g gamma %g; %d-fold "
       "cross-validated accuracy %.3f (balanced %.3f)",
       learn_scenes, piles, stacked,
+      sensor_name.empty() ? "per sensor" : ("seen by " + sensor_name).c_str(),
       static_cast<unsigned>(eval::kTrainingSceneSeed), samples.size(), best.c,
       best.gamma, best_cv.folds, best_cv.accuracy, best_cv.balanced_accuracy);
   const size_t at = text.find("\nprovenance ");
