@@ -46,8 +46,10 @@ std::optional<PileBody> MakePileBody(StackedKind kind, float room,
                                      Random& rng);
 
 // Whether a body of `kind` may rest on the top of one of kind `support`:
-// books carry anything but open boxes; boxes carry boxes, cups and cans;
-// tablets and open boxes those and mugs; plates cups and mugs; bowls cups.
+// books carry anything but open boxes; boxes carry boxes, cups, cans, pens
+// and parts; tablets those, mugs and bananas; open boxes boxes, cups, mugs
+// and cans; plates cups, mugs, bananas and parts; bowls cups. Drills,
+// bananas, pens and parts carry nothing.
 bool CanRestOn(StackedKind kind, StackedKind support);
 
 // An axis-aligned box primitive centred at `centre` with half sizes

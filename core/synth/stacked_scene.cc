@@ -52,10 +52,6 @@ constexpr int kMinObjects = 8;
 constexpr int kMaxObjects = 16;
 constexpr int kMinStacked = 3;
 
-// Frame: the sensors' 4:3 resolution.
-constexpr int kWidth = 640;
-constexpr int kHeight = 480;
-
 // Camera, metres: height above the table, distance back from the pile's
 // centre, sideways offset, the height it looks at, roll (radians).
 constexpr float kEyeHeightMin = 0.6f, kEyeHeightMax = 0.8f;
@@ -63,6 +59,9 @@ constexpr float kEyeBackMin = 0.5f, kEyeBackMax = 0.8f;
 constexpr float kEyeSideMax = 0.12f;
 constexpr float kLookAtHeight = 0.04f;
 constexpr float kRollMax = 3.0f * kPi / 180.0f;
+// From above (StackedPileOptions::from_above): height and distance back.
+constexpr float kAboveHeightMin = 0.6f, kAboveHeightMax = 0.9f;
+constexpr float kAboveBackMax = 0.25f;
 
 // The table and the room, metres.
 constexpr float kTableHalfXMin = 0.75f, kTableHalfXMax = 1.0f;
@@ -104,7 +103,8 @@ constexpr float kFillerWeights[] = {0.16f, 0.3f,  0.1f,  0.1f,
                                     0.06f, 0.18f, 0.05f, 0.05f};
 
 // Where a step puts its object.
-enum class Where { kTable, kOnKind, kAnywhere };
+// kOnLast: on the object placed just before (a tower's next storey).
+enum class Where { kTable, kOnKind, kAnywhere, kOnLast };
 
 struct Step {
   StackedKind kind;
@@ -127,7 +127,7 @@ StackedKind DrawFillerKind(Random& rng) {
 
 // The plan: a book on the table, the open box and its contents, then the
 // other groups in random order.
-std::vector<Step> Plan(Random& rng) {
+std::vector<Step> Plan(const StackedPileOptions& options, Random& rng) {
   using K = StackedKind;
   std::vector<std::vector<Step>> groups;
   std::vector<Step> books;
@@ -163,11 +163,33 @@ std::vector<Step> Plan(Random& rng) {
   }
   groups.push_back(
       {{K::kBox, Where::kTable}, {K::kBox, Where::kOnKind, K::kBox}});
+  // What real frames showed cut or missed: a tower, a drill, a banana, a
+  // pen and small parts (on the table or on a book, a box or a plate);
+  // placed before the other groups, so that a pile's object count does not
+  // cut them off.
+  std::vector<std::vector<Step>> more;
+  if (options.more_kinds) {
+    if (rng.Bernoulli(0.7)) {
+      more.push_back({{K::kBox, Where::kTable},
+                      {K::kBox, Where::kOnLast},
+                      {K::kBox, Where::kOnLast}});
+    }
+    if (rng.Bernoulli(0.6)) more.push_back({{K::kDrill, Where::kTable}});
+    if (rng.Bernoulli(0.6)) more.push_back({{K::kBanana, Where::kAnywhere}});
+    if (rng.Bernoulli(0.7)) more.push_back({{K::kPen, Where::kAnywhere}});
+    const int parts = rng.UniformInt(1, 2);
+    for (int i = 0; i < parts; ++i) {
+      more.push_back({{K::kPart, Where::kAnywhere}});
+    }
+  }
   for (size_t i = groups.size() - 1; i > 0; --i) {
     std::swap(groups[i], groups[rng.UniformInt(0, static_cast<int>(i))]);
   }
   std::vector<Step> plan = {{K::kBook, Where::kTable}};
   plan.insert(plan.end(), open_box.begin(), open_box.end());
+  for (const std::vector<Step>& group : more) {
+    plan.insert(plan.end(), group.begin(), group.end());
+  }
   for (const std::vector<Step>& group : groups) {
     plan.insert(plan.end(), group.begin(), group.end());
   }
@@ -175,11 +197,12 @@ std::vector<Step> Plan(Random& rng) {
 }
 
 // The table, the camera and the room around them.
-SceneSpec Stage(RoomSensor sensor, Random& rng, Vector2f* pile_centre) {
+SceneSpec Stage(RoomSensor sensor, const StackedPileOptions& options,
+                Random& rng, Vector2f* pile_centre) {
   SceneSpec spec;
-  spec.width = kWidth;
-  spec.height = kHeight;
-  spec.intrinsics = SensorIntrinsics(sensor, kWidth, kHeight);
+  spec.width = options.width;
+  spec.height = options.height;
+  spec.intrinsics = SensorIntrinsics(sensor, options.width, options.height);
   spec.table_half_size = Vector2f(rng.Uniform(kTableHalfXMin, kTableHalfXMax),
                                   rng.Uniform(kTableHalfYMin, kTableHalfYMax));
   // Oak to walnut: brown, not orange.
@@ -189,7 +212,12 @@ SceneSpec Stage(RoomSensor sensor, Random& rng, Vector2f* pile_centre) {
   spec.table_texture = Texture::kWood;
   *pile_centre = Vector2f(rng.Uniform(-kPileCentreX, kPileCentreX),
                           rng.Uniform(kPileCentreYMin, kPileCentreYMax));
-  const Vector3f eye(pile_centre->x() + rng.Uniform(-kEyeSideMax, kEyeSideMax),
+  const Vector3f eye =
+      options.from_above
+          ? Vector3f(pile_centre->x() + rng.Uniform(-kEyeSideMax, kEyeSideMax),
+                     pile_centre->y() - rng.Uniform(0.0f, kAboveBackMax),
+                     rng.Uniform(kAboveHeightMin, kAboveHeightMax))
+          : Vector3f(pile_centre->x() + rng.Uniform(-kEyeSideMax, kEyeSideMax),
                      pile_centre->y() - rng.Uniform(kEyeBackMin, kEyeBackMax),
                      rng.Uniform(kEyeHeightMin, kEyeHeightMax));
   spec.camera_pose =
@@ -323,6 +351,15 @@ bool CollidesWithAny(const Placed& candidate,
 // The objects a body of `kind` may rest on for `step`.
 std::vector<int> Supports(const Step& step, const std::vector<Placed>& placed) {
   std::vector<int> out;
+  if (step.where == Where::kOnLast) {
+    if (!placed.empty()) {
+      const PileBody& b = placed.back().body;
+      if (b.top.has_value() && CanRestOn(step.kind, b.kind)) {
+        out.push_back(static_cast<int>(placed.size()) - 1);
+      }
+    }
+    return out;
+  }
   for (size_t j = 0; j < placed.size(); ++j) {
     const PileBody& b = placed[j].body;
     if (!b.top.has_value() || !CanRestOn(step.kind, b.kind)) continue;
@@ -340,11 +377,10 @@ std::optional<Placed> Propose(const Step& step,
   int support = -1;
   if (step.where != Where::kTable) {
     const std::vector<int> supports = Supports(step, placed);
-    const bool stack =
-        step.where == Where::kOnKind || rng.Bernoulli(kFillerStackProbability);
-    if (stack && supports.empty() && step.where == Where::kOnKind) {
-      return std::nullopt;
-    }
+    const bool must_stack =
+        step.where == Where::kOnKind || step.where == Where::kOnLast;
+    const bool stack = must_stack || rng.Bernoulli(kFillerStackProbability);
+    if (stack && supports.empty() && must_stack) return std::nullopt;
     if (stack && !supports.empty()) {
       support =
           supports[rng.UniformInt(0, static_cast<int>(supports.size()) - 1)];
@@ -454,14 +490,15 @@ void AimAtPile(const std::vector<Placed>& placed, SceneSpec& spec) {
 }
 
 // One round of drawing a pile from `rng`.
-StackedPileSpec DrawPile(RoomSensor sensor, Random& rng) {
+StackedPileSpec DrawPile(RoomSensor sensor, const StackedPileOptions& options,
+                         Random& rng) {
   Vector2f pile_centre;
   StackedPileSpec out;
-  out.spec = Stage(sensor, rng, &pile_centre);
+  out.spec = Stage(sensor, options, rng, &pile_centre);
   const int wanted = rng.UniformInt(kMinObjects, kMaxObjects);
   std::vector<Placed> placed;
   std::vector<int> alone;
-  for (const Step& step : Plan(rng)) {
+  for (const Step& step : Plan(options, rng)) {
     if (static_cast<int>(placed.size()) >= wanted) break;
     PlaceStep(step, pile_centre, out.spec, rng, placed, alone);
   }
@@ -493,12 +530,43 @@ int CountStacked(const std::vector<int>& rests_on) {
                     [](int support) { return support >= 0; }));
 }
 
+absl::Status Validate(const StackedPileOptions& options) {
+  if (options.width < 160 || options.width > 1920) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("StackedPileOptions.width must be in [160, 1920], got ",
+                     options.width));
+  }
+  if (options.height < 120 || options.height > 1080) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("StackedPileOptions.height must be in [120, 1080], got ",
+                     options.height));
+  }
+  return absl::OkStatus();
+}
+
+StackedPileOptions AbovePileOptions(RoomSensor sensor) {
+  StackedPileOptions options;
+  options.more_kinds = true;
+  options.from_above = true;
+  if (sensor == RoomSensor::kActiveStereo) {
+    options.width = 1280;
+    options.height = 720;
+  }
+  return options;
+}
+
 StackedPileSpec RandomStackedPileSpec(uint64_t seed, RoomSensor sensor) {
+  return RandomStackedPileSpec(seed, sensor, StackedPileOptions());
+}
+
+StackedPileSpec RandomStackedPileSpec(uint64_t seed, RoomSensor sensor,
+                                      const StackedPileOptions& options) {
+  FOVEA_CHECK(Validate(options).ok());
   StackedPileSpec pile;
   for (int round = 0; round < kMaxRounds; ++round) {
     Random rng(seed ^
                (kPileStream + kRoundStep * static_cast<uint64_t>(round)));
-    pile = DrawPile(sensor, rng);
+    pile = DrawPile(sensor, options, rng);
     if (IsComplete(pile)) break;
   }
   FOVEA_CHECK(Validate(pile.spec).ok());
@@ -506,12 +574,20 @@ StackedPileSpec RandomStackedPileSpec(uint64_t seed, RoomSensor sensor) {
 }
 
 StackedPile GenerateStackedPile(uint64_t seed, RoomSensor sensor) {
-  StackedPileSpec pile = RandomStackedPileSpec(seed, sensor);
+  return GenerateStackedPile(seed, sensor, StackedPileOptions());
+}
+
+StackedPile GenerateStackedPile(uint64_t seed, RoomSensor sensor,
+                                const StackedPileOptions& options) {
+  StackedPileSpec pile = RandomStackedPileSpec(seed, sensor, options);
   AddPrints(seed, kPrintedObjectShare, pile.spec);
   StackedPile out;
   out.scene = RenderScene(pile.spec, RoomNoise(sensor), seed);
+  const bool kinect = sensor == RoomSensor::kKinectV1;
   out.scene.frame.name = absl::StrCat(
-      sensor == RoomSensor::kKinectV1 ? "stack-" : "stack-as-", seed);
+      options.from_above ? (kinect ? "stack-above-" : "stack-above-as-")
+                         : (kinect ? "stack-" : "stack-as-"),
+      seed);
   out.spec = std::move(pile.spec);
   out.kinds = std::move(pile.kinds);
   out.rests_on = std::move(pile.rests_on);

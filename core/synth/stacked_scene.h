@@ -5,6 +5,7 @@
 #include <string_view>
 #include <vector>
 
+#include "absl/status/status.h"
 #include "core/synth/room.h"
 #include "core/synth/synth_scene.h"
 
@@ -37,9 +38,41 @@ enum class StackedKind {
   kCan,      // a can or bottle, lying on its side (3 in 4) or standing
   kPlate,    // a disc 18-24 cm across, 1-2 cm thick
   kTablet,   // a box 20-25 x 14-17 cm, 1-2 cm thick
+  // StackedPileOptions::more_kinds only:
+  kDrill,   // standing: a battery block, a handle, a barrel across the top
+            // and a chuck, in three colours (one object)
+  kBanana,  // lying: a curved chain of 4 rounded segments, 16-20 cm long
+  kPen,     // lying: a cylinder 12-15 cm long, 1.1-1.5 cm thick, and its cap
+  kPart,    // a small flat part: 2.5-5 cm across, 1-1.5 cm thick (the
+            // least height an object has, issue 48)
 };
 
 std::string_view StackedKindName(StackedKind kind);  // "book", "box", ...
+
+// How a pile is built and seen. The defaults are the `stacked` set's.
+struct StackedPileOptions {
+  // Also the kinds real frames showed cut or missed: a drill, a banana, a
+  // pen and small flat parts, and a tower of three boxes (drawn from the
+  // same stream after the default plan's draws, so with this off a seed
+  // gives the pile it gave before these kinds existed).
+  bool more_kinds = false;
+  // Seen from above: the camera 0.6-0.9 m above the table and at most
+  // 0.25 m back from the pile's centre (looking down 70-90 degrees)
+  // instead of 0.5-0.8 m back at 0.6-0.8 m up.
+  bool from_above = false;
+  // The frame, pixels (SensorIntrinsics scales the sensor's to it):
+  // [160, 1920] x [120, 1080].
+  int width = 640;
+  int height = 480;
+};
+
+// OK, or INVALID_ARGUMENT naming the field.
+absl::Status Validate(const StackedPileOptions& options);
+
+// The options of the `stacked-above` scorecard set: every kind, from
+// above, at the sensor's usual resolution (the Kinect v1's 640 x 480, the
+// active stereo's 1280 x 720).
+StackedPileOptions AbovePileOptions(RoomSensor sensor);
 
 // A pile before rendering.
 struct StackedPileSpec {
@@ -71,6 +104,10 @@ struct StackedPileSpec {
 // On the rare draw that falls short of these counts the pile is drawn
 // again from a stream derived from `seed`.
 StackedPileSpec RandomStackedPileSpec(uint64_t seed, RoomSensor sensor);
+// The same with `options` (precondition, checked: Validate(options) is
+// OK). Of the counts above, the visible share holds at any resolution.
+StackedPileSpec RandomStackedPileSpec(uint64_t seed, RoomSensor sensor,
+                                      const StackedPileOptions& options);
 
 // A rendered pile.
 struct StackedPile {
@@ -85,6 +122,10 @@ struct StackedPile {
 };
 
 StackedPile GenerateStackedPile(uint64_t seed, RoomSensor sensor);
+// The same with `options`; frame.name "stack-above-<seed>" (Kinect v1) or
+// "stack-above-as-<seed>" when seen from above, else as above.
+StackedPile GenerateStackedPile(uint64_t seed, RoomSensor sensor,
+                                const StackedPileOptions& options);
 
 // The number of objects resting on another object (rests_on >= 0).
 int CountStacked(const std::vector<int>& rests_on);

@@ -314,8 +314,15 @@ absl::Status RunSyntheticSets(const SetContext& ctx) {
   // only in front of the pile's middle).
   const std::pair<std::string,
                   synth::StackedPile (*)(uint64_t, synth::RoomSensor)>
-      stacked_sets[] = {{"stacked", &synth::GenerateStackedPile},
-                        {"stacked-crop", &synth::GenerateCroppedPile}};
+      stacked_sets[] = {
+          {"stacked", &synth::GenerateStackedPile},
+          {"stacked-crop", &synth::GenerateCroppedPile},
+          // Every kind (drills, bananas, pens, small parts, towers) seen
+          // from above at each sensor's usual resolution.
+          {"stacked-above", [](uint64_t seed, synth::RoomSensor sensor) {
+             return synth::GenerateStackedPile(seed, sensor,
+                                               synth::AbovePileOptions(sensor));
+           }}};
   for (const auto& [set, generate] : stacked_sets) {
     if (!Wants(o, set)) continue;
     for (const synth::RoomSensor sensor : sensors) {

@@ -29,6 +29,9 @@ namespace fovea::eval {
 //   stacked      synthetic stacked piles (boxes on books and boxes, cups in
 //                bowls, objects in a box, mugs with handles), Kinect and
 //                active-stereo noise;
+//   stacked-above  stacked piles with every kind (drills, bananas, pens,
+//                small parts, towers) seen from above, the Kinect at
+//                640x480 and active stereo at 1280x720;
 //   rooms        synthetic rooms, Kinect and active stereo;
 //   realsense    the four raw RealSense frames (marked pixels only).
 // Everything but `osd*` uses the shipped models (held out).

@@ -30,7 +30,8 @@ ABSL_FLAG(bool, short, false,
           "stacked and realsense, each exactly as in the full form).");
 ABSL_FLAG(std::string, sets, "",
           "scorecard: sets to run, comma-separated (osd, osd-rot90, "
-          "osd-rot180, osd-half, piles, stacked, stacked-crop, rooms, "
+          "osd-rot180, osd-half, piles, stacked, stacked-crop, stacked-above, "
+          "rooms, "
           "realsense, realism); empty: all (or the short form's with "
           "--short).");
 ABSL_FLAG(std::string, methods, "inc",
