@@ -172,6 +172,15 @@ absl::Status Validate(const IncOptions& options) {
         ">= 0, beneath_radius_m > 0, and min_resting_share, min_touching, "
         "min_convexity, max_sharp_concave and min_hidden_share in [0, 1]");
   }
+  const IncOptions::RestingOnFace& resting = options.resting_on_face;
+  if (!(resting.max_tilt_deg >= 0.0 && resting.max_tilt_deg <= 90.0) ||
+      !(resting.min_step_m >= 0.0) ||
+      !(resting.min_inside >= 0.0 && resting.min_inside <= 1.0) ||
+      !(resting.apart_probability >= 0.0 && resting.apart_probability < 0.5)) {
+    return absl::InvalidArgumentError(
+        "resting_on_face: max_tilt_deg must be in [0, 90], min_step_m >= 0, "
+        "min_inside in [0, 1] and apart_probability in [0, 0.5)");
+  }
   if (options.max_growth_steps < 1) {
     return absl::InvalidArgumentError(absl::StrCat(
         "max_growth_steps must be positive, got ", options.max_growth_steps));
@@ -314,6 +323,10 @@ double IncSegmenter::SameProbability(int a, int b) {
   if (body.enabled && p < body.joined_probability &&
       OnOneBody(scene_.points[a], scene_.points[b], scene_.up, body.fit)) {
     p = body.joined_probability;
+  }
+  if (options_.resting_on_face.enabled && p > 0.5 &&
+      (RestsOnFace(a, b) || RestsOnFace(b, a))) {
+    p = std::min(p, options_.resting_on_face.apart_probability);
   }
   probability_.emplace(key, p);
   return p;

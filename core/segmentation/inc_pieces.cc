@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <set>
@@ -202,6 +203,44 @@ IncSegmenter::Footprint IncSegmenter::FootprintOf(
   return f;
 }
 
+const IncSegmenter::Footprint& IncSegmenter::SurfaceFootprint(int surface) {
+  if (!footprints_[surface]) {
+    footprints_[surface] = FootprintOf({surface}, kSurfaceFootprintPoints);
+  }
+  return *footprints_[surface];
+}
+
+bool IncSegmenter::RestsOnFace(int piece, int face) {
+  const IncOptions::RestingOnFace& options = options_.resting_on_face;
+  const std::vector<PlanarPatch>& patches = scene_.surfaces.patches.patches;
+  const float level = static_cast<float>(
+      std::cos(options.max_tilt_deg * std::numbers::pi / 180.0));
+  if (std::abs(patches[piece].normal.dot(scene_.up)) < level ||
+      std::abs(patches[face].normal.dot(scene_.up)) < level ||
+      patches[piece].points >= patches[face].points) {
+    return false;
+  }
+  const Footprint& upper = SurfaceFootprint(piece);
+  const Footprint& lower = SurfaceFootprint(face);
+  if (upper.flat.empty() || lower.flat.size() < 3) return false;
+  const auto median = [](std::vector<float> heights) {
+    const auto mid =
+        heights.begin() + static_cast<ptrdiff_t>(heights.size() / 2);
+    std::nth_element(heights.begin(), mid, heights.end());
+    return *mid;
+  };
+  if (median(upper.heights) - median(lower.heights) < options.min_step_m) {
+    return false;
+  }
+  std::vector<cv::Point2f> hull;
+  cv::convexHull(lower.flat, hull);
+  int inside = 0;
+  for (const cv::Point2f& p : upper.flat) {
+    inside += cv::pointPolygonTest(hull, p, false) >= 0 ? 1 : 0;
+  }
+  return inside >= options.min_inside * static_cast<double>(upper.flat.size());
+}
+
 int IncSegmenter::AddPiecesWithin(std::vector<int>& group) {
   const IncOptions::PiecesWithin& options = options_.pieces_within;
   if (!options.enabled) return 0;
@@ -266,11 +305,7 @@ int IncSegmenter::AddPiecesWithin(std::vector<int>& group) {
     // sliver of a bowl's rim) would be an object of its own.
     const bool bordering = borders_object(s);
     if (bordering && borders_others(s)) continue;
-    if (!footprints_[s]) {
-      footprints_[s] =
-          FootprintOf({static_cast<int>(s)}, kSurfaceFootprintPoints);
-    }
-    const Footprint& piece = *footprints_[s];
+    const Footprint& piece = SurfaceFootprint(static_cast<int>(s));
     if (std::abs(piece.top - object.top) > options.top_m ||
         piece.bottom < object.bottom - options.max_below_m) {
       continue;

@@ -312,6 +312,14 @@ TEST(IncOptionsTest, ValidateNamesTheField) {
   EXPECT_NE(Validate(options).message().find("whole_object"),
             std::string::npos);
   options = {};
+  options.resting_on_face.apart_probability = 0.5;
+  EXPECT_NE(Validate(options).message().find("resting_on_face"),
+            std::string::npos);
+  options = {};
+  options.resting_on_face.min_step_m = -0.001;
+  EXPECT_NE(Validate(options).message().find("resting_on_face"),
+            std::string::npos);
+  options = {};
   options.body_join.fit.max_radius_m = 0.0f;
   EXPECT_NE(Validate(options).message().find("body_join"), std::string::npos);
   EXPECT_TRUE(Validate(IncOptions{}).ok());

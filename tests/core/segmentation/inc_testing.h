@@ -128,10 +128,11 @@ inline std::pair<int, double> MasksOnObject(const Scene& scene,
 }
 
 // Per object label of `labels`: how many of INC's masks on `scene` (no
-// saliency) lie mostly on it, and its best IoU with one.
+// saliency; relations by `svm`) lie mostly on it, and its best IoU with
+// one.
 inline std::map<int, std::pair<int, double>> MasksPerObject(
     const Scene& scene, const IncOptions& options,
-    const std::vector<int>& labels) {
+    const std::vector<int>& labels, const RbfSvm& svm = TrainedSvm()) {
   const cv::Mat& truth_labels = scene.synth.frame.labels;
   const cv::Mat flat(truth_labels.size(), CV_32FC1, cv::Scalar(0));
   std::map<int, std::pair<int, double>> on;
@@ -140,7 +141,7 @@ inline std::map<int, std::pair<int, double>> MasksPerObject(
                     scene.prepared.table.region);
   EXPECT_TRUE(inc.ok()) << inc.status();
   if (!inc.ok()) return on;
-  IncSegmenter segmenter(*inc, TrainedSvm(), options);
+  IncSegmenter segmenter(*inc, svm, options);
   while (true) {
     absl::StatusOr<std::optional<IncObject>> next = segmenter.Next();
     EXPECT_TRUE(next.ok()) << next.status();
