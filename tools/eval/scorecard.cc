@@ -173,6 +173,11 @@ absl::Status ScoreLabelledScene(
                        set.c_str(), r.method.c_str(), kind.c_str(),
                        scene.name.c_str(), describe(id).c_str());
         }
+        for (const auto& [id, masks] : r.in_pieces) {
+          std::fprintf(stderr, "%-10s %-4s %-10s %-22s   in %d masks: %s\n",
+                       set.c_str(), r.method.c_str(), kind.c_str(),
+                       scene.name.c_str(), masks, describe(id).c_str());
+        }
       }
     }
     if (!ctx.options->out_dir.empty()) {
@@ -506,6 +511,7 @@ SegmentFigures ScoreSegments(const cv::Mat& labels, const cv::Mat& segments) {
   for (const auto& [object, n] : masks_on) {
     r.object_masks += n;
     ++r.objects_with_masks;
+    if (n > 1) r.in_pieces.emplace_back(object, n);
   }
   for (const auto& [object, size] : object_size) {
     bool found = false;

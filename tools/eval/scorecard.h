@@ -2,6 +2,7 @@
 #define FOVEA_TOOLS_EVAL_SCORECARD_H_
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -99,6 +100,8 @@ struct SegmentFigures {
   int false_objects = 0;
   // The objects no segment matches with F >= 0.5 (ObjectId), ascending.
   std::vector<int> missed;
+  // (ObjectId, masks) of the objects that came out in more than one mask.
+  std::vector<std::pair<int, int>> in_pieces;
 };
 // `segments`: CV_32SC1 of the labels' size, -1 none, else a segment id.
 SegmentFigures ScoreSegments(const cv::Mat& labels, const cv::Mat& segments);
