@@ -3,6 +3,9 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "core/base/status_macros.h"
@@ -40,24 +43,29 @@ absl::StatusOr<std::string> ReadModelFile(const std::filesystem::path& path,
   return text.str();
 }
 
-// INC's relation model at `path`, checked to compute this build's
-// relations.
-absl::StatusOr<RbfSvm> LoadIncModel(const std::filesystem::path& path,
-                                    std::string_view how_to_make) {
+// The SVM of `path` (LinearSvm or RbfSvm), checked to take the features
+// this build computes: `what` names the kind in errors ("a COS model"),
+// `tag` is its file tag and fovea-train command.
+template <typename Svm>
+absl::StatusOr<Svm> LoadSvm(const std::filesystem::path& path,
+                            std::string_view tag, std::string_view what,
+                            const std::vector<std::string>& features,
+                            std::string_view how_to_make) {
   FOVEA_ASSIGN_OR_RETURN(std::string text, ReadModelFile(path, how_to_make));
-  absl::StatusOr<RbfSvm> inc = RbfSvm::Parse(text, "inc");
-  if (!inc.ok()) {
+  absl::StatusOr<Svm> svm = Svm::Parse(text, tag);
+  if (!svm.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("model file ", path.string(), " is not ", AbslView(what),
+                     ": ", svm.status().message()));
+  }
+  if (svm->feature_names() != features) {
     return absl::InvalidArgumentError(absl::StrCat(
         "model file ", path.string(),
-        " is not an INC relation model: ", inc.status().message()));
+        " was trained on other features than this build computes; retrain "
+        "it with fovea-train ",
+        AbslView(tag)));
   }
-  if (inc->feature_names() != RelationFeatureNames()) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "model file ", path.string(),
-        " was trained on other relations than this build computes; retrain "
-        "it with fovea-train inc"));
-  }
-  return *std::move(inc);
+  return *std::move(svm);
 }
 
 }  // namespace
@@ -78,26 +86,14 @@ absl::StatusOr<LoadedModels> LoadModels(const std::string& dir) {
         absl::StrCat("models folder '", dir, "' does not exist"));
   }
   LoadedModels models;
-  const std::filesystem::path cos_path =
-      std::filesystem::path(dir) / kCosModelFile;
   FOVEA_ASSIGN_OR_RETURN(
-      std::string cos_text,
-      ReadModelFile(cos_path,
-                    "fovea-train cos --data DIR --out models/cos_svm.txt"));
-  absl::StatusOr<LinearSvm> cos = LinearSvm::Parse(cos_text, "cos");
-  if (!cos.ok()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("model file ", cos_path.string(),
-                     " is not a COS model: ", cos.status().message()));
-  }
-  if (cos->feature_names() != CosFeatureNames()) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "model file ", cos_path.string(),
-        " was trained on other features than this build computes; retrain "
-        "it with fovea-train cos"));
-  }
-  models.versions.emplace_back("cos_svm", cos->Version());
-  models.cos = *std::move(cos);
+      LinearSvm cos,
+      LoadSvm<LinearSvm>(
+          std::filesystem::path(dir) / kCosModelFile, "cos", "a COS model",
+          CosFeatureNames(),
+          "fovea-train cos --data DIR --out models/cos_svm.txt"));
+  models.versions.emplace_back("cos_svm", cos.Version());
+  models.cos = std::move(cos);
 
   const std::filesystem::path ebs_path =
       std::filesystem::path(dir) / kEbsModelFile;
@@ -114,12 +110,11 @@ absl::StatusOr<LoadedModels> LoadModels(const std::string& dir) {
   models.versions.emplace_back("ebs_edges", ebs->Version());
   models.ebs = *std::move(ebs);
 
-  const std::filesystem::path inc_path =
-      std::filesystem::path(dir) / kIncModelFile;
   FOVEA_ASSIGN_OR_RETURN(
       RbfSvm inc,
-      LoadIncModel(
-          inc_path,
+      LoadSvm<RbfSvm>(
+          std::filesystem::path(dir) / kIncModelFile, "inc",
+          "an INC relation model", RelationFeatureNames(),
           "fovea-train inc --data DIR --out models/inc_relations.txt"));
   models.versions.emplace_back("inc_relations", inc.Version());
   models.inc = std::move(inc);
@@ -130,10 +125,11 @@ absl::StatusOr<LoadedModels> LoadModels(const std::string& dir) {
   if (std::filesystem::exists(stereo_dir, error)) {
     FOVEA_ASSIGN_OR_RETURN(
         RbfSvm stereo,
-        LoadIncModel(stereo_dir / kIncModelFile,
-                     "fovea-train inc --data DIR --sensor active_stereo "
-                     "--piles 100 --stacked 30 --out "
-                     "models/active_stereo/inc_relations.txt"));
+        LoadSvm<RbfSvm>(stereo_dir / kIncModelFile, "inc",
+                        "an INC relation model", RelationFeatureNames(),
+                        "fovea-train inc --data DIR --sensor active_stereo "
+                        "--piles 100 --stacked 60 --out "
+                        "models/active_stereo/inc_relations.txt"));
     models.versions.emplace_back("inc_relations.active_stereo",
                                  stereo.Version());
     models.inc_active_stereo = std::move(stereo);
