@@ -23,6 +23,7 @@
 #include "core/base/strings.h"
 #include "core/synth/random.h"
 #include "core/synth/random_bodies.h"
+#include "core/synth/textures.h"
 
 namespace fovea::synth {
 namespace {

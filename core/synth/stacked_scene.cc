@@ -33,6 +33,7 @@
 #include "core/synth/room.h"
 #include "core/synth/stacked_bodies.h"
 #include "core/synth/synth_scene.h"
+#include "core/synth/textures.h"
 
 namespace fovea::synth {
 namespace {

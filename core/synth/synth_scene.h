@@ -310,20 +310,6 @@ SynthScene GenerateScene(uint64_t seed);
 // leaning, seen by a Kinect from 0.7 m up and 0.65 m back.
 RandomSceneOptions PileOptions();
 
-// Prints on household objects, as real packaging, labels and mugs carry
-// them (docs/realism.md: with flat albedos, two surfaces of one synthetic
-// object were nearly always of one colour, colour similarity median 0.9995
-// against OSD's 0.868). Each object of `spec` (its parts alike) gets
-// Texture::kPrint with probability `probability` and a print colour: white,
-// black or a saturated hue. Drawn from a stream of its own derived from
-// `seed`, so that the scene's geometry is the one without prints.
-// Precondition (checked): probability in [0, 1].
-void AddPrints(uint64_t seed, float probability, SceneSpec& spec);
-
-// The share of a pile's, stacked pile's or room's objects that carry prints
-// (AddPrints).
-inline constexpr float kPrintedObjectShare = 0.7f;
-
 // RandomSceneSpec(seed, PileOptions()) rendered with KinectV1Noise();
 // frame.name "pile-<seed>". Crowded piles may hold fewer objects than
 // drawn: every object keeps 30 % of its pixels.

@@ -10,6 +10,7 @@
 #include "core/synth/room.h"
 #include "core/synth/stacked_scene.h"
 #include "core/synth/synth_scene.h"
+#include "core/synth/textures.h"
 
 namespace fovea::eval {
 

@@ -14,6 +14,7 @@
 
 #include "absl/status/status.h"
 #include "core/synth/footprint.h"
+#include "core/synth/textures.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "tests/core/synth/synth_test_util.h"
