@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <set>
@@ -62,6 +63,105 @@ void AddGapNeighbours(const cv::Mat& labels, const cv::Rect& box, float fx,
     na.insert(std::lower_bound(na.begin(), na.end(), b), b);
     std::vector<int>& nb = scene.neighbours[b];
     nb.insert(std::lower_bound(nb.begin(), nb.end(), a), a);
+  }
+}
+
+// IncOptions::AcrossOccluder: scans the rows and columns of `box` for
+// two planar surfaces separated only by nearer points, the far one's pixel
+// on the near one's plane; pairs met on enough lines, parallel and alike in
+// colour, become neighbours (scene.neighbours, scene.across_occluder).
+void AddOccludedNeighbours(const cv::Mat& labels, const cv::Rect& box,
+                           const IncOptions& options, IncScene& scene) {
+  const IncOptions::AcrossOccluder& o = options.across_occluder;
+  if (!o.enabled || box.empty()) return;
+  const std::vector<PlanarPatch>& patches = scene.surfaces.patches.patches;
+  const Intrinsics& k = scene.intrinsics;
+  const int max_gap =
+      std::max(1, static_cast<int>(std::lround(o.max_gap_px * k.fx / 525.0)));
+  // Rows and columns on which each pair was met.
+  std::map<std::pair<int, int>, std::pair<int, int>> lines;
+  // The depth at which pixel `p`'s ray meets surface `s`'s plane, or a
+  // negative value where it does not (in front of the camera).
+  const auto plane_depth = [&](int s, cv::Point p) {
+    const Eigen::Vector3f ray((p.x - k.cx) / k.fx, (p.y - k.cy) / k.fy, 1.0);
+    const float facing = patches[s].normal.dot(ray);
+    return std::abs(facing) > 1e-3f ? -patches[s].d / facing : -1.0f;
+  };
+  const auto scan = [&](cv::Point start, cv::Point step, int length) {
+    std::set<std::pair<int, int>> met;
+    int near = -1;        // the last surface pixel's label
+    cv::Point near_at;    // ... where it was
+    float near_z = 0.0f;  // ... and its depth
+    int occluding = 0;    // pixels in front of its plane since
+    int gap = 0;          // pixels since it
+    for (int i = 0; i < length; ++i) {
+      const cv::Point p = start + step * i;
+      const int l = labels.at<int>(p);
+      const float z = scene.xyz.at<cv::Vec3f>(p)[2];
+      if (near >= 0 && l != near) {
+        ++gap;
+        const float on_plane = plane_depth(near, p);
+        if (gap > max_gap || !(on_plane > 0.0f)) {
+          near = -1;
+        } else if (std::isnan(z)) {
+          continue;  // without depth: neither in front nor behind
+        } else if (z < on_plane - o.min_in_front_m) {
+          ++occluding;
+          continue;
+        } else if (l >= 0 && occluding > 0 &&
+                   std::abs(z - on_plane) <= o.plane_tolerance_m &&
+                   std::abs(near_z - plane_depth(l, near_at)) <=
+                       o.plane_tolerance_m) {
+          // Each side on the other's plane.
+          met.emplace(std::min(near, l), std::max(near, l));
+        } else if (l < 0) {
+          near = -1;  // behind or beside the plane: no occluder
+        }
+      }
+      if (l >= 0 && !scene.points[l].empty() && !std::isnan(z)) {
+        near = l;
+        near_at = p;
+        near_z = z;
+        occluding = 0;
+        gap = 0;
+      }
+    }
+    for (const auto& pair : met) {
+      (step.x != 0 ? lines[pair].first : lines[pair].second) += 1;
+    }
+  };
+  for (int v = box.y; v < box.br().y; ++v) {
+    scan({box.x, v}, {1, 0}, box.width);
+  }
+  for (int u = box.x; u < box.br().x; ++u) {
+    scan({u, box.y}, {0, 1}, box.height);
+  }
+  const double min_dot = std::cos(o.max_angle_deg * std::numbers::pi / 180.0);
+  const double max_up = std::cos(o.min_tilt_deg * std::numbers::pi / 180.0);
+  const std::vector<cv::Rect>& extent = scene.surfaces.label_boxes;
+  for (const auto& [pair, count] : lines) {  // sorted: so is across_occluder
+    const auto [a, b] = pair;
+    // Across the occluder along most of the smaller side's extent: a face
+    // continued, not two faces that happen to share a plane somewhere.
+    const auto continued = [&](int met, int extent_a, int extent_b) {
+      return met >= o.min_lines &&
+             met >= o.min_continued * std::min(extent_a, extent_b);
+    };
+    if (!continued(count.first, extent[a].height, extent[b].height) &&
+        !continued(count.second, extent[a].width, extent[b].width)) {
+      continue;
+    }
+    std::vector<int>& na = scene.neighbours[a];
+    if (std::binary_search(na.begin(), na.end(), b)) continue;
+    if (std::abs(patches[a].normal.dot(patches[b].normal)) < min_dot ||
+        std::abs(patches[a].normal.dot(scene.up)) > max_up) {
+      continue;
+    }
+    if (scene.relations->Relate(a, b)[0] < o.min_color_similarity) continue;
+    na.insert(std::lower_bound(na.begin(), na.end(), b), b);
+    std::vector<int>& nb = scene.neighbours[b];
+    nb.insert(std::lower_bound(nb.begin(), nb.end(), a), a);
+    scene.across_occluder.push_back(pair);
   }
 }
 
@@ -171,6 +271,21 @@ absl::Status Validate(const IncOptions& options) {
         "min_inside_concavity_m must be "
         ">= 0, beneath_radius_m > 0, and min_resting_share, min_touching, "
         "min_convexity, max_sharp_concave and min_hidden_share in [0, 1]");
+  }
+  const IncOptions::AcrossOccluder& across = options.across_occluder;
+  if (!(across.max_angle_deg >= 0.0 && across.max_angle_deg <= 90.0) ||
+      !(across.plane_tolerance_m >= 0.0) || !(across.min_in_front_m >= 0.0) ||
+      !(across.min_continued >= 0.0 && across.min_continued <= 1.0) ||
+      across.max_gap_px < 1 || across.min_lines < 1 ||
+      !(across.min_color_similarity >= 0.0 &&
+        across.min_color_similarity <= 1.0) ||
+      !(across.min_tilt_deg >= 0.0 && across.min_tilt_deg <= 90.0) ||
+      !(across.joined_probability > 0.5 && across.joined_probability <= 1.0)) {
+    return absl::InvalidArgumentError(
+        "across_occluder: max_angle_deg and min_tilt_deg must be in [0, 90], "
+        "plane_tolerance_m and min_in_front_m >= 0, max_gap_px and min_lines "
+        ">= 1, min_continued and min_color_similarity in [0, 1] and "
+        "joined_probability in (0.5, 1]");
   }
   const IncOptions::RestingOnFace& resting = options.resting_on_face;
   if (!(resting.max_tilt_deg >= 0.0 && resting.max_tilt_deg <= 90.0) ||
@@ -282,6 +397,7 @@ absl::StatusOr<IncScene> BuildIncScene(CosScene surfaces,
   }
   scene.neighbours = scene.surfaces.neighbours;
   AddGapNeighbours(object_labels, box, cloud.intrinsics.fx, options, scene);
+  AddOccludedNeighbours(object_labels, box, options, scene);
   clock.Lap("surface_points");
   return scene;
 }
@@ -323,6 +439,12 @@ double IncSegmenter::SameProbability(int a, int b) {
   if (body.enabled && p < body.joined_probability &&
       OnOneBody(scene_.points[a], scene_.points[b], scene_.up, body.fit)) {
     p = body.joined_probability;
+  }
+  if (options_.across_occluder.enabled &&
+      std::binary_search(scene_.across_occluder.begin(),
+                         scene_.across_occluder.end(),
+                         std::make_pair(std::min(a, b), std::max(a, b)))) {
+    p = std::max(p, options_.across_occluder.joined_probability);
   }
   if (options_.resting_on_face.enabled && p > 0.5 &&
       (RestsOnFace(a, b) || RestsOnFace(b, a))) {

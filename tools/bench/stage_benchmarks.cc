@@ -548,12 +548,13 @@ void RegisterFrameCases(
     // cross-section in the footprint, without what rests beyond the
     // visible table's hull, without each object checked as a whole
     // (IncOptions::whole_object), without what rests on a face kept apart
-    // (IncOptions::resting_on_face), or with the base INC model instead of the
-    // frame's sensor family's (SegmentModels::IncFor; the same on Kinect
-    // frames): what each costs.
+    // (IncOptions::resting_on_face), without one face joined across what
+    // stands in front of it (IncOptions::across_occluder), or with the base
+    // INC model instead of the frame's sensor family's
+    // (SegmentModels::IncFor; the same on Kinect frames): what each costs.
     const struct {
       const char* suffix;
-      bool pieces, body, beyond, whole, family, resting = true;
+      bool pieces, body, beyond, whole, family, resting = true, across = true;
     } variants[] = {
         {"", true, true, true, true, true},
         {"_without_pieces", false, false, true, true, true},
@@ -561,6 +562,7 @@ void RegisterFrameCases(
         {"_without_rest_beyond_hull", true, true, false, true, true},
         {"_without_whole_object", true, true, true, false, true},
         {"_without_resting_on_face", true, true, true, true, true, false},
+        {"_without_across_occluder", true, true, true, true, true, true, false},
         {"_with_base_model", true, true, true, true, false}};
     for (const auto& variant : variants) {
       IncrementalOptions options;
@@ -568,6 +570,7 @@ void RegisterFrameCases(
       options.inc.pieces_within.body_footprint = variant.body;
       options.inc.whole_object.enabled = variant.whole;
       options.inc.resting_on_face.enabled = variant.resting;
+      options.inc.across_occluder.enabled = variant.across;
       if (!variant.beyond) options.detect.table_scene.rest_beyond_hull_m = 0.0f;
       const bool family = variant.family;
       Register(

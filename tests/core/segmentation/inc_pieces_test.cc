@@ -284,5 +284,42 @@ TEST(IncTest, AThinPartLyingOnABookIsAnObjectOfItsOwn) {
   EXPECT_LT(joined[30].second, 0.3);
 }
 
+// A box seen on both sides of a can standing in front of it is one
+// object: its front face's two pieces lie on one plane, only the can's
+// nearer points between them. Without the rule INC never relates them (they
+// share no border) and the box is two masks.
+TEST(IncTest, ABoxSeenOnBothSidesOfACanInFrontOfItIsOneObject) {
+  synth::SceneSpec spec;
+  spec.camera_pose =
+      synth::LookAt(Eigen::Vector3f(0.0f, -0.7f, 0.45f), {0.0f, 0.05f, 0.06f});
+  synth::Primitive box;
+  box.shape = synth::Shape::kBox;
+  box.half_extents = {0.12f, 0.03f, 0.06f};
+  box.pose.translation() = Eigen::Vector3f(0.0f, 0.1f, 0.06f);
+  box.rgb = Eigen::Vector3f(0.2f, 0.45f, 0.7f);
+  synth::Primitive can;
+  can.shape = synth::Shape::kCylinder;
+  can.radius = 0.03f;
+  can.half_extents = {0.03f, 0.03f, 0.09f};
+  can.pose.translation() = Eigen::Vector3f(0.0f, -0.05f, 0.09f);
+  can.rgb = Eigen::Vector3f(0.8f, 0.3f, 0.1f);
+  spec.objects = {box, can};
+  const Scene scene =
+      Prepare(synth::RenderScene(spec, synth::NoiseOptions{}, 7));
+  IncOptions with;
+  IncOptions without = with;
+  without.across_occluder.enabled = false;
+  std::map<int, std::pair<int, double>> one =
+      MasksPerObject(scene, with, {20, 30});
+  std::map<int, std::pair<int, double>> two =
+      MasksPerObject(scene, without, {20, 30});
+  EXPECT_EQ(one[20].first, 1);
+  EXPECT_GT(one[20].second, 0.85);
+  EXPECT_EQ(one[30].first, 1);
+  EXPECT_GT(one[30].second, 0.85);
+  EXPECT_EQ(two[20].first, 2);
+  EXPECT_LT(two[20].second, 0.7);
+}
+
 }  // namespace
 }  // namespace fovea

@@ -312,6 +312,10 @@ TEST(IncOptionsTest, ValidateNamesTheField) {
   EXPECT_NE(Validate(options).message().find("whole_object"),
             std::string::npos);
   options = {};
+  options.across_occluder.min_continued = 1.5;
+  EXPECT_NE(Validate(options).message().find("across_occluder"),
+            std::string::npos);
+  options = {};
   options.resting_on_face.apart_probability = 0.5;
   EXPECT_NE(Validate(options).message().find("resting_on_face"),
             std::string::npos);
