@@ -514,6 +514,19 @@ bool IncSegmenter::TouchesIn3d(const std::vector<int>& piece,
   return touching;
 }
 
+std::vector<int> IncSegmenter::GroupAround(int s) {
+  std::set<int> near = {s};
+  for (int step = 0; step < 2; ++step) {
+    const std::vector<int> ring(near.begin(), near.end());
+    for (const int r : ring) {
+      for (const int t : scene_.neighbours[r]) {
+        if (!removed_[t]) near.insert(t);
+      }
+    }
+  }
+  return GroupOf(std::vector<int>(near.begin(), near.end()), s, nullptr);
+}
+
 int IncSegmenter::TakeHangingNeighbours(IncObject& object) {
   int pixels = 0;
   std::vector<int> around;
@@ -526,18 +539,7 @@ int IncSegmenter::TakeHangingNeighbours(IncObject& object) {
   around.erase(std::unique(around.begin(), around.end()), around.end());
   for (const int s : around) {
     if (removed_[s]) continue;  // taken with an earlier one
-    // The group INC would grow from it, within two steps.
-    std::set<int> near = {s};
-    for (int step = 0; step < 2; ++step) {
-      const std::vector<int> ring(near.begin(), near.end());
-      for (const int r : ring) {
-        for (const int t : scene_.neighbours[r]) {
-          if (!removed_[t]) near.insert(t);
-        }
-      }
-    }
-    const std::vector<int> piece =
-        GroupOf(std::vector<int>(near.begin(), near.end()), s, nullptr);
+    const std::vector<int> piece = GroupAround(s);
     if (RestsOnSomething(piece) || !HangsFrom(piece, object.surfaces)) {
       continue;
     }
