@@ -57,6 +57,22 @@ void RegisterStageBenchmarks(const SceneList* scenes,
                              const std::string& suffix,
                              const SweepOptions& sweep);
 
+// Rough per-frame cost of a whole Detect and a whole INC segmentation on
+// one core, milliseconds; only sizes the number of passes per repetition
+// (SweepIterations).
+inline constexpr double kDetectMs = 30.0;
+inline constexpr double kSegmentMs = 60.0;
+
+// What a benchmark case does with one scene.
+using SceneBody = std::function<absl::Status(const BenchScene&)>;
+
+// Registers benchmark `name`: `body` over every scene of `scenes` per
+// iteration (SweepScenes), as many iterations as `sweep` and
+// `expected_ms` per frame ask (SweepIterations), in milliseconds.
+void Register(const std::string& name, const SceneList* scenes,
+              const std::string& set_name, const SweepOptions& sweep,
+              double expected_ms, SceneBody body);
+
 // Whole requests from the raw wire frame, as the server runs them in
 // process: decode, then Detect ("BM_Frame/detect/<set>") or
 // SegmentIncremental to the end of the scene ("BM_Frame/inc/<set>"), each
