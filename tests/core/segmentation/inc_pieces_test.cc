@@ -225,12 +225,7 @@ TEST(IncTest, ABlockStandingInAnOpenBoxStaysApartFromIt) {
   synth::SceneSpec spec;
   spec.camera_pose = synth::LookAt({0.0f, -0.6f, 0.45f}, {0.0f, 0.0f, 0.04f});
   const auto slab = [](Eigen::Vector3f half, Eigen::Vector3f at) {
-    synth::Primitive p;
-    p.shape = synth::Shape::kBox;
-    p.half_extents = half;
-    p.pose.translation() = at;
-    p.rgb = {0.8f, 0.3f, 0.2f};
-    return p;
+    return testing::Solid(synth::Shape::kBox, half, at, {0.8f, 0.3f, 0.2f});
   };
   const synth::Primitive floor =
       slab({0.06f, 0.05f, 0.003f}, {0.0f, 0.0f, 0.003f});
@@ -258,16 +253,11 @@ TEST(IncTest, AThinPartLyingOnABookIsAnObjectOfItsOwn) {
   synth::SceneSpec spec;
   spec.camera_pose =
       synth::LookAt(Eigen::Vector3f(0.0f, -0.25f, 0.7f), {0.0f, 0.0f, 0.0f});
-  synth::Primitive book;
-  book.shape = synth::Shape::kBox;
-  book.half_extents = {0.12f, 0.09f, 0.015f};
-  book.pose.translation() = Eigen::Vector3f(0.0f, 0.0f, 0.015f);
-  book.rgb = Eigen::Vector3f(0.2f, 0.3f, 0.6f);
-  synth::Primitive part = book;
-  part.half_extents = {0.025f, 0.02f, 0.006f};
-  part.pose.translation() = Eigen::Vector3f(0.02f, 0.01f, 0.036f);
-  part.rgb = Eigen::Vector3f(0.85f, 0.15f, 0.15f);
-  spec.objects = {book, part};
+  spec.objects = {
+      testing::Solid(synth::Shape::kBox, {0.12f, 0.09f, 0.015f},
+                     {0.0f, 0.0f, 0.015f}, {0.2f, 0.3f, 0.6f}),  // book
+      testing::Solid(synth::Shape::kBox, {0.025f, 0.02f, 0.006f},
+                     {0.02f, 0.01f, 0.036f}, {0.85f, 0.15f, 0.15f})};  // part
   const Scene scene =
       Prepare(synth::RenderScene(spec, synth::NoiseOptions{}, 5));
   IncOptions with;
@@ -292,18 +282,11 @@ TEST(IncTest, ABoxSeenOnBothSidesOfACanInFrontOfItIsOneObject) {
   synth::SceneSpec spec;
   spec.camera_pose =
       synth::LookAt(Eigen::Vector3f(0.0f, -0.7f, 0.45f), {0.0f, 0.05f, 0.06f});
-  synth::Primitive box;
-  box.shape = synth::Shape::kBox;
-  box.half_extents = {0.12f, 0.03f, 0.06f};
-  box.pose.translation() = Eigen::Vector3f(0.0f, 0.1f, 0.06f);
-  box.rgb = Eigen::Vector3f(0.2f, 0.45f, 0.7f);
-  synth::Primitive can;
-  can.shape = synth::Shape::kCylinder;
-  can.radius = 0.03f;
-  can.half_extents = {0.03f, 0.03f, 0.09f};
-  can.pose.translation() = Eigen::Vector3f(0.0f, -0.05f, 0.09f);
-  can.rgb = Eigen::Vector3f(0.8f, 0.3f, 0.1f);
-  spec.objects = {box, can};
+  spec.objects = {
+      testing::Solid(synth::Shape::kBox, {0.12f, 0.03f, 0.06f},
+                     {0.0f, 0.1f, 0.06f}, {0.2f, 0.45f, 0.7f}),
+      testing::Solid(synth::Shape::kCylinder, {0.03f, 0.03f, 0.09f},
+                     {0.0f, -0.05f, 0.09f}, {0.8f, 0.3f, 0.1f})};  // the can
   const Scene scene =
       Prepare(synth::RenderScene(spec, synth::NoiseOptions{}, 7));
   IncOptions with;

@@ -66,6 +66,20 @@ inline const RbfSvm& ContrarySvm() {
   return *svm;
 }
 
+// An upright primitive of `shape` with half sizes `half` (a cylinder's or
+// sphere's radius half.x()) centred at `centre`, albedo `rgb`.
+inline synth::Primitive Solid(synth::Shape shape, const Eigen::Vector3f& half,
+                              const Eigen::Vector3f& centre,
+                              const Eigen::Vector3f& rgb) {
+  synth::Primitive p;
+  p.shape = shape;
+  p.half_extents = half;
+  p.radius = half.x();
+  p.pose.translation() = centre;
+  p.rgb = rgb;
+  return p;
+}
+
 struct Scene {
   synth::SynthScene synth;
   PreparedScene prepared;
