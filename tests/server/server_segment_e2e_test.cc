@@ -38,7 +38,6 @@ using ::fovea::server::testing::HealthStatus;
 using ::fovea::server::testing::kCallTimeout;
 using ::fovea::server::testing::MakeSyntheticRequest;
 using ::fovea::server::testing::MetricIncrease;
-using ::fovea::server::testing::MetricValue;
 using ::fovea::server::testing::ServerTest;
 using ::fovea::server::testing::SyntheticRequest;
 using ::fovea::server::testing::WaitFor;
@@ -90,11 +89,13 @@ TEST_F(ServerTest, StreamWhoseClientNeverReadsIsCancelledAndFreesItsWorker) {
   grpc::ClientContext context;
   context.set_deadline(std::chrono::system_clock::now() +
                        std::chrono::seconds(60));
+  // The binary's tests share one process, and its metrics.
+  const std::string before = Scrape();
   auto never_read = lazy->Segment(&context, request);
   ASSERT_TRUE(WaitFor(
-      [this] {
-        return MetricValue(Scrape(), "fovea_calls_shed_total",
-                           {"reason=\"stalled_stream\""}) >= 1;
+      [&] {
+        return MetricIncrease(before, Scrape(), "fovea_calls_shed_total",
+                              {"reason=\"stalled_stream\""}) >= 1;
       },
       kCallTimeout));
   // The worker is free: a Detect from another client succeeds.
@@ -331,6 +332,7 @@ TEST_F(ServerTest, SegmentIncrementalStreamsObjectsInOrderAndStops) {
   EXPECT_EQ(messages.back().summary().object_count(), 1u);
   request.set_max_objects(0);
   request.set_time_budget_seconds(1e-9);
+  const std::string before = Scrape();
   grpc::ClientContext budget;
   auto budget_reader = stub_->SegmentIncremental(&budget, request);
   messages.clear();
@@ -338,10 +340,9 @@ TEST_F(ServerTest, SegmentIncrementalStreamsObjectsInOrderAndStops) {
   ASSERT_TRUE(budget_reader->Finish().ok());
   EXPECT_EQ(messages.back().summary().stop_reason(),
             v1::STOP_REASON_TIME_BUDGET);
-  const std::string text = Scrape();
-  EXPECT_EQ(MetricValue(text, "fovea_segment_stops_total",
-                        {"grpc_method=\"SegmentIncremental\"",
-                         "reason=\"time_budget\""}),
+  EXPECT_EQ(MetricIncrease(before, Scrape(), "fovea_segment_stops_total",
+                           {"grpc_method=\"SegmentIncremental\"",
+                            "reason=\"time_budget\""}),
             1);
   // A negative budget is refused naming the field.
   request.set_time_budget_seconds(-1.0);
@@ -376,6 +377,7 @@ TEST_F(ServerTest, SegmentDeadlineMidStreamKeepsWhatWasSentAndEndsDeadline) {
     ASSERT_TRUE(reader->Finish().ok());
   }
   const auto whole_call = std::chrono::steady_clock::now() - first_start;
+  const std::string before = Scrape();  // the binary's tests share metrics
   const int passes_before = stage_gate_.entered();
   const int held_pass = passes_before + kAfterSeedsMessage;
   stage_gate_.CloseAtPass(held_pass);
@@ -414,9 +416,9 @@ TEST_F(ServerTest, SegmentDeadlineMidStreamKeepsWhatWasSentAndEndsDeadline) {
   // The worker stops at its next check and the server goes on.
   ASSERT_TRUE(WaitFor(
       [&] {
-        return MetricValue(Scrape(), "grpc_server_handled_total",
-                           {"grpc_method=\"Segment\"",
-                            "grpc_code=\"DeadlineExceeded\""}) == 1;
+        return MetricIncrease(before, Scrape(), "grpc_server_handled_total",
+                              {"grpc_method=\"Segment\"",
+                               "grpc_code=\"DeadlineExceeded\""}) == 1;
       },
       std::chrono::seconds(10)));
   EXPECT_EQ(stage_gate_.entered(), held_pass);  // stopped there
@@ -426,13 +428,15 @@ TEST_F(ServerTest, SegmentCancelledAfterTheFirstMessageEndsCancelled) {
   StartServer();
   v1::SegmentRequest request;
   *request.mutable_frame() = MakeSyntheticRequest(3, false).request.frame();
+  // The binary's tests share one process, and its metrics.
+  const std::string before = Scrape();
   const SegmentCall call = CallSegment(*stub_, request, /*read_at_most=*/1);
   EXPECT_EQ(call.status.error_code(), grpc::StatusCode::CANCELLED);
   // The server finishes the call and goes on serving.
   ASSERT_TRUE(WaitFor(
       [&] {
-        return MetricValue(
-                   Scrape(), "grpc_server_handled_total",
+        return MetricIncrease(
+                   before, Scrape(), "grpc_server_handled_total",
                    {"grpc_method=\"Segment\"", "grpc_code=\"Canceled\""}) == 1;
       },
       std::chrono::seconds(10)));

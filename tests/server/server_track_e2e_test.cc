@@ -75,6 +75,7 @@ TEST_F(ServerTest, TrackKeepsIdentitiesOverAStillScene) {
   StartServer();
   const synth::Sequence sequence =
       synth::GenerateSequence(synth::SequenceKind::kStatic, 3, 3);
+  const std::string before = Scrape();   // the binary's tests share metrics
   ::testing::internal::CaptureStderr();  // the call's log line
   auto context = Context();
   std::unique_ptr<Stream> stream = stub_->Track(context.get());
@@ -115,10 +116,12 @@ TEST_F(ServerTest, TrackKeepsIdentitiesOverAStillScene) {
     }
   }
   const std::string metrics = Scrape();
-  EXPECT_EQ(Handled(metrics, "Track", "OK"), 1);
-  EXPECT_EQ(
-      MetricValue(metrics, "fovea_track_frames_total", {"outcome=\"reused\""}),
-      2);
+  EXPECT_EQ(MetricIncrease(before, metrics, "grpc_server_handled_total",
+                           {"grpc_method=\"Track\"", "grpc_code=\"OK\""}),
+            1);
+  EXPECT_EQ(MetricIncrease(before, metrics, "fovea_track_frames_total",
+                           {"outcome=\"reused\""}),
+            2);
   // The stream is closed once the server's side of the call is done too.
   EXPECT_TRUE(WaitFor(
       [&] {
@@ -134,6 +137,7 @@ TEST_F(ServerTest, TrackSegmentsOnlyTheRegionThatChanged) {
   StartServer();
   const synth::Sequence sequence =
       synth::GenerateSequence(synth::SequenceKind::kPush, 5, 3);
+  const std::string before = Scrape();  // the binary's tests share metrics
   auto context = Context();
   std::unique_ptr<Stream> stream = stub_->Track(context.get());
   ASSERT_TRUE(stream->Write(Options("push")));
@@ -178,9 +182,9 @@ TEST_F(ServerTest, TrackSegmentsOnlyTheRegionThatChanged) {
     }
   }
   EXPECT_GT(kept_outside, 0);
-  EXPECT_EQ(
-      MetricValue(Scrape(), "fovea_track_frames_total", {"outcome=\"region\""}),
-      2);
+  EXPECT_EQ(MetricIncrease(before, Scrape(), "fovea_track_frames_total",
+                           {"outcome=\"region\""}),
+            2);
 }
 
 // Frames that arrive while one is processed wait in one slot; a newer one
@@ -190,6 +194,7 @@ TEST_F(ServerTest, TrackAnswersTheFreshestFrameAndCountsTheSkipped) {
   StartServer();
   const synth::Sequence sequence =
       synth::GenerateSequence(synth::SequenceKind::kDrift, 4, 4);
+  const std::string before = Scrape();  // the binary's tests share metrics
   auto context = Context();
   std::unique_ptr<Stream> stream = stub_->Track(context.get());
   ASSERT_TRUE(stream->Write(Options("fresh")));
@@ -202,9 +207,8 @@ TEST_F(ServerTest, TrackAnswersTheFreshestFrameAndCountsTheSkipped) {
   }
   ASSERT_TRUE(WaitFor(
       [&] {
-        return MetricValue(Scrape(), "fovea_track_frames_total",
-                           {"outcome=\"skipped\""})
-                   .value_or(0) >= 2;
+        return MetricIncrease(before, Scrape(), "fovea_track_frames_total",
+                              {"outcome=\"skipped\""}) >= 2;
       },
       std::chrono::seconds(30)));
   stage_gate_.Open();
@@ -354,6 +358,7 @@ TEST_F(ServerTest, TrackWhoseClientNeverReadsIsCancelledAndOthersGoOn) {
       ::fovea::server::testing::SlowReaderStub(server_->port());
   const synth::Sequence sequence =
       synth::GenerateSequence(synth::SequenceKind::kStatic, 3, 2);
+  const std::string before = Scrape();  // the binary's tests share metrics
   auto context = Context();
   std::unique_ptr<Stream> stream = lazy->Track(context.get());
   ASSERT_TRUE(stream->Write(Options("never-reads")));
@@ -361,17 +366,15 @@ TEST_F(ServerTest, TrackWhoseClientNeverReadsIsCancelledAndOthersGoOn) {
   // answer several kB of masks: the client's window fills quickly.
   for (uint64_t t = 0; t < 400; ++t) {
     if (!stream->Write(FrameMessage(sequence.frames[t % 2], t))) break;
-    if (MetricValue(Scrape(), "fovea_calls_shed_total",
-                    {"reason=\"stalled_stream\""})
-            .value_or(0) >= 1) {
+    if (MetricIncrease(before, Scrape(), "fovea_calls_shed_total",
+                       {"reason=\"stalled_stream\""}) >= 1) {
       break;
     }
   }
   ASSERT_TRUE(WaitFor(
       [&] {
-        return MetricValue(Scrape(), "fovea_calls_shed_total",
-                           {"reason=\"stalled_stream\""})
-                   .value_or(0) >= 1;
+        return MetricIncrease(before, Scrape(), "fovea_calls_shed_total",
+                              {"reason=\"stalled_stream\""}) >= 1;
       },
       std::chrono::seconds(30)));
   v1::DetectResponse response;
