@@ -43,7 +43,7 @@ absl::StatusOr<fovea::v1::Fusion> ParseFusion(absl::string_view text);
 // "cos", "ebs".
 absl::StatusOr<fovea::v1::SegmentationMethod> ParseSegmentationMethod(
     absl::string_view text);
-// "generic", "kinect_v1", "active_stereo".
+// "generic", "kinect_v1", "active_stereo", "time_of_flight".
 absl::StatusOr<fovea::v1::SensorModel> ParseSensorModel(absl::string_view text);
 
 // The names the parsers above accept for `type`'s values, in the

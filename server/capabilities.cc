@@ -5,6 +5,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "core/frame/sensor_model.h"
 #include "core/pipeline/saliency_registry.h"
 #include "server/convert.h"
 
@@ -102,10 +103,8 @@ v1::GetCapabilitiesResponse BuildCapabilities(
     model->set_version(version);
   }
   out.set_segment_incremental(true);
-  for (const v1::SensorModel model :
-       {v1::SENSOR_MODEL_GENERIC, v1::SENSOR_MODEL_KINECT_V1,
-        v1::SENSOR_MODEL_ACTIVE_STEREO}) {
-    out.add_sensor_models(model);
+  for (const NamedValue<SensorKind>& sensor : SensorKinds()) {
+    out.add_sensor_models(ToProtoEnum(sensor.value));
   }
   *out.mutable_default_detect_options() = ToProtoDetectOptions(DetectOptions{});
   return out;

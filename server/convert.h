@@ -78,6 +78,7 @@ v1::Pyramid ToProtoEnum(PyramidKind pyramid);
 v1::LevelCombination ToProtoEnum(LevelCombination combination);
 v1::Normalization ToProtoEnum(NormalizationKind normalization);
 v1::Fusion ToProtoEnum(FusionKind fusion);
+v1::SensorModel ToProtoEnum(SensorKind sensor);
 v1::Extraction ToProtoEnum(ExtractionKind extraction);
 
 // Detect responses (convert_detect_response.cc).

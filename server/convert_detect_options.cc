@@ -219,6 +219,9 @@ absl::Status ApplyScene(const v1::SceneOptions& in, DetectOptions& out) {
     case v1::SENSOR_MODEL_ACTIVE_STEREO:
       scene.sensor = SensorKind::kActiveStereo;
       break;
+    case v1::SENSOR_MODEL_TIME_OF_FLIGHT:
+      scene.sensor = SensorKind::kTimeOfFlight;
+      break;
     default:
       return UnknownEnumValue("options.scene.sensor", in.sensor());
   }
@@ -356,6 +359,20 @@ v1::Extraction ToProtoEnum(ExtractionKind extraction) {
   return value;
 }
 
+v1::SensorModel ToProtoEnum(SensorKind sensor) {
+  switch (sensor) {
+    case SensorKind::kGeneric:
+      return v1::SENSOR_MODEL_GENERIC;
+    case SensorKind::kKinectV1:
+      return v1::SENSOR_MODEL_KINECT_V1;
+    case SensorKind::kActiveStereo:
+      return v1::SENSOR_MODEL_ACTIVE_STEREO;
+    case SensorKind::kTimeOfFlight:
+      return v1::SENSOR_MODEL_TIME_OF_FLIGHT;
+  }
+  return v1::SENSOR_MODEL_UNSPECIFIED;
+}
+
 v1::DetectOptions ToProtoDetectOptions(const DetectOptions& options) {
   v1::DetectOptions out;
   for (const WeightedChannel& channel : options.channels) {
@@ -372,17 +389,7 @@ v1::DetectOptions ToProtoDetectOptions(const DetectOptions& options) {
   out.set_return_channel_maps(options.keep_channel_maps);
   out.set_split_at_surface_edges(options.split_at_surface_edges);
   v1::SceneOptions* scene = out.mutable_scene();
-  switch (options.scene.sensor) {
-    case SensorKind::kGeneric:
-      scene->set_sensor(v1::SENSOR_MODEL_GENERIC);
-      break;
-    case SensorKind::kKinectV1:
-      scene->set_sensor(v1::SENSOR_MODEL_KINECT_V1);
-      break;
-    case SensorKind::kActiveStereo:
-      scene->set_sensor(v1::SENSOR_MODEL_ACTIVE_STEREO);
-      break;
-  }
+  scene->set_sensor(ToProtoEnum(options.scene.sensor));
   scene->set_processing_width(
       static_cast<uint32_t>(options.scene.processing_width));
   return out;

@@ -27,9 +27,15 @@ enum class SensorKind {
   // range, and bands without depth beside foreground objects and at the
   // image's left edge.
   kActiveStereo,
+  // Time of flight in the manner of Azure Kinect / Kinect v2: per-pixel
+  // noise of a millimetre or two, growing slowly with distance; no
+  // shadows (illuminator and sensor sit together), mixed ("flying")
+  // pixels along depth edges, dark surfaces without depth.
+  kTimeOfFlight,
 };
 
-// The kinds' names (core/base/name_table.h): generic kinect_v1 active_stereo.
+// The kinds' names (core/base/name_table.h): generic kinect_v1
+// active_stereo time_of_flight.
 absl::Span<const NamedValue<SensorKind>> SensorKinds();
 std::string_view SensorKindName(SensorKind kind);
 // The inverse of SensorKindName; INVALID_ARGUMENT listing the known names.
@@ -43,7 +49,10 @@ struct SensorModel {
   // disparity noise of about 0.08 px over a 5 cm baseline and a focal length
   // near 600 px gives about 2.5e-3 / m; the four RealSense frames of
   // shared/data/realsense show 0.7-1.8 mm on their table tops at 0.45-1 m,
-  // hence the millimetre floor.
+  // hence the millimetre floor. Time of flight: 1 mm + 0.5e-3 / m (about
+  // 1.5 mm at 1 m and 3 mm at 2 m, as published for the Kinect v2 and
+  // Azure Kinect on matte surfaces, Fankhauser et al. 2015, Tolgyessy et
+  // al. 2021; no frames of one have been measured here).
   float sigma0_m = 0.0f;
   float sigma_per_z2 = 1.43e-3f;
   // Depth beyond which the sensor's data is not used by default, metres:
@@ -56,20 +65,27 @@ struct SensorModel {
 };
 
 // The model of `kind` for a frame with these intrinsics (pixels of the
-// frame as sent). kGeneric chooses from the focal length a frame of the
-// camera 640 pixels on its longer side would have
-// (fx * 640 / (2 max(cx, cy) + 1), so that a camera rolled a quarter turn
-// is still itself): 500-590 px is
-// the structured-light PrimeSense family (Kinect v1, Xtion, Astra) and gets
-// the Kinect v1 model; any other camera gets the active-stereo model, the
-// noisier one, with a 3 m range.
+// frame as sent). kGeneric chooses from the frame's shape, as its
+// principal point gives it ((2 cx + 1) by (2 cy + 1), longer side over
+// shorter, so that a camera rolled a quarter turn is still itself), then
+// from the focal length a frame of the camera 640 pixels on its longer
+// side would have (fx * 640 / (2 max(cx, cy) + 1)):
+//   - nearly square, at most 1.22 to 1 (time-of-flight depth cameras:
+//     Azure Kinect 640x576 and 512x512, Kinect v2 512x424, where 4:3 is
+//     1.33 and 16:9 1.78): the time-of-flight model;
+//   - 500-590 px: the structured-light PrimeSense family (Kinect v1,
+//     Xtion, Astra), the Kinect v1 model;
+//   - any other camera the active-stereo model, the noisier one, with a
+//     3 m range.
+// A time-of-flight frame registered to a wider colour camera looks like
+// that camera: declare its sensor.
 SensorModel SensorModelFor(SensorKind kind, const Intrinsics& intrinsics);
 
 // The kind whose noise SensorModelFor gives `kind` with these intrinsics:
-// `kind` itself, or for kGeneric kKinectV1 or kActiveStereo as chosen
-// above (whose range is then the generic 3 m, not the stereo one). For a
-// part of the frame cut out (its principal point moved), whose own
-// intrinsics would choose otherwise.
+// `kind` itself, or for kGeneric kTimeOfFlight, kKinectV1 or
+// kActiveStereo as chosen above (whose range is then the generic 3 m, not the
+// stereo one). For a part of the frame cut out (its principal point moved),
+// whose own intrinsics would choose otherwise.
 SensorKind NoiseKind(SensorKind kind, const Intrinsics& intrinsics);
 
 }  // namespace fovea

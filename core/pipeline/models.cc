@@ -75,7 +75,9 @@ SegmentModels LoadedModels::View() const {
   models.cos = cos ? &*cos : nullptr;
   models.ebs = ebs ? &*ebs : nullptr;
   models.inc = inc ? &*inc : nullptr;
-  models.inc_active_stereo = inc_active_stereo ? &*inc_active_stereo : nullptr;
+  for (size_t i = 0; i < inc_family.size(); ++i) {
+    models.inc_family[i] = inc_family[i] ? &*inc_family[i] : nullptr;
+  }
   return models;
 }
 
@@ -120,19 +122,23 @@ absl::StatusOr<LoadedModels> LoadModels(const std::string& dir) {
   models.inc = std::move(inc);
 
   // A sensor family's folder, when there is one, must hold its model.
-  const std::filesystem::path stereo_dir =
-      std::filesystem::path(dir) / kActiveStereoModelsDir;
-  if (std::filesystem::exists(stereo_dir, error)) {
+  for (size_t i = 0; i < std::size(kIncFamilies); ++i) {
+    const std::string family(SensorKindName(kIncFamilies[i]));
+    const std::filesystem::path family_dir =
+        std::filesystem::path(dir) / family;
+    if (!std::filesystem::exists(family_dir, error)) continue;
     FOVEA_ASSIGN_OR_RETURN(
-        RbfSvm stereo,
-        LoadSvm<RbfSvm>(stereo_dir / kIncModelFile, "inc",
-                        "an INC relation model", RelationFeatureNames(),
-                        "fovea-train inc --data DIR --sensor active_stereo "
-                        "--piles 100 --stacked 60 --out "
-                        "models/active_stereo/inc_relations.txt"));
-    models.versions.emplace_back("inc_relations.active_stereo",
-                                 stereo.Version());
-    models.inc_active_stereo = std::move(stereo);
+        RbfSvm svm,
+        LoadSvm<RbfSvm>(
+            family_dir / kIncModelFile, "inc", "an INC relation model",
+            RelationFeatureNames(),
+            absl::StrCat("fovea-train inc --data DIR --sensor ", family,
+                         " --piles 100 --stacked 60 --out "
+                         "models/",
+                         family, "/inc_relations.txt")));
+    models.versions.emplace_back(absl::StrCat("inc_relations.", family),
+                                 svm.Version());
+    models.inc_family[i] = std::move(svm);
   }
   return models;
 }

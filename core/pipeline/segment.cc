@@ -375,8 +375,10 @@ absl::StatusOr<std::vector<AttentionPoint>> TakeSeeds(
 }  // namespace
 
 const RbfSvm* SegmentModels::IncFor(SensorKind noise_kind) const {
-  if (noise_kind == SensorKind::kActiveStereo && inc_active_stereo != nullptr) {
-    return inc_active_stereo;
+  for (size_t i = 0; i < std::size(kIncFamilies); ++i) {
+    if (kIncFamilies[i] == noise_kind && inc_family[i] != nullptr) {
+      return inc_family[i];
+    }
   }
   return inc;
 }

@@ -2,6 +2,7 @@
 #define FOVEA_CORE_PIPELINE_SEGMENT_H_
 
 #include <Eigen/Core>
+#include <array>
 #include <chrono>
 #include <functional>
 #include <memory>
@@ -120,6 +121,13 @@ struct SegmentOptions {
 // max_objects, more than kMaxAttentionPoints seeds.
 absl::Status Validate(const SegmentOptions& options);
 
+// The sensor families that may have INC relation models of their own,
+// trained on scenes that family sees (models/<SensorKindName>/, see
+// core/pipeline/models.h); every other family's frames, the Kinect v1's
+// among them, get the base model.
+inline constexpr SensorKind kIncFamilies[] = {SensorKind::kActiveStereo,
+                                              SensorKind::kTimeOfFlight};
+
 // The trained models segmentation uses; not owned, may be null when the
 // method does not need them.
 struct SegmentModels {
@@ -128,10 +136,9 @@ struct SegmentModels {
   // INC's relation SVM (incremental.h): the structured-light (Kinect v1)
   // family's, and every family's that has none of its own.
   const RbfSvm* inc = nullptr;
-  // INC's relation SVM of the active-stereo family (RealSense D4xx-like;
-  // models/active_stereo/, trained on scenes that sensor sees); null:
-  // `inc` serves those frames too.
-  const RbfSvm* inc_active_stereo = nullptr;
+  // INC's relation SVM of each of kIncFamilies, in its order; null: `inc`
+  // serves that family's frames too.
+  std::array<const RbfSvm*, std::size(kIncFamilies)> inc_family{};
 
   // INC's model for a frame whose depth noise is `noise_kind`'s (NoiseKind
   // in core/frame/sensor_model.h; kGeneric is taken as the Kinect v1).

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 
+#include "absl/strings/str_cat.h"
+#include "core/base/strings.h"
 #include "core/frame/osd_pcd.h"
 #include "core/synth/random.h"
 
@@ -51,8 +53,7 @@ StackedPile GenerateCroppedPile(uint64_t seed, RoomSensor sensor) {
   CropLikeOsd(pile.spec, mean_y + rng.Uniform(kCropShiftMin, kCropShiftMax),
               pile.scene);
   pile.scene.frame.name =
-      (sensor == RoomSensor::kKinectV1 ? "stack-crop-" : "stack-crop-as-") +
-      std::to_string(seed);
+      absl::StrCat("stack-crop-", AbslView(RoomSensorTag(sensor)), seed);
   return pile;
 }
 

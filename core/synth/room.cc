@@ -19,6 +19,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
+#include "core/base/name_table.h"
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/synth/random.h"
@@ -27,6 +28,12 @@
 
 namespace fovea::synth {
 namespace {
+
+constexpr NamedValue<RoomSensor> kRoomSensors[] = {
+    {RoomSensor::kKinectV1, "kinect_v1"},
+    {RoomSensor::kActiveStereo, "active_stereo"},
+    {RoomSensor::kTimeOfFlight, "time_of_flight"},
+};
 
 using Eigen::Vector2f;
 using Eigen::Vector3f;
@@ -192,15 +199,23 @@ float EdgeDistance(const Vector2f& half, const Vector2f& dir) {
 }  // namespace
 
 std::string_view RoomSensorName(RoomSensor sensor) {
-  return sensor == RoomSensor::kKinectV1 ? "kinect_v1" : "active_stereo";
+  return NameOf<RoomSensor>(kRoomSensors, sensor);
+}
+
+std::string_view RoomSensorTag(RoomSensor sensor) {
+  switch (sensor) {
+    case RoomSensor::kKinectV1:
+      return "";
+    case RoomSensor::kActiveStereo:
+      return "as-";
+    case RoomSensor::kTimeOfFlight:
+      return "tof-";
+  }
+  return "";
 }
 
 absl::StatusOr<RoomSensor> ParseRoomSensor(std::string_view text) {
-  if (text == "kinect_v1") return RoomSensor::kKinectV1;
-  if (text == "active_stereo") return RoomSensor::kActiveStereo;
-  return absl::InvalidArgumentError(
-      absl::StrCat("room sensor: unknown '", AbslView(text),
-                   "' (known: kinect_v1 active_stereo)"));
+  return ParseNamed<RoomSensor>(kRoomSensors, "room sensor", "kind", text);
 }
 
 absl::Status Validate(const RoomOptions& options) {
@@ -235,8 +250,20 @@ absl::Status Validate(const RoomOptions& options) {
 }
 
 NoiseOptions RoomNoise(RoomSensor sensor) {
-  return sensor == RoomSensor::kKinectV1 ? KinectV1Noise()
-                                         : ActiveStereoNoise();
+  switch (sensor) {
+    case RoomSensor::kKinectV1:
+      return KinectV1Noise();
+    case RoomSensor::kActiveStereo:
+      return ActiveStereoNoise();
+    case RoomSensor::kTimeOfFlight:
+      return TimeOfFlightNoise();
+  }
+  return KinectV1Noise();
+}
+
+cv::Size SensorFrameSize(RoomSensor sensor) {
+  return sensor == RoomSensor::kTimeOfFlight ? cv::Size(640, 576)
+                                             : cv::Size(640, 480);
 }
 
 Intrinsics SensorIntrinsics(RoomSensor sensor, int width, int height) {
@@ -246,6 +273,13 @@ Intrinsics SensorIntrinsics(RoomSensor sensor, int width, int height) {
     k.fx = k.fy = 525.0 * w / 640.0;
     k.cx = (w - 1.0) / 2.0;
     k.cy = (h - 1.0) / 2.0;
+    return k;
+  }
+  if (sensor == RoomSensor::kTimeOfFlight) {
+    // Azure Kinect NFOV unbinned: 75 x 65 degrees at 640x576.
+    k.fx = k.fy = 504.0 * w / 640.0;
+    k.cx = w / 2.0 + 1.0 * w / 640.0;
+    k.cy = h / 2.0 + 4.0 * h / 576.0;
     return k;
   }
   const bool wide = w / h > 1.55;  // 16:9 rather than 4:3

@@ -24,9 +24,14 @@ enum class RoomSensor {
   kKinectV1,      // 640x480 at fx 525 (scaled with the width), KinectV1Noise
   kActiveStereo,  // fx 613 at 640x480 (4:3) or 920 at 1280x720 (16:9),
                   // ActiveStereoNoise
+  kTimeOfFlight,  // fx 504 at 640x576 (Azure Kinect NFOV), TimeOfFlightNoise
 };
 
-std::string_view RoomSensorName(RoomSensor sensor);  // "kinect_v1", ...
+// "kinect_v1", "active_stereo", "time_of_flight".
+std::string_view RoomSensorName(RoomSensor sensor);
+// The sensor's part of a synthetic scene's name: "" for the Kinect v1 (the
+// names scenes had before there were others), "as-", "tof-".
+std::string_view RoomSensorTag(RoomSensor sensor);
 absl::StatusOr<RoomSensor> ParseRoomSensor(std::string_view text);
 
 struct RoomOptions {
@@ -63,6 +68,11 @@ SceneSpec RandomRoomSpec(uint64_t seed, const RoomOptions& options);
 
 // The noise model of options.sensor.
 NoiseOptions RoomNoise(RoomSensor sensor);
+
+// The frame `sensor` sends unless asked for another size: 640x480, or
+// 640x576 for time of flight (whose nearly square frame is how a generic
+// camera is recognised as one, core/frame/sensor_model.h).
+cv::Size SensorFrameSize(RoomSensor sensor);
 
 // The pinhole intrinsics of `sensor` at width x height pixels, as
 // RoomSensor describes them (the Kinect's principal point at the image

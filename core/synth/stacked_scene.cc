@@ -27,6 +27,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/check.h"
+#include "core/base/strings.h"
 #include "core/synth/footprint.h"
 #include "core/synth/random.h"
 #include "core/synth/raycast.h"
@@ -545,8 +546,16 @@ absl::Status Validate(const StackedPileOptions& options) {
   return absl::OkStatus();
 }
 
-StackedPileOptions AbovePileOptions(RoomSensor sensor) {
+StackedPileOptions SensorPileOptions(RoomSensor sensor) {
   StackedPileOptions options;
+  const cv::Size size = SensorFrameSize(sensor);
+  options.width = size.width;
+  options.height = size.height;
+  return options;
+}
+
+StackedPileOptions AbovePileOptions(RoomSensor sensor) {
+  StackedPileOptions options = SensorPileOptions(sensor);
   options.more_kinds = true;
   options.from_above = true;
   if (sensor == RoomSensor::kActiveStereo) {
@@ -557,7 +566,7 @@ StackedPileOptions AbovePileOptions(RoomSensor sensor) {
 }
 
 StackedPileSpec RandomStackedPileSpec(uint64_t seed, RoomSensor sensor) {
-  return RandomStackedPileSpec(seed, sensor, StackedPileOptions());
+  return RandomStackedPileSpec(seed, sensor, SensorPileOptions(sensor));
 }
 
 StackedPileSpec RandomStackedPileSpec(uint64_t seed, RoomSensor sensor,
@@ -575,7 +584,7 @@ StackedPileSpec RandomStackedPileSpec(uint64_t seed, RoomSensor sensor,
 }
 
 StackedPile GenerateStackedPile(uint64_t seed, RoomSensor sensor) {
-  return GenerateStackedPile(seed, sensor, StackedPileOptions());
+  return GenerateStackedPile(seed, sensor, SensorPileOptions(sensor));
 }
 
 StackedPile GenerateStackedPile(uint64_t seed, RoomSensor sensor,
@@ -584,11 +593,9 @@ StackedPile GenerateStackedPile(uint64_t seed, RoomSensor sensor,
   AddPrints(seed, kPrintedObjectShare, pile.spec);
   StackedPile out;
   out.scene = RenderScene(pile.spec, RoomNoise(sensor), seed);
-  const bool kinect = sensor == RoomSensor::kKinectV1;
-  out.scene.frame.name = absl::StrCat(
-      options.from_above ? (kinect ? "stack-above-" : "stack-above-as-")
-                         : (kinect ? "stack-" : "stack-as-"),
-      seed);
+  out.scene.frame.name =
+      absl::StrCat(options.from_above ? "stack-above-" : "stack-",
+                   AbslView(RoomSensorTag(sensor)), seed);
   out.spec = std::move(pile.spec);
   out.kinds = std::move(pile.kinds);
   out.rests_on = std::move(pile.rests_on);

@@ -69,15 +69,21 @@ struct StackedPileOptions {
 // OK, or INVALID_ARGUMENT naming the field.
 absl::Status Validate(const StackedPileOptions& options);
 
+// The default options at `sensor`'s own frame size (SensorFrameSize:
+// 640 x 576 for time of flight, else 640 x 480): what the overloads
+// without options use.
+StackedPileOptions SensorPileOptions(RoomSensor sensor);
+
 // The options of the `stacked-above` scorecard set: every kind, from
 // above, at the sensor's usual resolution (the Kinect v1's 640 x 480, the
-// active stereo's 1280 x 720).
+// active stereo's 1280 x 720, the time of flight's 640 x 576).
 StackedPileOptions AbovePileOptions(RoomSensor sensor);
 
 // A pile before rendering.
 struct StackedPileSpec {
   // spec.objects[k] (and its object_parts) is object k; spec.intrinsics,
-  // width and height are the sensor's (SensorIntrinsics at 640 x 480).
+  // width and height are the sensor's (SensorIntrinsics at the options'
+  // size).
   SceneSpec spec;
   std::vector<StackedKind> kinds;  // per object
   // Per object: -1 on the table, else the index j < k of the object it
@@ -104,8 +110,9 @@ struct StackedPileSpec {
 // On the rare draw that falls short of these counts the pile is drawn
 // again from a stream derived from `seed`.
 StackedPileSpec RandomStackedPileSpec(uint64_t seed, RoomSensor sensor);
-// The same with `options` (precondition, checked: Validate(options) is
-// OK). Of the counts above, the visible share holds at any resolution.
+// The same with `options` (the overload above: SensorPileOptions(sensor))
+// (precondition, checked: Validate(options) is OK). Of the counts above, the
+// visible share holds at any resolution.
 StackedPileSpec RandomStackedPileSpec(uint64_t seed, RoomSensor sensor,
                                       const StackedPileOptions& options);
 
@@ -113,8 +120,9 @@ StackedPileSpec RandomStackedPileSpec(uint64_t seed, RoomSensor sensor,
 struct StackedPile {
   // RandomStackedPileSpec rendered with RoomNoise(sensor), noise seeded by
   // `seed`: labels 10 * (k + 2) for object k and all its parts, 1 the
-  // table, 2 floor, 3 wall, 0 no depth. frame.name is "stack-<seed>" for
-  // the Kinect v1 and "stack-as-<seed>" for active stereo.
+  // table, 2 floor, 3 wall, 0 no depth. frame.name is "stack-<tag><seed>",
+  // the tag RoomSensorTag(sensor): "" for the Kinect v1, "as-" for active
+  // stereo, "tof-" for time of flight.
   SynthScene scene;
   SceneSpec spec;                  // what was rendered
   std::vector<StackedKind> kinds;  // as StackedPileSpec
@@ -122,8 +130,8 @@ struct StackedPile {
 };
 
 StackedPile GenerateStackedPile(uint64_t seed, RoomSensor sensor);
-// The same with `options`; frame.name "stack-above-<seed>" (Kinect v1) or
-// "stack-above-as-<seed>" when seen from above, else as above.
+// The same with `options`; frame.name "stack-above-<tag><seed>" when seen
+// from above, else as above.
 StackedPile GenerateStackedPile(uint64_t seed, RoomSensor sensor,
                                 const StackedPileOptions& options);
 

@@ -140,6 +140,9 @@ float NoisyDepth(float z, float focal_px, const NoiseOptions& noise,
                  float normal) {
   const float sigma = noise.sigma0_m + noise.sigma_per_z2 * z * z;
   const float noisy = z + sigma * normal;
+  if (noise.disparity_step_px == 0.0f) {
+    return noisy > 0.0f ? noisy : std::numeric_limits<float>::quiet_NaN();
+  }
   const float fb = focal_px * noise.baseline_m;  // disparity = fb / z
   const float disparity = std::round(fb / noisy / noise.disparity_step_px) *
                           noise.disparity_step_px;
@@ -261,9 +264,13 @@ absl::Status Validate(const NoiseOptions& options) {
   if (!(options.baseline_m > 0.0f)) {
     return absl::InvalidArgumentError("NoiseOptions.baseline_m must be > 0");
   }
-  if (!(options.disparity_step_px > 0.0f)) {
+  if (!(options.disparity_step_px >= 0.0f)) {
     return absl::InvalidArgumentError(
-        "NoiseOptions.disparity_step_px must be > 0");
+        "NoiseOptions.disparity_step_px must be >= 0");
+  }
+  if (!IsUnit(options.flying_pixel_probability)) {
+    return absl::InvalidArgumentError(
+        "NoiseOptions.flying_pixel_probability must be in [0, 1]");
   }
   if (options.edge_dropout_px < 0 || !(options.edge_jump_m > 0.0f)) {
     return absl::InvalidArgumentError(
@@ -316,6 +323,21 @@ NoiseOptions ActiveStereoNoise() {
   return noise;
 }
 
+NoiseOptions TimeOfFlightNoise() {
+  NoiseOptions noise;
+  noise.sigma0_m = 0.001f;
+  noise.sigma_per_z2 = 0.5e-3f;
+  noise.noise_correlation_px = 1.0f;  // the lens's blur, little else
+  noise.disparity_step_px = 0.0f;
+  noise.edge_dropout_px = 2;
+  noise.flying_pixel_probability = 0.3f;
+  noise.shadow_baseline_m = 0.0f;
+  noise.dark_albedo = 0.1f;
+  noise.dark_dropout_probability = 0.5f;
+  noise.color_sigma = 2.5f;
+  return noise;
+}
+
 SynthScene RenderScene(const SceneSpec& spec, const NoiseOptions& noise,
                        uint64_t seed) {
   FOVEA_CHECK(Validate(spec).ok());
@@ -325,9 +347,18 @@ SynthScene RenderScene(const SceneSpec& spec, const NoiseOptions& noise,
   const bool noisy = noise.enabled;
   const float focal = static_cast<float>(spec.intrinsics.fx);
   cv::Mat edge_dropout;
+  // With flying pixels: the edge band (not the shadows) and how far each
+  // of its pixels lies behind the nearer surface.
+  cv::Mat flying_band;
+  cv::Mat behind_nearest;
   if (noisy) {
-    edge_dropout =
-        EdgeDropoutMask(ray.depth, noise) | ShadowMask(ray.depth, focal, noise);
+    const cv::Mat band = EdgeDropoutMask(ray.depth, noise);
+    edge_dropout = band | ShadowMask(ray.depth, focal, noise);
+    if (noise.flying_pixel_probability > 0.0f) {
+      flying_band = band;
+      behind_nearest =
+          DepthBehindNearest(ray.depth, std::max(1, noise.edge_dropout_px));
+    }
   }
   const cv::Mat depth_noise =
       noisy && noise.noise_correlation_px > 0.0f
@@ -429,8 +460,17 @@ SynthScene RenderScene(const SceneSpec& spec, const NoiseOptions& noise,
               edge ||
               (dark[hit] && rng.Bernoulli(noise.dark_dropout_probability));
           if (dropped) {
+            const float z = depth_row[u];
             depth_row[u] = nan;
             labelled = !edge;
+            if (edge && !flying_band.empty() &&
+                flying_band.at<uint8_t>(v, u) != 0 &&
+                rng.Bernoulli(noise.flying_pixel_probability)) {
+              const float mixed =
+                  z - rng.Uniform(0.2f, 0.8f) * behind_nearest.at<float>(v, u);
+              depth_row[u] = NoisyDepth(mixed, focal, noise,
+                                        static_cast<float>(rng.Normal()));
+            }
           } else {
             const float normal = depth_noise.empty()
                                      ? static_cast<float>(rng.Normal())

@@ -141,13 +141,19 @@ struct NoiseOptions {
   float noise_correlation_px = 0.0f;
   // Disparity quantisation: depth is quantised to steps of
   // z^2 / (focal_px * baseline_m) * disparity_step (Kinect: 1/8 px,
-  // baseline 0.075 m).
+  // baseline 0.075 m). A step of 0 quantises nothing (time of flight,
+  // whose millimetre steps lie below its noise).
   float baseline_m = 0.075f;
   float disparity_step_px = 0.125f;
   // Depth is dropped within this many pixels of a depth jump larger than
   // `edge_jump_m` (the projector shadow and edge dropouts).
   int edge_dropout_px = 2;
   float edge_jump_m = 0.03f;
+  // Mixed ("flying") pixels: an edge-dropout pixel (not a shadow's) keeps
+  // a depth with this probability, between its own and the nearer
+  // surface's (a time-of-flight pixel that sees both averages them); it
+  // belongs to no object. 0 = every edge pixel drops.
+  float flying_pixel_probability = 0.0f;
   // Shadows: a point hidden from a second viewpoint `shadow_baseline_m` to
   // the camera's right (the projector, or the second imager of a stereo
   // pair) has no depth. This is the band left of every foreground object
@@ -183,6 +189,13 @@ absl::Status Validate(const NoiseOptions& options);
 // border band, dark surfaces losing depth more often.
 NoiseOptions KinectV1Noise();
 NoiseOptions ActiveStereoNoise();
+// Time of flight (Azure Kinect / Kinect v2-like), from published
+// characterisations, as no frames of one are at hand to measure against:
+// sigma 1 mm + 0.5e-3 z^2 per pixel (Fankhauser et al. 2015, Tolgyessy et
+// al. 2021), no disparity steps, no shadows (illuminator beside the
+// sensor), a pixel of mixed depths or none along depth edges, dark
+// surfaces (little returned infrared) losing depth.
+NoiseOptions TimeOfFlightNoise();
 
 // KinectV1Noise() with independent per-pixel noise (noise_correlation_px
 // 0), as every synthetic Kinect scene was rendered before docs/realism.md

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "core/frame/sensor_model.h"
 #include "core/synth/synth_scene.h"
 #include "gmock/gmock.h"
 #include "gtest/gtest.h"
@@ -203,6 +204,20 @@ TEST(ToDetectOptionsTest, SceneOptionsReachCore) {
   EXPECT_EQ(plain->scene.processing_width, 640);
   EXPECT_FALSE(plain->scene.support.gravity.has_value());
   EXPECT_FALSE(plain->scene.workspace.box.has_value());
+}
+
+// Every sensor core knows has a wire value that comes back as itself.
+TEST(ToDetectOptionsTest, EverySensorSurvivesTheWire) {
+  for (const NamedValue<SensorKind>& sensor : SensorKinds()) {
+    DetectOptions options;
+    options.scene.sensor = sensor.value;
+    const absl::StatusOr<DetectOptions> back =
+        ToDetectOptions(ToProtoDetectOptions(options));
+    ASSERT_TRUE(back.ok()) << sensor.name << ": " << back.status();
+    EXPECT_EQ(back->scene.sensor, sensor.value) << sensor.name;
+  }
+  EXPECT_EQ(ToProtoEnum(SensorKind::kTimeOfFlight),
+            v1::SENSOR_MODEL_TIME_OF_FLIGHT);
 }
 
 TEST(ToDetectOptionsTest, BadSceneHintsAreInvalidAndNamed) {

@@ -86,6 +86,12 @@ TEST_F(ServerTest, CapabilitiesReportWhatCoreImplements) {
   EXPECT_EQ(capabilities.models(3).name(), "inc_relations.active_stereo");
   EXPECT_THAT(capabilities.models(3).version(), ::testing::StartsWith("inc-"));
   EXPECT_NE(capabilities.models(3).version(), capabilities.models(2).version());
+  // Every sensor model core has, time of flight among them.
+  EXPECT_THAT(capabilities.sensor_models(),
+              ::testing::ElementsAre(v1::SENSOR_MODEL_GENERIC,
+                                     v1::SENSOR_MODEL_KINECT_V1,
+                                     v1::SENSOR_MODEL_ACTIVE_STEREO,
+                                     v1::SENSOR_MODEL_TIME_OF_FLIGHT));
   EXPECT_TRUE(capabilities.segment_incremental());
   EXPECT_EQ(capabilities.default_detect_options().max_points(), 100u);
 }

@@ -315,8 +315,12 @@ absl::Status RunSyntheticSets(const SetContext& ctx) {
   }
   const synth::RoomSensor sensors[] = {synth::RoomSensor::kKinectV1,
                                        synth::RoomSensor::kActiveStereo};
-  // The stacked piles as generated, and with OSD's crop (the table seen
-  // only in front of the pile's middle).
+  // The stacked piles as generated (and, for the Kinect and the active
+  // stereo, with OSD's crop: the table seen only in front of the pile's
+  // middle); time of flight at its own 640 x 576.
+  const synth::RoomSensor stacked_sensors[] = {
+      synth::RoomSensor::kKinectV1, synth::RoomSensor::kActiveStereo,
+      synth::RoomSensor::kTimeOfFlight};
   const std::pair<std::string,
                   synth::StackedPile (*)(uint64_t, synth::RoomSensor)>
       stacked_sets[] = {
@@ -330,7 +334,10 @@ absl::Status RunSyntheticSets(const SetContext& ctx) {
            }}};
   for (const auto& [set, generate] : stacked_sets) {
     if (!Wants(o, set)) continue;
-    for (const synth::RoomSensor sensor : sensors) {
+    for (const synth::RoomSensor sensor : stacked_sensors) {
+      if (set == "stacked-crop" && sensor == synth::RoomSensor::kTimeOfFlight) {
+        continue;
+      }
       for (int k = 0; k < o.stacked; ++k) {
         const synth::StackedPile pile = generate(1 + k, sensor);
         // Object k has label 10 (k + 2), ObjectId k + 2.

@@ -58,16 +58,19 @@ inline std::vector<LabelledFrame> SyntheticTrainingScenes(int piles,
 
 // The training pile of `seed` as `sensor` sees it: GeneratePile's
 // arrangement, printed as GeneratePile's (synth::AddPrints), with that
-// sensor's intrinsics at 640 x 480 and its noise (synth::RoomNoise). For the
-// Kinect v1, TrainingPile: flat albedos, as the shipped base model was
-// trained (retrained on printed piles it gave a trade, not a gain:
-// RealSense masks per object 1.78 -> 1.67 and stacked piles up, but
+// sensor's intrinsics at its frame size (synth::SensorFrameSize) and its noise
+// (synth::RoomNoise). For the Kinect v1, TrainingPile: flat albedos, as the
+// shipped base model was trained (retrained on printed piles it gave a trade,
+// not a gain: RealSense masks per object 1.78 -> 1.67 and stacked piles up, but
 // synthetic piles overlap F 0.913 -> 0.910 and Kinect rooms 0.932 -> 0.923;
 // docs/scorecard.md).
 inline LabelledFrame TrainingPile(uint64_t seed, synth::RoomSensor sensor) {
   if (sensor == synth::RoomSensor::kKinectV1) return TrainingPile(seed);
   synth::SceneSpec spec = synth::RandomSceneSpec(seed, synth::PileOptions());
   synth::AddPrints(seed, synth::kPrintedObjectShare, spec);
+  const cv::Size size = synth::SensorFrameSize(sensor);
+  spec.width = size.width;
+  spec.height = size.height;
   spec.intrinsics = synth::SensorIntrinsics(sensor, spec.width, spec.height);
   synth::SynthScene scene =
       synth::RenderScene(spec, synth::RoomNoise(sensor), seed);

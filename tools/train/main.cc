@@ -47,7 +47,8 @@ ABSL_FLAG(int, stacked, 0,
           "(core/synth GenerateStackedPile, Kinect v1 and active stereo).");
 ABSL_FLAG(std::string, sensor, "",
           "inc: train the model of this sensor family (kinect_v1, "
-          "active_stereo; models/README.md): the synthetic piles and stacked "
+          "active_stereo, time_of_flight; models/README.md): the synthetic "
+          "piles and stacked "
           "piles are all seen by it. Unset: piles seen by the Kinect v1 and "
           "stacked piles of both sensors.");
 ABSL_FLAG(double, c, fovea::LinearSvmTrainingOptions().c,

@@ -6,8 +6,9 @@ namespace fovea {
 namespace {
 
 TEST(SensorModelTest, NamesRoundTripAndUnknownNamesListTheKnownOnes) {
-  for (const SensorKind kind : {SensorKind::kGeneric, SensorKind::kKinectV1,
-                                SensorKind::kActiveStereo}) {
+  for (const SensorKind kind :
+       {SensorKind::kGeneric, SensorKind::kKinectV1, SensorKind::kActiveStereo,
+        SensorKind::kTimeOfFlight}) {
     absl::StatusOr<SensorKind> parsed = ParseSensorKind(SensorKindName(kind));
     ASSERT_TRUE(parsed.ok());
     EXPECT_EQ(*parsed, kind);
@@ -66,6 +67,42 @@ TEST(SensorModelTest, GenericPicksTheModelFromTheFocalLength) {
         << k.fx;
     EXPECT_FLOAT_EQ(g.max_range_m, 3.0f);
   }
+}
+
+TEST(SensorModelTest, TimeOfFlightIsQuieterThanStereoAndTheFarKinect) {
+  const Intrinsics azure{504.2, 504.3, 321.0, 331.5};  // 640x576
+  const SensorModel t = SensorModelFor(SensorKind::kTimeOfFlight, azure);
+  const SensorModel s = SensorModelFor(SensorKind::kActiveStereo, azure);
+  const SensorModel k = SensorModelFor(SensorKind::kKinectV1, azure);
+  for (const float z : {0.3f, 0.7f, 1.0f, 2.0f, 3.0f}) {
+    EXPECT_LT(t.DepthSigma(z), s.DepthSigma(z)) << z;
+  }
+  // Per-pixel noise a millimetre and a half at 1 m, growing slowly: the
+  // Kinect's quadratic overtakes it beyond a metre.
+  EXPECT_NEAR(t.DepthSigma(1.0f), 0.0015f, 1e-6f);
+  for (const float z : {1.5f, 2.0f, 3.0f}) {
+    EXPECT_LT(t.DepthSigma(z), k.DepthSigma(z)) << z;
+  }
+}
+
+TEST(SensorModelTest, GenericTakesANearlySquareFrameForTimeOfFlight) {
+  // Azure Kinect NFOV 640x576 (its fx640 of 504 would pass for a
+  // PrimeSense), WFOV binned 512x512, Kinect v2 512x424 (principal point a
+  // few pixels off centre), and the Azure frame rolled a quarter turn.
+  for (const Intrinsics& k : {Intrinsics{504.2, 504.3, 321.0, 331.5},
+                              Intrinsics{252.0, 252.0, 255.5, 255.5},
+                              Intrinsics{365.5, 365.5, 256.5, 210.5},
+                              Intrinsics{504.3, 504.2, 331.5, 321.0}}) {
+    EXPECT_EQ(NoiseKind(SensorKind::kGeneric, k), SensorKind::kTimeOfFlight)
+        << k.fx << " " << k.cx << " " << k.cy;
+    EXPECT_EQ(SensorModelFor(SensorKind::kGeneric, k).sigma_per_z2,
+              SensorModelFor(SensorKind::kTimeOfFlight, k).sigma_per_z2);
+  }
+  // 4:3 with the principal point 8 px off centre each way is still 4:3.
+  EXPECT_EQ(NoiseKind(SensorKind::kGeneric, {525.0, 525.0, 311.5, 247.5}),
+            SensorKind::kKinectV1);
+  EXPECT_EQ(NoiseKind(SensorKind::kGeneric, {612.9, 613.2, 311.5, 247.5}),
+            SensorKind::kActiveStereo);
 }
 
 TEST(SensorModelTest, NoiseKindIsTheModelGenericChoseForTheWholeFrame) {

@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 
 #include "core/frame/osd_pcd.h"
+#include "core/frame/sensor_model.h"
 #include "core/synth/raycast.h"
 
 namespace fovea::synth {
@@ -82,6 +84,30 @@ TEST(RoomTest, WideFramesUseTheWideIntrinsics) {
   EXPECT_EQ(room.frame.frame.depth.size(), cv::Size(1280, 720));
   EXPECT_DOUBLE_EQ(room.frame.frame.intrinsics.fx, 920.0);
   EXPECT_GT(CountLabel(room.frame.labels, kSupportTableLabel), 40000);
+}
+
+// Each sensor's name round-trips; its own frame is one a generic camera's
+// intrinsics are recognised from (core/frame/sensor_model.h): the time of
+// flight's nearly square 640x576.
+TEST(RoomTest, EachSensorsFrameIsRecognisedAsThatSensor) {
+  const std::pair<RoomSensor, SensorKind> sensors[] = {
+      {RoomSensor::kKinectV1, SensorKind::kKinectV1},
+      {RoomSensor::kActiveStereo, SensorKind::kActiveStereo},
+      {RoomSensor::kTimeOfFlight, SensorKind::kTimeOfFlight}};
+  for (const auto& [sensor, kind] : sensors) {
+    const absl::StatusOr<RoomSensor> parsed =
+        ParseRoomSensor(RoomSensorName(sensor));
+    ASSERT_TRUE(parsed.ok()) << RoomSensorName(sensor);
+    EXPECT_EQ(*parsed, sensor);
+    const cv::Size size = SensorFrameSize(sensor);
+    EXPECT_EQ(NoiseKind(SensorKind::kGeneric,
+                        SensorIntrinsics(sensor, size.width, size.height)),
+              kind)
+        << RoomSensorName(sensor);
+  }
+  EXPECT_EQ(SensorFrameSize(RoomSensor::kTimeOfFlight), cv::Size(640, 576));
+  EXPECT_NE(ParseRoomSensor("tof").status().message().find("time_of_flight"),
+            std::string::npos);
 }
 
 TEST(RoomTest, ValidateNamesTheField) {

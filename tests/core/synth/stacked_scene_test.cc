@@ -176,6 +176,8 @@ TEST(StackedPileTest, SameSeedSameLabelsOtherSeedDiffers) {
             1000);
 }
 
+void ExpectEachRestsOnWhatItNames(const StackedPile& pile);
+
 TEST(StackedPileTest, NameAndIntrinsicsFollowTheSensor) {
   const StackedPile kinect = GenerateStackedPile(3, RoomSensor::kKinectV1);
   const StackedPile stereo = GenerateStackedPile(3, RoomSensor::kActiveStereo);
@@ -186,6 +188,17 @@ TEST(StackedPileTest, NameAndIntrinsicsFollowTheSensor) {
   EXPECT_EQ(stereo.scene.frame.frame.color.cols, 640);
   EXPECT_EQ(stereo.scene.frame.frame.color.rows, 480);
   EXPECT_GE(stereo.kinds.size(), 8u);
+  // Time of flight at its own 640x576, every object still in view.
+  const StackedPile tof = GenerateStackedPile(3, RoomSensor::kTimeOfFlight);
+  EXPECT_EQ(tof.scene.frame.name, "stack-tof-3");
+  EXPECT_EQ(tof.scene.frame.frame.color.size(), cv::Size(640, 576));
+  EXPECT_DOUBLE_EQ(tof.scene.frame.frame.intrinsics.fx, 504.0);
+  EXPECT_GE(tof.kinds.size(), 8u);
+  ExpectEachRestsOnWhatItNames(tof);
+  EXPECT_EQ(GenerateStackedPile(3, RoomSensor::kTimeOfFlight,
+                                AbovePileOptions(RoomSensor::kTimeOfFlight))
+                .scene.frame.name,
+            "stack-above-tof-3");
 }
 
 TEST(StackedPileTest, EveryPileHoldsEightToSixteenVisibleObjectsThreeStacked) {

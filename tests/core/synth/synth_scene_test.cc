@@ -589,6 +589,53 @@ TEST(RenderSceneTest, DepthEdgesHaveNaNDropoutsOnTheFarSide) {
   EXPECT_EQ(away_dropped, 0);
 }
 
+// Time of flight: no shadow beside the box (illuminator and sensor sit
+// together); along its edge about 30 % of the far side's band keep a depth
+// between the table's and the box top's, belonging to no object.
+TEST(RenderSceneTest, TimeOfFlightEdgesHoldMixedPixelsAndNoShadow) {
+  SceneSpec spec = TopDownSpec(1.0f);
+  spec.objects.push_back(MakePrimitive(Shape::kBox, Vector3f(0, 0, 0.05f),
+                                       Vector3f::Constant(0.05f), 0.0f));
+  const NoiseOptions noise = TimeOfFlightNoise();
+  const SynthScene clean = RenderScene(spec, NoNoise(), 4);
+  const SynthScene tof = RenderScene(spec, noise, 4);
+  const cv::Mat& box = clean.frame.labels;
+  int band = 0, mixed = 0, away = 0, away_dropped = 0;
+  for (int v = 10; v < spec.height - 10; ++v) {
+    for (int u = 10; u < spec.width - 10; ++u) {
+      if (box.at<int>(v, u) != 1) continue;
+      int nearest = 1000;  // Chebyshev distance to the box, capped
+      for (int dv = -6; dv <= 6; ++dv) {
+        for (int du = -6; du <= 6; ++du) {
+          if (box.at<int>(v + dv, u + du) == 20) {
+            nearest = std::min(nearest, std::max(std::abs(du), std::abs(dv)));
+          }
+        }
+      }
+      const float z = DepthAt(tof, u, v);
+      if (nearest <= noise.edge_dropout_px) {
+        ++band;
+        if (!std::isnan(z)) {
+          // The table lies at 1.0 m, the box top at 0.9 m: a mixed pixel
+          // is well inside, more than 4 sigma (6 mm) from either.
+          EXPECT_GT(z, 0.906f) << u << ", " << v;
+          EXPECT_LT(z, 0.994f) << u << ", " << v;
+          EXPECT_EQ(tof.frame.labels.at<int>(v, u), 0);
+          ++mixed;
+        }
+      } else if (nearest > noise.edge_dropout_px + 1 && nearest < 1000) {
+        ++away;
+        away_dropped += std::isnan(z);
+      }
+    }
+  }
+  EXPECT_GT(band, 400);
+  EXPECT_NEAR(static_cast<double>(mixed) / band, noise.flying_pixel_probability,
+              0.08);
+  EXPECT_GT(away, 400);
+  EXPECT_EQ(away_dropped, 0);  // no shadow on either side
+}
+
 TEST(GenerateSceneTest, SameSeedGivesIdenticalBytesOtherSeedDiffers) {
   const SynthScene a = GenerateScene(7);
   const SynthScene b = GenerateScene(7);
