@@ -4,6 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <limits>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string_view>
 #include <utility>
@@ -220,6 +223,44 @@ void AddPileScenes(int objects, int count, uint64_t first_seed,
     AddScene(pile.frame.name, pile.frame.frame, scenes);
     ++added;
   }
+}
+
+absl::Status AddRawFrames(const std::string& dir, const Intrinsics& k,
+                          const std::string& suffix, SceneList& scenes) {
+  constexpr std::string_view kColor = "_color.png";
+  std::vector<std::string> names;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, error)) {
+    const std::string file = entry.path().filename().string();
+    if (file.size() > kColor.size() &&
+        file.compare(file.size() - kColor.size(), kColor.size(), kColor) == 0) {
+      names.push_back(file.substr(0, file.size() - kColor.size()));
+    }
+  }
+  std::sort(names.begin(), names.end());
+  int found = 0;
+  for (const std::string& name : names) {
+    const std::filesystem::path root(dir);
+    const cv::Mat bgr = cv::imread((root / (name + "_color.png")).string());
+    const cv::Mat mm = cv::imread((root / (name + "_depth_mm.png")).string(),
+                                  cv::IMREAD_UNCHANGED);
+    if (bgr.empty() || mm.empty() || mm.type() != CV_16UC1 ||
+        mm.size() != bgr.size()) {
+      continue;
+    }
+    ++found;
+    RgbdFrame frame;
+    cv::cvtColor(bgr, frame.color, cv::COLOR_BGR2RGB);
+    mm.convertTo(frame.depth, CV_32FC1, kWireDepthScale);
+    frame.depth.setTo(std::numeric_limits<float>::quiet_NaN(), mm == 0);
+    frame.intrinsics = k;
+    AddScene(name + suffix, frame, scenes);
+  }
+  if (found == 0) {
+    return absl::NotFoundError(absl::StrCat(
+        "no <name>_color.png with <name>_depth_mm.png in '", dir, "'"));
+  }
+  return absl::OkStatus();
 }
 
 absl::Status AddOsdScenes(const std::string& osd_dir, int max_scenes,

@@ -85,6 +85,16 @@ void AddRoomScenes(const std::vector<uint64_t>& seeds, synth::RoomSensor sensor,
 void AddPileScenes(int objects, int count, uint64_t first_seed,
                    SceneList& scenes);
 
+// Raw, uncropped frames as a robot sends them: every
+// `<name>_color.png` with its `<name>_depth_mm.png` (16-bit millimetres, 0
+// = none) in `dir`, in name order, with intrinsics `k`; the scenes are
+// named `<name>` + `suffix`. The OSD folder's frames/ (its raw Kinect
+// frame, intrinsics kKinectV1Intrinsics) and the RealSense folder are
+// such. Frames whose preparation fails are left out with a line on
+// stderr; NOT_FOUND when `dir` holds none.
+absl::Status AddRawFrames(const std::string& dir, const Intrinsics& k,
+                          const std::string& suffix, SceneList& scenes);
+
 // The OSD learn*.pcd scenes of `osd_dir`/learn (all of them when
 // `max_scenes` <= 0). Scenes whose preparation fails are left out with a
 // line on stderr; an error when the folder cannot be listed.

@@ -7,15 +7,18 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_split.h"
 #include "core/base/parallel.h"
 #include "core/base/stage_clock.h"
 #include "core/base/status_macros.h"
@@ -29,6 +32,7 @@
 #include "core/pipeline/segment.h"
 #include "core/synth/room.h"
 #include "tools/bench/bench_inputs.h"
+#include "tools/eval/realsense_frames.h"
 
 namespace fovea::bench {
 namespace {
@@ -73,8 +77,10 @@ struct StagesFlags {
 
 int Usage(const char* command) {
   std::fprintf(stderr,
-               "usage: fovea-bench %s [--set osd|pile-15|room-640x480|"
-               "room-1920x1080] [--scenes N] [--passes N] [--threads N]\n",
+               "usage: fovea-bench %s [--set SET[,SET...]] [--scenes N] "
+               "[--passes N] [--threads N]\n  sets: osd osd-raw realsense "
+               "pile-15 room-640x480 room-1920x1080 "
+               "room-<kinect_v1|active_stereo|time_of_flight>-<W>x<H>\n",
                command);
   return 2;
 }
@@ -183,6 +189,52 @@ std::vector<Column> Columns(const LoadedModels& models) {
 
 absl::Status LoadSceneSet(const std::string& set, int count,
                           SceneList& scenes) {
+  if (set == "osd-raw") {
+    const char* dir = std::getenv("FOVEA_OSD_DIR");
+    if (dir == nullptr || *dir == '\0') {
+      return absl::FailedPreconditionError(
+          "--set osd-raw needs FOVEA_OSD_DIR (the OSD data folder)");
+    }
+    return AddRawFrames(absl::StrCat(dir, "/frames"), kKinectV1Intrinsics,
+                        "-raw", scenes);
+  }
+  if (set == "realsense") {
+    const std::string dir = eval::RealSenseDir();
+    if (dir.empty()) {
+      return absl::FailedPreconditionError(
+          "--set realsense needs FOVEA_REALSENSE_DIR (the RealSense frames' "
+          "folder)");
+    }
+    const std::string params =
+        eval::ReadAll(std::filesystem::path(dir) / "camera_params.json");
+    const Intrinsics k{eval::JsonNumber(params, "fx"),
+                       eval::JsonNumber(params, "fy"),
+                       eval::JsonNumber(params, "x_offset"),
+                       eval::JsonNumber(params, "y_offset")};
+    return AddRawFrames(dir, k, "", scenes);
+  }
+  // room-<sensor>-<width>x<height>
+  if (absl::StartsWith(set, "room-") &&
+      std::count(set.begin(), set.end(), '-') == 2) {
+    const std::vector<std::string> parts = absl::StrSplit(set, '-');
+    FOVEA_ASSIGN_OR_RETURN(const synth::RoomSensor sensor,
+                           synth::ParseRoomSensor(parts[1]));
+    const std::vector<std::string> size = absl::StrSplit(parts[2], 'x');
+    int width = 0;
+    int height = 0;
+    if (size.size() != 2 || !absl::SimpleAtoi(size[0], &width) ||
+        !absl::SimpleAtoi(size[1], &height) || width < 160 || width > 1920 ||
+        height < 120 || height > 1080) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("--set ", set,
+                       ": expected room-<sensor>-<W>x<H>, 160x120 to "
+                       "1920x1080"));
+    }
+    std::vector<uint64_t> seeds;
+    for (int s = 1; s <= (count > 0 ? count : 8); ++s) seeds.push_back(s);
+    AddRoomScenes(seeds, sensor, width, height, scenes);
+    return absl::OkStatus();
+  }
   if (set == "osd") {
     const char* dir = std::getenv("FOVEA_OSD_DIR");
     if (dir == nullptr || *dir == '\0') {
@@ -209,17 +261,25 @@ absl::Status LoadSceneSet(const std::string& set, int count,
 int RunStagesCommand(int argc, char** argv) {
   StagesFlags flags;
   if (!ParseStagesFlags(argc, argv, flags)) return Usage(argv[1]);
-  SceneList scenes;
-  if (absl::Status status = LoadSceneSet(flags.set, flags.scenes, scenes);
-      !status.ok()) {
-    std::fprintf(stderr, "fovea-bench stages: %s\n", status.ToString().c_str());
-    return 2;
+  // Several sets run in one process, pass by pass, so that their figures
+  // compare within one run.
+  const std::vector<std::string> set_names =
+      absl::StrSplit(flags.set, ',', absl::SkipEmpty());
+  std::vector<SceneList> sets(set_names.size());
+  for (size_t s = 0; s < set_names.size(); ++s) {
+    if (absl::Status status = LoadSceneSet(set_names[s], flags.scenes, sets[s]);
+        !status.ok()) {
+      std::fprintf(stderr, "fovea-bench stages: %s\n",
+                   status.ToString().c_str());
+      return 2;
+    }
+    if (sets[s].empty()) {
+      std::fprintf(stderr, "fovea-bench stages: no scenes in set %s\n",
+                   set_names[s].c_str());
+      return 1;
+    }
   }
-  if (scenes.empty()) {
-    std::fprintf(stderr, "fovea-bench stages: no scenes in set %s\n",
-                 flags.set.c_str());
-    return 1;
-  }
+  if (sets.empty()) return Usage(argv[1]);
   const absl::StatusOr<LoadedModels> models =
       LoadModels(FOVEA_BENCH_MODELS_DIR);
   if (!models.ok()) {
@@ -230,25 +290,28 @@ int RunStagesCommand(int argc, char** argv) {
   const std::vector<Column> columns = Columns(*models);
   ThreadPool pool(flags.threads - 1);
   const ParallelScope scope(&pool, flags.threads);
-  // Per column and stage: one figure per request.
-  std::vector<std::map<std::string, std::vector<double>>> samples(
-      columns.size());
+  // Per set, column and stage: one figure per request.
+  using Samples = std::map<std::string, std::vector<double>>;
+  std::vector<std::vector<Samples>> samples(
+      sets.size(), std::vector<Samples>(columns.size()));
   std::vector<std::string> order;  // stages in first-seen order
   for (int pass = 0; pass < flags.passes; ++pass) {
-    for (size_t c = 0; c < columns.size(); ++c) {
-      for (const auto& scene : scenes) {
-        StageSeconds stages;
-        if (absl::Status s = columns[c].run(*scene, stages); !s.ok()) {
-          std::fprintf(stderr, "fovea-bench stages: %s on %s: %s\n",
-                       columns[c].name.c_str(), scene->name.c_str(),
-                       s.ToString().c_str());
-          return 1;
-        }
-        for (const auto& [stage, seconds] : stages.stages()) {
-          if (std::find(order.begin(), order.end(), stage) == order.end()) {
-            order.push_back(stage);
+    for (size_t s = 0; s < sets.size(); ++s) {
+      for (size_t c = 0; c < columns.size(); ++c) {
+        for (const auto& scene : sets[s]) {
+          StageSeconds stages;
+          if (absl::Status st = columns[c].run(*scene, stages); !st.ok()) {
+            std::fprintf(stderr, "fovea-bench stages: %s on %s: %s\n",
+                         columns[c].name.c_str(), scene->name.c_str(),
+                         st.ToString().c_str());
+            return 1;
           }
-          samples[c][stage].push_back(seconds);
+          for (const auto& [stage, seconds] : stages.stages()) {
+            if (std::find(order.begin(), order.end(), stage) == order.end()) {
+              order.push_back(stage);
+            }
+            samples[s][c][stage].push_back(seconds);
+          }
         }
       }
     }
@@ -261,26 +324,64 @@ int RunStagesCommand(int argc, char** argv) {
       order.push_back(last);
     }
   }
-  std::printf(
-      "%zu %s frames x %d passes, %d thread(s) per request; medians, ms per "
-      "request\n\n",
-      scenes.size(), flags.set.c_str(), flags.passes, flags.threads);
-  std::printf("| stage |");
-  for (const Column& c : columns) std::printf(" %s |", c.name.c_str());
-  std::printf("\n|---|");
-  for (size_t c = 0; c < columns.size(); ++c) std::printf("---|");
-  std::printf("\n");
-  for (const std::string& stage : order) {
-    std::printf("| %s |", stage.c_str());
-    for (size_t c = 0; c < columns.size(); ++c) {
-      const auto found = samples[c].find(stage);
-      if (found == samples[c].end()) {
-        std::printf(" |");
-      } else {
-        std::printf(" %.1f |", 1e3 * Median(found->second));
-      }
-    }
+  const auto median_ms = [&](size_t s, size_t c,
+                             const std::string& stage) -> double {
+    const auto found = samples[s][c].find(stage);
+    return found == samples[s][c].end() ? -1.0 : 1e3 * Median(found->second);
+  };
+  for (size_t s = 0; s < sets.size(); ++s) {
+    std::printf(
+        "%s%zu %s frames x %d passes, %d thread(s) per request; medians, ms "
+        "per request\n\n",
+        s == 0 ? "" : "\n", sets[s].size(), set_names[s].c_str(), flags.passes,
+        flags.threads);
+    std::printf("| stage |");
+    for (const Column& c : columns) std::printf(" %s |", c.name.c_str());
+    std::printf("\n|---|");
+    for (size_t c = 0; c < columns.size(); ++c) std::printf("---|");
     std::printf("\n");
+    for (const std::string& stage : order) {
+      std::printf("| %s |", stage.c_str());
+      for (size_t c = 0; c < columns.size(); ++c) {
+        const double ms = median_ms(s, c, stage);
+        if (ms < 0.0) {
+          std::printf(" |");
+        } else {
+          std::printf(" %.1f |", ms);
+        }
+      }
+      std::printf("\n");
+    }
+  }
+  if (sets.size() < 2) return 0;
+  // The sets side by side: each whole request against the first set's,
+  // and INC against pcl-lccp on the same frames.
+  const auto column_of = [&](std::string_view name) {
+    for (size_t c = 0; c < columns.size(); ++c) {
+      if (columns[c].name == name) return c;
+    }
+    return columns.size();
+  };
+  const size_t detect = column_of("Detect");
+  const size_t inc = column_of("SegmentIncremental (INC)");
+  const size_t lccp = column_of("pcl-lccp");
+  std::printf(
+      "\nSets side by side (whole request, medians, ms; x: against %s, the "
+      "first set)\n\n| set | frames | Detect | x | INC | x | INC first "
+      "object | first / whole | pcl-lccp | INC / pcl-lccp |\n"
+      "|---|---|---|---|---|---|---|---|---|---|\n",
+      set_names[0].c_str());
+  for (size_t s = 0; s < sets.size(); ++s) {
+    const double d = median_ms(s, detect, "total");
+    const double i = median_ms(s, inc, "total");
+    const double first = median_ms(s, inc, "first_object");
+    const double l = median_ms(s, lccp, "total");
+    std::printf(
+        "| %s | %zu | %.1f | %.2f | %.1f | %.2f | %.1f | %.2f | %.1f | %.2f "
+        "|\n",
+        set_names[s].c_str(), sets[s].size(), d,
+        d / median_ms(0, detect, "total"), i, i / median_ms(0, inc, "total"),
+        first, first / i, l, i / l);
   }
   return 0;
 }

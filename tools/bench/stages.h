@@ -8,19 +8,29 @@
 
 namespace fovea::bench {
 
-// Appends the frames of a named set to `scenes`: "osd" (FOVEA_OSD_DIR's
-// learn scenes; an error without it), "pile-15" (synthetic 15-object
-// piles, 8 by default), "room-640x480" or "room-1920x1080" (synthetic
-// active-stereo rooms, 8 by default). `count` > 0: that many frames.
+// Appends the frames of a named set to `scenes`:
+//   - "osd": FOVEA_OSD_DIR's cropped learn scenes (an error without it);
+//   - "osd-raw": its raw, uncropped Kinect frames (frames/);
+//   - "realsense": FOVEA_REALSENSE_DIR's raw frames (an error without it);
+//   - "pile-15": synthetic 15-object piles, 8 by default;
+//   - "room-<sensor>-<W>x<H>": synthetic rooms seen by that sensor
+//     (kinect_v1, active_stereo, time_of_flight), 8 by default;
+//     "room-640x480" and "room-1920x1080" are the active stereo's.
+// `count` > 0: at most that many frames of "osd" and of the synthetic
+// sets (the raw real sets are used whole).
 absl::Status LoadSceneSet(const std::string& set, int count, SceneList& scenes);
 
-// fovea-bench stages [--set osd|pile-15|room-640x480|room-1920x1080]
-//                    [--scenes N] [--passes N] [--threads N]
-// Runs Detect, Segment (COS), SegmentIncremental (INC) and pcl-lccp, each
-// from the raw wire frame with default options, on every frame of the set
-// `passes` times, and prints a Markdown table of the median time of each
-// stage per request (same-named stages of one request summed), with the
-// time to the first object and the whole request last. `argv[1]` is
+// fovea-bench stages [--set SET[,SET...]] [--scenes N] [--passes N]
+//                    [--threads N]
+// Runs Detect, Segment (COS), SegmentIncremental (INC) and pcl-lccp (its
+// support removal included), each from the raw wire frame with default
+// options, on every frame of each set `passes` times, and prints per set a
+// Markdown table of the median time of each stage per request (same-named
+// stages of one request summed), with the time to the first object and the
+// whole request last. With several sets (run pass by pass in one process,
+// so one run) a last table puts them side by side: each whole request
+// against the first set's, the first object against the whole scene, and
+// INC against pcl-lccp on the same frames. `argv[1]` is
 // "stages". --threads: threads per request (ParallelScope), default 1.
 // Returns the process's exit code.
 int RunStagesCommand(int argc, char** argv);
