@@ -198,11 +198,15 @@ void AddSyntheticScenes(const std::vector<uint64_t>& seeds, SceneList& scenes) {
 }
 
 void AddRoomScenes(const std::vector<uint64_t>& seeds, synth::RoomSensor sensor,
-                   int width, int height, SceneList& scenes) {
+                   int width, int height, SceneList& scenes, int objects) {
   synth::RoomOptions options;
   options.sensor = sensor;
   options.width = width;
   options.height = height;
+  if (objects > 0) {
+    options.clutter.min_objects = objects;
+    options.clutter.max_objects = objects;
+  }
   for (const uint64_t seed : seeds) {
     synth::SynthScene room = synth::GenerateRoom(seed, options);
     AddScene(room.frame.name, room.frame.frame, scenes);

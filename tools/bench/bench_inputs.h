@@ -76,8 +76,10 @@ void AddSyntheticScenes(const std::vector<uint64_t>& seeds, SceneList& scenes);
 
 // Synthetic rooms (core/synth/room.h) of one sensor and size, one per
 // seed: uncropped frames with floor, walls and furniture around the table.
+// `objects` > 0: that many objects on the table (as many as fit), else the
+// rooms' 2-8.
 void AddRoomScenes(const std::vector<uint64_t>& seeds, synth::RoomSensor sensor,
-                   int width, int height, SceneList& scenes);
+                   int width, int height, SceneList& scenes, int objects = 0);
 
 // Synthetic piles (core/synth GeneratePile) of exactly `objects` visible
 // objects: the first `count` such piles from seed `first_seed` upwards

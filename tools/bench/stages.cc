@@ -80,7 +80,7 @@ int Usage(const char* command) {
                "usage: fovea-bench %s [--set SET[,SET...]] [--scenes N] "
                "[--passes N] [--threads N]\n  sets: osd osd-raw realsense "
                "pile-15 room-640x480 room-1920x1080 "
-               "room-<kinect_v1|active_stereo|time_of_flight>-<W>x<H>\n",
+               "room-<kinect_v1|active_stereo|time_of_flight>-<W>x<H>[-<N>]\n",
                command);
   return 2;
 }
@@ -213,26 +213,29 @@ absl::Status LoadSceneSet(const std::string& set, int count,
                        eval::JsonNumber(params, "y_offset")};
     return AddRawFrames(dir, k, "", scenes);
   }
-  // room-<sensor>-<width>x<height>
-  if (absl::StartsWith(set, "room-") &&
-      std::count(set.begin(), set.end(), '-') == 2) {
+  // room-<sensor>-<width>x<height>[-<objects>]
+  const int dashes = static_cast<int>(std::count(set.begin(), set.end(), '-'));
+  if (absl::StartsWith(set, "room-") && (dashes == 2 || dashes == 3)) {
     const std::vector<std::string> parts = absl::StrSplit(set, '-');
     FOVEA_ASSIGN_OR_RETURN(const synth::RoomSensor sensor,
                            synth::ParseRoomSensor(parts[1]));
     const std::vector<std::string> size = absl::StrSplit(parts[2], 'x');
     int width = 0;
     int height = 0;
+    int objects = 0;
     if (size.size() != 2 || !absl::SimpleAtoi(size[0], &width) ||
         !absl::SimpleAtoi(size[1], &height) || width < 160 || width > 1920 ||
-        height < 120 || height > 1080) {
+        height < 120 || height > 1080 ||
+        (dashes == 3 && (!absl::SimpleAtoi(parts[3], &objects) || objects < 1 ||
+                         objects > 20))) {
       return absl::InvalidArgumentError(
           absl::StrCat("--set ", set,
-                       ": expected room-<sensor>-<W>x<H>, 160x120 to "
-                       "1920x1080"));
+                       ": expected room-<sensor>-<W>x<H>[-<objects>], "
+                       "160x120 to 1920x1080, 1 to 20 objects"));
     }
     std::vector<uint64_t> seeds;
     for (int s = 1; s <= (count > 0 ? count : 8); ++s) seeds.push_back(s);
-    AddRoomScenes(seeds, sensor, width, height, scenes);
+    AddRoomScenes(seeds, sensor, width, height, scenes, objects);
     return absl::OkStatus();
   }
   if (set == "osd") {

@@ -13,8 +13,9 @@ namespace fovea::bench {
 //   - "osd-raw": its raw, uncropped Kinect frames (frames/);
 //   - "realsense": FOVEA_REALSENSE_DIR's raw frames (an error without it);
 //   - "pile-15": synthetic 15-object piles, 8 by default;
-//   - "room-<sensor>-<W>x<H>": synthetic rooms seen by that sensor
-//     (kinect_v1, active_stereo, time_of_flight), 8 by default;
+//   - "room-<sensor>-<W>x<H>[-<N>]": synthetic rooms seen by that sensor
+//     (kinect_v1, active_stereo, time_of_flight), 8 by default, with N
+//     objects on the table (as many as fit) when given, else 2-8;
 //     "room-640x480" and "room-1920x1080" are the active stereo's.
 // `count` > 0: at most that many frames of "osd" and of the synthetic
 // sets (the raw real sets are used whole).
