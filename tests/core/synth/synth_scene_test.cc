@@ -547,6 +547,20 @@ TEST(RenderSceneTest, DarkObjectLosesDepthPixels) {
               0.02);
 }
 
+// The Chebyshev distance from (u, v) to the nearest pixel labelled
+// `label`, within 6 pixels; 1000 beyond.
+int DistanceToLabel(const cv::Mat& labels, int u, int v, int label) {
+  int nearest = 1000;
+  for (int dv = -6; dv <= 6; ++dv) {
+    for (int du = -6; du <= 6; ++du) {
+      if (labels.at<int>(v + dv, u + du) == label) {
+        nearest = std::min(nearest, std::max(std::abs(du), std::abs(dv)));
+      }
+    }
+  }
+  return nearest;
+}
+
 // The far side of every depth jump loses depth over edge_dropout_px
 // pixels; the near side and surfaces away from edges keep it.
 TEST(RenderSceneTest, DepthEdgesHaveNaNDropoutsOnTheFarSide) {
@@ -566,14 +580,7 @@ TEST(RenderSceneTest, DepthEdgesHaveNaNDropoutsOnTheFarSide) {
         continue;
       }
       if (box.at<int>(v, u) != 1) continue;
-      int nearest = 1000;  // Chebyshev distance to the box, capped
-      for (int dv = -6; dv <= 6; ++dv) {
-        for (int du = -6; du <= 6; ++du) {
-          if (box.at<int>(v + dv, u + du) == 20) {
-            nearest = std::min(nearest, std::max(std::abs(du), std::abs(dv)));
-          }
-        }
-      }
+      const int nearest = DistanceToLabel(box, u, v, 20);
       if (nearest <= noise.edge_dropout_px) {
         ++band;
         band_dropped += dropped;
@@ -604,14 +611,7 @@ TEST(RenderSceneTest, TimeOfFlightEdgesHoldMixedPixelsAndNoShadow) {
   for (int v = 10; v < spec.height - 10; ++v) {
     for (int u = 10; u < spec.width - 10; ++u) {
       if (box.at<int>(v, u) != 1) continue;
-      int nearest = 1000;  // Chebyshev distance to the box, capped
-      for (int dv = -6; dv <= 6; ++dv) {
-        for (int du = -6; du <= 6; ++du) {
-          if (box.at<int>(v + dv, u + du) == 20) {
-            nearest = std::min(nearest, std::max(std::abs(du), std::abs(dv)));
-          }
-        }
-      }
+      const int nearest = DistanceToLabel(box, u, v, 20);
       const float z = DepthAt(tof, u, v);
       if (nearest <= noise.edge_dropout_px) {
         ++band;
