@@ -532,39 +532,6 @@ int CountStacked(const std::vector<int>& rests_on) {
                     [](int support) { return support >= 0; }));
 }
 
-absl::Status Validate(const StackedPileOptions& options) {
-  if (options.width < 160 || options.width > 1920) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("StackedPileOptions.width must be in [160, 1920], got ",
-                     options.width));
-  }
-  if (options.height < 120 || options.height > 1080) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("StackedPileOptions.height must be in [120, 1080], got ",
-                     options.height));
-  }
-  return absl::OkStatus();
-}
-
-StackedPileOptions SensorPileOptions(RoomSensor sensor) {
-  StackedPileOptions options;
-  const cv::Size size = SensorFrameSize(sensor);
-  options.width = size.width;
-  options.height = size.height;
-  return options;
-}
-
-StackedPileOptions AbovePileOptions(RoomSensor sensor) {
-  StackedPileOptions options = SensorPileOptions(sensor);
-  options.more_kinds = true;
-  options.from_above = true;
-  if (sensor == RoomSensor::kActiveStereo) {
-    options.width = 1280;
-    options.height = 720;
-  }
-  return options;
-}
-
 StackedPileSpec RandomStackedPileSpec(uint64_t seed, RoomSensor sensor) {
   return RandomStackedPileSpec(seed, sensor, SensorPileOptions(sensor));
 }
