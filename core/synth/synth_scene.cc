@@ -150,6 +150,67 @@ float NoisyDepth(float z, float focal_px, const NoiseOptions& noise,
   return fb / disparity;
 }
 
+// What the sensor makes of a ray-cast depth image: its dropouts (edges,
+// shadows, dark surfaces), mixed pixels and noise, pixel by pixel. Draws
+// from `rng` in the order RenderScene always has: the correlated noise
+// field here, then per pixel as Measure is called.
+class SensorDepth {
+ public:
+  SensorDepth(const cv::Mat& depth, float focal, const NoiseOptions& noise,
+              Random& rng)
+      : focal_(focal), noise_(noise) {
+    if (!noise.enabled) return;
+    const cv::Mat band = EdgeDropoutMask(depth, noise);
+    edge_dropout_ = band | ShadowMask(depth, focal, noise);
+    // With flying pixels: the edge band (not the shadows) and how far each
+    // of its pixels lies behind the nearer surface.
+    if (noise.flying_pixel_probability > 0.0f) {
+      flying_band_ = band;
+      behind_nearest_ =
+          DepthBehindNearest(depth, std::max(1, noise.edge_dropout_px));
+    }
+    if (noise.noise_correlation_px > 0.0f) {
+      depth_noise_ =
+          CorrelatedNormalField(depth.size(), noise.noise_correlation_px, rng);
+    }
+  }
+
+  // Replaces the true depth `z` of pixel (v, u), on a dark surface or not,
+  // with what the sensor measures there (NaN for none). Whether the pixel
+  // keeps its label: a dark surface's dropped pixels do, as a labeller
+  // marks a black mug whole; an edge's do not (OSD labels points, and
+  // there is no point there, or a mixed one).
+  bool Measure(int v, int u, bool dark, Random& rng, float& z) const {
+    const bool edge = edge_dropout_.at<uint8_t>(v, u) != 0;
+    const bool dropped =
+        edge || (dark && rng.Bernoulli(noise_.dark_dropout_probability));
+    if (!dropped) {
+      const float normal = depth_noise_.empty()
+                               ? static_cast<float>(rng.Normal())
+                               : depth_noise_.at<float>(v, u);
+      z = NoisyDepth(z, focal_, noise_, normal);
+      return true;
+    }
+    const float true_z = z;
+    z = std::numeric_limits<float>::quiet_NaN();
+    if (edge && !flying_band_.empty() && flying_band_.at<uint8_t>(v, u) != 0 &&
+        rng.Bernoulli(noise_.flying_pixel_probability)) {
+      const float mixed =
+          true_z - rng.Uniform(0.2f, 0.8f) * behind_nearest_.at<float>(v, u);
+      z = NoisyDepth(mixed, focal_, noise_, static_cast<float>(rng.Normal()));
+    }
+    return !edge;
+  }
+
+ private:
+  const float focal_;
+  const NoiseOptions& noise_;
+  cv::Mat edge_dropout_;
+  cv::Mat flying_band_;
+  cv::Mat behind_nearest_;
+  cv::Mat depth_noise_;
+};
+
 // OK, or INVALID_ARGUMENT naming `field` (the primitive's place in the
 // SceneSpec): see Validate(const SceneSpec&).
 absl::Status ValidatePrimitive(const Primitive& p, const std::string& field) {
@@ -346,25 +407,7 @@ SynthScene RenderScene(const SceneSpec& spec, const NoiseOptions& noise,
   Random rng(seed ^ kNoiseStream);
   const bool noisy = noise.enabled;
   const float focal = static_cast<float>(spec.intrinsics.fx);
-  cv::Mat edge_dropout;
-  // With flying pixels: the edge band (not the shadows) and how far each
-  // of its pixels lies behind the nearer surface.
-  cv::Mat flying_band;
-  cv::Mat behind_nearest;
-  if (noisy) {
-    const cv::Mat band = EdgeDropoutMask(ray.depth, noise);
-    edge_dropout = band | ShadowMask(ray.depth, focal, noise);
-    if (noise.flying_pixel_probability > 0.0f) {
-      flying_band = band;
-      behind_nearest =
-          DepthBehindNearest(ray.depth, std::max(1, noise.edge_dropout_px));
-    }
-  }
-  const cv::Mat depth_noise =
-      noisy && noise.noise_correlation_px > 0.0f
-          ? CorrelatedNormalField(ray.depth.size(), noise.noise_correlation_px,
-                                  rng)
-          : cv::Mat();
+  const SensorDepth sensor(ray.depth, focal, noise, rng);
 
   // Albedo, texture, label, object (or -1) and darkness of each hit index
   // (0 table, k + 1 object, then the background parts, then the object
@@ -418,7 +461,6 @@ SynthScene RenderScene(const SceneSpec& spec, const NoiseOptions& noise,
   cv::Mat color(spec.height, spec.width, CV_8UC3);
   cv::Mat labels(spec.height, spec.width, CV_32SC1);
   std::vector<int> visible(spec.objects.size(), 0);
-  const float nan = std::numeric_limits<float>::quiet_NaN();
   for (int v = 0; v < spec.height; ++v) {
     const int* hit_row = ray.hit.ptr<int>(v);
     const cv::Vec3f* normal_row = ray.normal.ptr<cv::Vec3f>(v);
@@ -450,34 +492,8 @@ SynthScene RenderScene(const SceneSpec& spec, const NoiseOptions& noise,
           }
         }
         rgb = (surface * shade).cwiseMin(1.0f);
-        // A dark surface's dropped pixels keep their label, as a labeller
-        // marks a black mug whole; an edge dropout's, like a shadow's, do
-        // not (OSD labels points, and there is no point there).
-        bool labelled = true;
-        if (noisy) {
-          const bool edge = edge_dropout.at<uint8_t>(v, u) != 0;
-          const bool dropped =
-              edge ||
-              (dark[hit] && rng.Bernoulli(noise.dark_dropout_probability));
-          if (dropped) {
-            const float z = depth_row[u];
-            depth_row[u] = nan;
-            labelled = !edge;
-            if (edge && !flying_band.empty() &&
-                flying_band.at<uint8_t>(v, u) != 0 &&
-                rng.Bernoulli(noise.flying_pixel_probability)) {
-              const float mixed =
-                  z - rng.Uniform(0.2f, 0.8f) * behind_nearest.at<float>(v, u);
-              depth_row[u] = NoisyDepth(mixed, focal, noise,
-                                        static_cast<float>(rng.Normal()));
-            }
-          } else {
-            const float normal = depth_noise.empty()
-                                     ? static_cast<float>(rng.Normal())
-                                     : depth_noise.at<float>(v, u);
-            depth_row[u] = NoisyDepth(depth_row[u], focal, noise, normal);
-          }
-        }
+        const bool labelled =
+            !noisy || sensor.Measure(v, u, dark[hit], rng, depth_row[u]);
         if (labelled) {
           label_row[u] = label[hit];
           if (object_of_hit[hit] >= 0) ++visible[object_of_hit[hit]];
