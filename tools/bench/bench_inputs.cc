@@ -5,9 +5,8 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <limits>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <string_view>
 #include <utility>
 
@@ -20,6 +19,7 @@
 #include "core/saliency/rso.h"
 #include "core/synth/room.h"
 #include "core/synth/synth_scene.h"
+#include "tools/eval/realsense_frames.h"
 
 namespace fovea::bench {
 namespace {
@@ -244,21 +244,10 @@ absl::Status AddRawFrames(const std::string& dir, const Intrinsics& k,
   std::sort(names.begin(), names.end());
   int found = 0;
   for (const std::string& name : names) {
-    const std::filesystem::path root(dir);
-    const cv::Mat bgr = cv::imread((root / (name + "_color.png")).string());
-    const cv::Mat mm = cv::imread((root / (name + "_depth_mm.png")).string(),
-                                  cv::IMREAD_UNCHANGED);
-    if (bgr.empty() || mm.empty() || mm.type() != CV_16UC1 ||
-        mm.size() != bgr.size()) {
-      continue;
-    }
+    const std::optional<RgbdFrame> frame = eval::ReadRawFrame(dir, name, k);
+    if (!frame) continue;
     ++found;
-    RgbdFrame frame;
-    cv::cvtColor(bgr, frame.color, cv::COLOR_BGR2RGB);
-    mm.convertTo(frame.depth, CV_32FC1, kWireDepthScale);
-    frame.depth.setTo(std::numeric_limits<float>::quiet_NaN(), mm == 0);
-    frame.intrinsics = k;
-    AddScene(name + suffix, frame, scenes);
+    AddScene(name + suffix, *frame, scenes);
   }
   if (found == 0) {
     return absl::NotFoundError(absl::StrCat(

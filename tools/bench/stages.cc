@@ -7,7 +7,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
 #include <functional>
 #include <map>
 #include <string>
@@ -205,13 +204,7 @@ absl::Status LoadSceneSet(const std::string& set, int count,
           "--set realsense needs FOVEA_REALSENSE_DIR (the RealSense frames' "
           "folder)");
     }
-    const std::string params =
-        eval::ReadAll(std::filesystem::path(dir) / "camera_params.json");
-    const Intrinsics k{eval::JsonNumber(params, "fx"),
-                       eval::JsonNumber(params, "fy"),
-                       eval::JsonNumber(params, "x_offset"),
-                       eval::JsonNumber(params, "y_offset")};
-    return AddRawFrames(dir, k, "", scenes);
+    return AddRawFrames(dir, eval::RealSenseIntrinsics(dir), "", scenes);
   }
   // room-<sensor>-<width>x<height>[-<objects>]
   const int dashes = static_cast<int>(std::count(set.begin(), set.end(), '-'));

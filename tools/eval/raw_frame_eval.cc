@@ -1,12 +1,11 @@
 #include "tools/eval/raw_frame_eval.h"
 
 #include <filesystem>
-#include <limits>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
+#include <optional>
 
 #include "absl/strings/str_cat.h"
 #include "core/frame/osd_pcd.h"
+#include "tools/eval/realsense_frames.h"
 #include "tools/eval/stats.h"
 
 namespace fovea::eval {
@@ -69,19 +68,15 @@ absl::StatusOr<std::vector<RawFrameResult>> EvaluateRawFrames(
     absl::StatusOr<LabelledFrame> cropped =
         LoadOsdPcd((fs::path(osd_dir) / "learn" / (name + ".pcd")).string());
     if (!cropped.ok()) return InScene(name, cropped.status());
-    const cv::Mat bgr = cv::imread((frames / (name + kColorSuffix)).string());
-    const cv::Mat mm = cv::imread((frames / (name + "_depth_mm.png")).string(),
-                                  cv::IMREAD_UNCHANGED);
-    if (bgr.empty() || mm.empty() || bgr.size() != cropped->labels.size()) {
+    std::optional<RgbdFrame> read =
+        ReadRawFrame(frames, name, cropped->frame.intrinsics);
+    if (!read || read->color.size() != cropped->labels.size()) {
       return absl::InvalidArgumentError(
           absl::StrCat(name, ": raw frame missing or not the scene's size"));
     }
     LabelledFrame raw;
     raw.name = name + "-raw";
-    cv::cvtColor(bgr, raw.frame.color, cv::COLOR_BGR2RGB);
-    mm.convertTo(raw.frame.depth, CV_32FC1, 0.001);
-    raw.frame.depth.setTo(std::numeric_limits<float>::quiet_NaN(), mm == 0);
-    raw.frame.intrinsics = cropped->frame.intrinsics;
+    raw.frame = *std::move(read);
     raw.labels = cropped->labels;
     RawFrameResult r;
     r.name = name;

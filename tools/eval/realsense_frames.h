@@ -2,8 +2,10 @@
 #define FOVEA_TOOLS_EVAL_REALSENSE_FRAMES_H_
 
 // The four raw RealSense-like frames of shared/data/realsense: where the
-// tests and `fovea-eval scorecard` find them, and their marked pixels.
-// Header-only, so that tests use it without linking the eval tool.
+// tests and `fovea-eval scorecard` find them, and their marked pixels; and
+// the reading of any raw frame stored as `<name>_color.png` +
+// `<name>_depth_mm.png` (these, the OSD folder's frames/). Header-only, so
+// that tests and fovea-bench use it without linking the eval tool.
 
 #include <cstdlib>
 #include <filesystem>
@@ -12,6 +14,7 @@
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -76,13 +79,40 @@ inline std::vector<cv::Point> JsonPixels(const std::string& block,
   return out;
 }
 
+// The raw frame `<name>_color.png` (8-bit colour) + `<name>_depth_mm.png`
+// (16-bit millimetres, 0 = no depth) of `dir`, with intrinsics `k`;
+// nullopt when either is missing or unreadable, or the depth is not 16-bit
+// of the colour's size.
+inline std::optional<RgbdFrame> ReadRawFrame(const std::filesystem::path& dir,
+                                             const std::string& name,
+                                             const Intrinsics& k) {
+  const cv::Mat bgr = cv::imread((dir / (name + "_color.png")).string());
+  const cv::Mat mm = cv::imread((dir / (name + "_depth_mm.png")).string(),
+                                cv::IMREAD_UNCHANGED);
+  if (bgr.empty() || mm.empty() || mm.type() != CV_16UC1 ||
+      mm.size() != bgr.size()) {
+    return std::nullopt;
+  }
+  RgbdFrame frame;
+  cv::cvtColor(bgr, frame.color, cv::COLOR_BGR2RGB);
+  mm.convertTo(frame.depth, CV_32FC1, 0.001);
+  frame.depth.setTo(std::numeric_limits<float>::quiet_NaN(), mm == 0);
+  frame.intrinsics = k;
+  return frame;
+}
+
+// The RealSense folder's intrinsics (its camera_params.json).
+inline Intrinsics RealSenseIntrinsics(const std::string& dir) {
+  const std::string params =
+      ReadAll(std::filesystem::path(dir) / "camera_params.json");
+  return {JsonNumber(params, "fx"), JsonNumber(params, "fy"),
+          JsonNumber(params, "x_offset"), JsonNumber(params, "y_offset")};
+}
+
 // The frames of `dir` (RealSenseDir()), in name order.
 inline std::vector<RealSenseFrame> LoadRealSenseFrames(const std::string& dir) {
   const std::filesystem::path root(dir);
-  const std::string params = ReadAll(root / "camera_params.json");
-  const Intrinsics k{JsonNumber(params, "fx"), JsonNumber(params, "fy"),
-                     JsonNumber(params, "x_offset"),
-                     JsonNumber(params, "y_offset")};
+  const Intrinsics k = RealSenseIntrinsics(dir);
   const std::string points = ReadAll(root / "points.json");
   std::vector<RealSenseFrame> frames;
   const std::regex entry("\"(rs[0-9]+)\"\\s*:\\s*\\{([^}]*)\\}");
@@ -94,14 +124,9 @@ inline std::vector<RealSenseFrame> LoadRealSenseFrames(const std::string& dir) {
     f.objects = JsonPixels(block, "objects");
     f.table = JsonPixels(block, "table");
     f.off_table = JsonPixels(block, "off_table");
-    const cv::Mat bgr = cv::imread((root / (f.name + "_color.png")).string());
-    const cv::Mat mm = cv::imread((root / (f.name + "_depth_mm.png")).string(),
-                                  cv::IMREAD_UNCHANGED);
-    if (bgr.empty() || mm.empty()) continue;
-    cv::cvtColor(bgr, f.frame.color, cv::COLOR_BGR2RGB);
-    mm.convertTo(f.frame.depth, CV_32FC1, 0.001);
-    f.frame.depth.setTo(std::numeric_limits<float>::quiet_NaN(), mm == 0);
-    f.frame.intrinsics = k;
+    std::optional<RgbdFrame> frame = ReadRawFrame(root, f.name, k);
+    if (!frame) continue;
+    f.frame = *std::move(frame);
     frames.push_back(std::move(f));
   }
   return frames;
