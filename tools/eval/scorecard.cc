@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "absl/types/span.h"
 #include "core/base/status_macros.h"
 #include "core/base/strings.h"
 #include "core/eval/detection_metrics.h"
@@ -315,31 +316,33 @@ absl::Status RunSyntheticSets(const SetContext& ctx) {
   }
   const synth::RoomSensor sensors[] = {synth::RoomSensor::kKinectV1,
                                        synth::RoomSensor::kActiveStereo};
-  // The stacked piles as generated (and, for the Kinect and the active
-  // stereo, with OSD's crop: the table seen only in front of the pile's
-  // middle); time of flight at its own 640 x 576.
-  const synth::RoomSensor stacked_sensors[] = {
-      synth::RoomSensor::kKinectV1, synth::RoomSensor::kActiveStereo,
-      synth::RoomSensor::kTimeOfFlight};
-  const std::pair<std::string,
-                  synth::StackedPile (*)(uint64_t, synth::RoomSensor)>
-      stacked_sets[] = {
-          {"stacked", &synth::GenerateStackedPile},
-          {"stacked-crop", &synth::GenerateCroppedPile},
-          // Every kind (drills, bananas, pens, small parts, towers) seen
-          // from above at each sensor's usual resolution.
-          {"stacked-above", [](uint64_t seed, synth::RoomSensor sensor) {
-             return synth::GenerateStackedPile(seed, sensor,
-                                               synth::AbovePileOptions(sensor));
-           }}};
-  for (const auto& [set, generate] : stacked_sets) {
+  // The stacked piles as generated, with OSD's crop (the table seen only in
+  // front of the pile's middle, as OSD's Kinect frames were cut: the Kinect
+  // and the active stereo), and every kind (drills, bananas, pens, small
+  // parts, towers) seen from above; each at its sensor's usual resolution.
+  const synth::RoomSensor all_sensors[] = {synth::RoomSensor::kKinectV1,
+                                           synth::RoomSensor::kActiveStereo,
+                                           synth::RoomSensor::kTimeOfFlight};
+  struct StackedSet {
+    std::string name;
+    synth::StackedPile (*generate)(uint64_t, synth::RoomSensor);
+    absl::Span<const synth::RoomSensor> sensors;
+  };
+  const StackedSet stacked_sets[] = {
+      {"stacked", &synth::GenerateStackedPile, all_sensors},
+      {"stacked-crop", &synth::GenerateCroppedPile, sensors},
+      {"stacked-above",
+       [](uint64_t seed, synth::RoomSensor sensor) {
+         return synth::GenerateStackedPile(seed, sensor,
+                                           synth::AbovePileOptions(sensor));
+       },
+       all_sensors}};
+  for (const StackedSet& stacked_set : stacked_sets) {
+    const std::string& set = stacked_set.name;
     if (!Wants(o, set)) continue;
-    for (const synth::RoomSensor sensor : stacked_sensors) {
-      if (set == "stacked-crop" && sensor == synth::RoomSensor::kTimeOfFlight) {
-        continue;
-      }
+    for (const synth::RoomSensor sensor : stacked_set.sensors) {
       for (int k = 0; k < o.stacked; ++k) {
-        const synth::StackedPile pile = generate(1 + k, sensor);
+        const synth::StackedPile pile = stacked_set.generate(1 + k, sensor);
         // Object k has label 10 (k + 2), ObjectId k + 2.
         const auto describe = [&pile](int id) {
           const int k = id - 2;
